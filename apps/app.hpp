@@ -1,0 +1,63 @@
+#pragma once
+// What every svokit tool shares: version text, the common options (--quiet, --threads), and the
+// exit protocol (0 ok, 1 check failed, 2 bad input or usage, 3 internal error; one line on
+// stderr per error). Tools stay thin: options → library calls → report.
+
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <new>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+
+namespace svokit::app {
+
+struct CommonOptions {
+  bool quiet = false;
+  std::size_t threads = 0;  // 0 = all cores
+
+  Progress MakeProgress() const { return Progress(quiet ? Progress::Style::kQuiet : Progress::Style::kAuto); }
+};
+
+inline void AddCommonOptions(CLI::App& cli, CommonOptions& options) {
+  cli.set_version_flag("--version", std::string("svokit ") + SVOKIT_VERSION);
+  cli.add_flag("-q,--quiet", options.quiet, "No progress output on stderr");
+  cli.add_option("-j,--threads", options.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, 4096));
+}
+
+/// Prints `status` as one line on stderr and returns its exit code.
+inline int Fail(const std::string& tool, const Status& status) {
+  fmt::print(stderr, "{}: {}\n", tool, status.message());
+  return status.exit_code();
+}
+
+/// Parses the command line and runs `body`, mapping usage errors to exit 2 and anything thrown to
+/// a one-line message with exit 3.
+inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
+               const std::function<int()>& body) {
+  try {
+    try {
+      cli.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+      return cli.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+      return cli.exit(e);
+    } catch (const CLI::ParseError& e) {
+      fmt::print(stderr, "{}: {} (see --help)\n", tool, e.what());
+      return static_cast<int>(StatusCode::kBadInput);
+    }
+    return body();
+  } catch (const std::bad_alloc&) {
+    return Fail(tool, Status::Internal("out of memory"));
+  } catch (const std::exception& e) {
+    return Fail(tool, Status::Internal("internal error: {}", e.what()));
+  }
+}
+
+}  // namespace svokit::app

@@ -1,0 +1,84 @@
+#pragma once
+// The sectioned container every svokit file format shares (.svm, and the later .vfrag and .svo):
+// a fixed header, a table of tagged sections with offsets, sizes and CRC-32C checksums, and the
+// 64-byte-aligned section payloads. Layout: formats/container/README.md.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+
+namespace svokit::container {
+
+using Tag = std::array<char, 4>;
+/// "ABCD" → Tag; the literal must have exactly four characters.
+constexpr Tag MakeTag(const char (&s)[5]) { return {s[0], s[1], s[2], s[3]}; }
+
+inline constexpr std::size_t kHeaderSize = 32;
+inline constexpr std::size_t kSectionEntrySize = 32;
+inline constexpr std::size_t kAlignment = 64;
+
+/// What identifies one format: its 8-byte magic and the newest version this build reads.
+struct FormatId {
+  std::array<char, 8> magic;
+  std::uint32_t version;
+  std::string_view name;  ///< for messages, e.g. "svokit mesh (.svm)"
+};
+
+class Writer {
+ public:
+  Writer(const FormatId& format, std::uint32_t flags) : format_(format), flags_(flags) {}
+  void AddSection(Tag tag, std::vector<std::uint8_t> bytes);
+  /// The whole file as bytes.
+  std::vector<std::uint8_t> Serialize() const;
+  /// Writes atomically (temporary file + rename).
+  Status WriteFile(const std::filesystem::path& path) const;
+
+ private:
+  struct Section {
+    Tag tag;
+    std::vector<std::uint8_t> bytes;
+  };
+  FormatId format_;
+  std::uint32_t flags_;
+  std::vector<Section> sections_;
+};
+
+/// A verified, memory-mapped container file. Open() checks the magic, version, file size,
+/// header checksum, section bounds and every section checksum before returning.
+class Reader {
+ public:
+  static StatusOr<Reader> Open(const std::filesystem::path& path, const FormatId& format);
+  /// Verifies in-memory bytes (they must outlive the Reader); `name` is used in messages.
+  static StatusOr<Reader> FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                                    const FormatId& format);
+
+  std::uint32_t version() const { return version_; }
+  std::uint32_t flags() const { return flags_; }
+  const std::string& name() const { return name_; }
+  /// The section with this tag, if present.
+  std::optional<std::span<const std::uint8_t>> Find(Tag tag) const;
+  /// Like Find, but a missing section is an error naming the file.
+  StatusOr<std::span<const std::uint8_t>> Require(Tag tag) const;
+
+ private:
+  struct Mapping;
+  struct Entry {
+    Tag tag;
+    std::span<const std::uint8_t> bytes;
+  };
+  std::shared_ptr<Mapping> mapping_;
+  std::string name_;
+  std::uint32_t version_ = 0;
+  std::uint32_t flags_ = 0;
+  std::vector<Entry> entries_;
+};
+
+}  // namespace svokit::container

@@ -1,0 +1,113 @@
+#include "svokit/core/file_io.hpp"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+namespace svokit {
+
+StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::BadInput("{}: is a directory, not a file", path.string());
+  }
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return Status::BadInput("{}: cannot open ({})", path.string(), std::strerror(errno));
+  std::vector<std::uint8_t> bytes;
+  std::uint8_t buf[1 << 16];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.insert(bytes.end(), buf, buf + n);
+  const bool failed = std::ferror(f);
+  std::fclose(f);
+  if (failed) return Status::BadInput("{}: read error", path.string());
+  return bytes;
+}
+
+std::string LowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+AtomicFileWriter::AtomicFileWriter(std::filesystem::path path) : path_(std::move(path)) {}
+
+AtomicFileWriter::~AtomicFileWriter() { Discard(); }
+
+void AtomicFileWriter::Discard() {
+  if (file_) {
+    std::fclose(file_);
+    file_ = nullptr;
+  }
+  if (!temp_path_.empty()) {
+    ::unlink(temp_path_.c_str());
+    temp_path_.clear();
+  }
+}
+
+Status AtomicFileWriter::Open() {
+  std::filesystem::path dir = path_.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return Status::BadInput("{}: output directory does not exist", path_.string());
+  }
+  std::string templ = (dir / ("." + path_.filename().string() + ".tmp.XXXXXX")).string();
+  const int fd = ::mkstemp(templ.data());
+  if (fd < 0) {
+    return Status::BadInput("{}: cannot create output ({})", path_.string(), std::strerror(errno));
+  }
+  ::fchmod(fd, 0644);
+  temp_path_ = templ;
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    ::close(fd);
+    Discard();
+    return Status::Internal("{}: fdopen failed", path_.string());
+  }
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::Write(std::span<const std::uint8_t> bytes) {
+  if (!file_) return Status::Internal("{}: write to a writer that is not open", path_.string());
+  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
+    const int err = errno;
+    Discard();
+    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+  }
+  bytes_written_ += bytes.size();
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::Commit() {
+  if (!file_) return Status::Internal("{}: commit of a writer that is not open", path_.string());
+  const bool flushed = std::fflush(file_) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!flushed || !closed) {
+    const int err = errno;
+    Discard();
+    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+  }
+  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+    const int err = errno;
+    Discard();
+    return Status::Internal("{}: cannot rename into place ({})", path_.string(),
+                            std::strerror(err));
+  }
+  temp_path_.clear();
+  return Status::Ok();
+}
+
+Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {
+  AtomicFileWriter writer(path);
+  SVOKIT_RETURN_IF_ERROR(writer.Open());
+  SVOKIT_RETURN_IF_ERROR(writer.Write(bytes));
+  return writer.Commit();
+}
+
+}  // namespace svokit

@@ -1,0 +1,52 @@
+#pragma once
+// Whole-file reads and atomic writes: an output file either appears complete or not at all.
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+
+namespace svokit {
+
+/// Reads a whole file. Errors name the file: "PATH: cannot open (No such file or directory)".
+StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path);
+
+/// Lower-case extension without the dot ("obj" for "Model.OBJ").
+std::string LowerExtension(const std::filesystem::path& path);
+
+/// Writes to a temporary file beside `path` and renames it into place on Commit(). Destroying an
+/// uncommitted writer removes the temporary, so a failed run never leaves a partial output.
+class AtomicFileWriter {
+ public:
+  explicit AtomicFileWriter(std::filesystem::path path);
+  ~AtomicFileWriter();
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+  /// Creates the temporary file; must succeed before Write.
+  Status Open();
+  Status Write(std::span<const std::uint8_t> bytes);
+  Status Write(const void* data, std::size_t size) {
+    return Write({static_cast<const std::uint8_t*>(data), size});
+  }
+  /// Flushes, closes and renames onto the final path.
+  Status Commit();
+  std::uint64_t bytes_written() const { return bytes_written_; }
+
+ private:
+  void Discard();
+
+  std::filesystem::path path_;
+  std::string temp_path_;
+  std::FILE* file_ = nullptr;
+  std::uint64_t bytes_written_ = 0;
+};
+
+/// Writes `bytes` to `path` atomically.
+Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
+
+}  // namespace svokit

@@ -1,0 +1,53 @@
+#pragma once
+// 64-bit Morton keys, 21 bits per axis: bit 3i is bit i of x, 3i+1 of y, 3i+2 of z. Sorting keys
+// orders voxels along the Z-curve, so every octree node is a contiguous key range.
+
+#include <cstdint>
+
+namespace svokit {
+
+inline constexpr int kMortonBitsPerAxis = 21;
+inline constexpr std::uint32_t kMortonAxisLimit = 1u << kMortonBitsPerAxis;  // exclusive
+
+namespace detail {
+constexpr std::uint64_t SpreadBits3(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+constexpr std::uint32_t CompactBits3(std::uint64_t v) {
+  v &= 0x1249249249249249ULL;
+  v = (v ^ (v >> 2)) & 0x10c30c30c30c30c3ULL;
+  v = (v ^ (v >> 4)) & 0x100f00f00f00f00fULL;
+  v = (v ^ (v >> 8)) & 0x1f0000ff0000ffULL;
+  v = (v ^ (v >> 16)) & 0x1f00000000ffffULL;
+  v = (v ^ (v >> 32)) & 0x1fffffULL;
+  return static_cast<std::uint32_t>(v);
+}
+}  // namespace detail
+
+/// Morton key of voxel (x, y, z); each coordinate must be < kMortonAxisLimit.
+constexpr std::uint64_t MortonEncode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  return detail::SpreadBits3(x) | detail::SpreadBits3(y) << 1 | detail::SpreadBits3(z) << 2;
+}
+
+struct MortonCoord {
+  std::uint32_t x, y, z;
+  constexpr bool operator==(const MortonCoord&) const = default;
+};
+
+constexpr MortonCoord MortonDecode(std::uint64_t key) {
+  return {detail::CompactBits3(key), detail::CompactBits3(key >> 1), detail::CompactBits3(key >> 2)};
+}
+
+/// Key of the ancestor `levels` levels up (each level drops one bit per axis).
+constexpr std::uint64_t MortonParent(std::uint64_t key, int levels = 1) { return key >> (3 * levels); }
+
+/// Which of the 8 children of its parent a key is (bit 0: x, bit 1: y, bit 2: z).
+constexpr unsigned MortonChildIndex(std::uint64_t key) { return static_cast<unsigned>(key & 7u); }
+
+}  // namespace svokit

@@ -1,0 +1,53 @@
+#pragma once
+// Parallel helpers on TBB. Work is split into chunks whose boundaries depend only on the problem
+// size, never on the thread count, and results are combined in chunk order: deterministic output.
+
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+namespace svokit {
+
+/// Limits TBB to `threads` worker threads for this object's lifetime (0 = all cores).
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(std::size_t threads) {
+    if (threads > 0) {
+      control_ = std::make_unique<tbb::global_control>(
+          tbb::global_control::max_allowed_parallelism, threads);
+    }
+  }
+
+ private:
+  std::unique_ptr<tbb::global_control> control_;
+};
+
+/// Calls body(begin, end) on fixed chunks of [0, n) in parallel.
+template <class Body>
+void ParallelChunks(std::size_t n, std::size_t chunk, const Body& body) {
+  chunk = std::max<std::size_t>(chunk, 1);
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    body(c * chunk, std::min(n, (c + 1) * chunk));
+  });
+}
+
+/// Deterministic reduction: map(begin, end) → T per fixed chunk in parallel, then
+/// combine(acc, part) left to right in chunk order.
+template <class T, class Map, class Combine>
+T OrderedReduce(std::size_t n, std::size_t chunk, T init, const Map& map, const Combine& combine) {
+  chunk = std::max<std::size_t>(chunk, 1);
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  std::vector<T> parts(chunks, init);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    parts[c] = map(c * chunk, std::min(n, (c + 1) * chunk));
+  });
+  for (auto& p : parts) combine(init, p);
+  return init;
+}
+
+}  // namespace svokit

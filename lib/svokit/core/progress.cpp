@@ -1,0 +1,74 @@
+#include "svokit/core/progress.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace svokit {
+
+Progress::Progress(Style style, std::FILE* out) : style_(style), out_(out) {
+  if (style_ == Style::kAuto) style_ = ::isatty(::fileno(out_)) ? Style::kBar : Style::kLines;
+}
+
+Progress& Progress::Silent() {
+  static Progress silent(Style::kQuiet);
+  return silent;
+}
+
+Progress::Stage::Stage(Progress& progress, std::string name, std::uint64_t total)
+    : progress_(progress),
+      name_(std::move(name)),
+      total_(total),
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_) {
+  if (progress_.style_ == Style::kBar) Draw(false);
+}
+
+Progress::Stage::~Stage() {
+  done_ = total_;
+  Draw(true);
+}
+
+double Progress::Stage::seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void Progress::Stage::Advance(std::uint64_t units) {
+  done_.fetch_add(units, std::memory_order_relaxed);
+  if (progress_.style_ != Style::kBar) return;
+  // Redraw at most every 100 ms, and never block a worker on another one's drawing.
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_draw_ < std::chrono::milliseconds(100)) return;
+  std::unique_lock lock(draw_mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;
+  last_draw_ = now;
+  Draw(false);
+}
+
+void Progress::Stage::Draw(bool final) {
+  std::FILE* out = progress_.out_;
+  const std::string tail = summary_.empty() ? "" : "  " + summary_;
+  switch (progress_.style_) {
+    case Style::kQuiet:
+    case Style::kAuto:
+      return;
+    case Style::kLines:
+      if (final) fmt::print(out, "{:<12} done in {:.2f} s{}\n", name_, seconds(), tail);
+      break;
+    case Style::kBar: {
+      constexpr int kWidth = 30;
+      const double frac =
+          total_ == 0 ? 1.0 : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
+      const int filled = static_cast<int>(frac * kWidth);
+      fmt::print(out, "\r{:<12} [{}{}] {:3.0f}% {:.1f} s{}\x1b[K{}", name_, std::string(filled, '#'),
+                 std::string(kWidth - filled, '.'), frac * 100.0, seconds(), final ? tail : "",
+                 final ? "\n" : "");
+      break;
+    }
+  }
+  std::fflush(out);
+}
+
+}  // namespace svokit

@@ -1,0 +1,57 @@
+#pragma once
+// Progress reporting on stderr: a redrawn bar on a terminal, one line per finished stage
+// otherwise (logs and CI stay readable), nothing at all when quiet.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <mutex>
+#include <string>
+
+namespace svokit {
+
+class Progress {
+ public:
+  enum class Style { kAuto, kBar, kLines, kQuiet };
+
+  /// kAuto picks kBar when `out` is a terminal, kLines otherwise.
+  explicit Progress(Style style = Style::kAuto, std::FILE* out = stderr);
+  /// A reporter that prints nothing.
+  static Progress& Silent();
+
+  Style style() const { return style_; }
+
+  /// One named stage with `total` work units; finishes (and prints its line) on destruction.
+  class Stage {
+   public:
+    Stage(Progress& progress, std::string name, std::uint64_t total);
+    ~Stage();
+    Stage(const Stage&) = delete;
+    Stage& operator=(const Stage&) = delete;
+
+    /// Thread-safe; cheap enough to call from parallel loops once per chunk.
+    void Advance(std::uint64_t units = 1);
+    /// Text appended to the stage's final line (e.g. "1.2 M triangles").
+    void SetSummary(std::string summary) { summary_ = std::move(summary); }
+    double seconds() const;
+
+   private:
+    void Draw(bool final);
+
+    Progress& progress_;
+    std::string name_;
+    std::string summary_;
+    std::uint64_t total_;
+    std::atomic<std::uint64_t> done_{0};
+    std::chrono::steady_clock::time_point start_;
+    std::chrono::steady_clock::time_point last_draw_;
+    std::mutex draw_mutex_;
+  };
+
+ private:
+  Style style_;
+  std::FILE* out_;
+};
+
+}  // namespace svokit

@@ -1,0 +1,77 @@
+#include "svokit/mesh/import.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+
+#include "formats/svm/svm.hpp"
+#include "svokit/core/file_io.hpp"
+#include "svokit/mesh/importers.hpp"
+
+namespace svokit {
+
+const std::vector<std::string>& SupportedMeshExtensions() {
+  static const std::vector<std::string> kExtensions = {"obj", "ply", "off", "stl",
+                                                       "gltf", "glb", "drc", "svm"};
+  return kExtensions;
+}
+
+StatusOr<Mesh> ImportMesh(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return Status::BadInput("{}: no such file", name);
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return Status::BadInput("{}: not a regular file", name);
+  }
+  if (::access(path.c_str(), R_OK) != 0) return Status::BadInput("{}: not readable", name);
+
+  const std::string ext = LowerExtension(path);
+  StatusOr<Mesh> mesh = Status::BadInput(
+      "{}: unknown mesh format '.{}' (supported: .obj .ply .off .stl .gltf .glb .drc .svm)", name,
+      ext);
+  if (ext == "obj") {
+    mesh = detail::ImportObj(path);
+  } else if (ext == "ply") {
+    mesh = detail::ImportPly(path);
+  } else if (ext == "off") {
+    mesh = detail::ImportOff(path);
+  } else if (ext == "stl") {
+    mesh = detail::ImportStl(path);
+  } else if (ext == "gltf" || ext == "glb") {
+    mesh = detail::ImportGltf(path);
+  } else if (ext == "drc") {
+    mesh = detail::ImportDracoFile(path);
+  } else if (ext == "svm") {
+    mesh = ReadSvm(path);
+  }
+  if (!mesh.ok()) return mesh;
+  SVOKIT_RETURN_IF_ERROR(ValidateAndSanitize(*mesh, name));
+  return mesh;
+}
+
+namespace detail {
+
+void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
+                       Material& material, Mesh& mesh) {
+  std::filesystem::path file = uri;
+  if (file.is_relative()) file = base_dir / file;
+  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file);
+  if (!bytes.ok() || bytes->empty()) {
+    material.missing_texture = uri;
+    mesh.warnings.push_back(fmt::format("material '{}': texture '{}' not found, using base colour",
+                                        material.name, uri));
+    return;
+  }
+  // Several materials often share one image: embed it once.
+  for (std::size_t i = 0; i < mesh.textures.size(); ++i) {
+    if (mesh.textures[i].name() == uri && mesh.textures[i].encoded() == *bytes) {
+      material.texture = static_cast<std::int32_t>(i);
+      return;
+    }
+  }
+  mesh.textures.emplace_back(uri, std::move(bytes).value());
+  material.texture = static_cast<std::int32_t>(mesh.textures.size() - 1);
+}
+
+}  // namespace detail
+}  // namespace svokit

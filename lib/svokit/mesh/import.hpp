@@ -1,0 +1,23 @@
+#pragma once
+// Mesh import: any supported file → Mesh, validated. The format is chosen by extension:
+//   .obj (+.mtl) .ply .off .stl  via OpenMesh's readers
+//   .gltf .glb                   via tinygltf (+ Draco for KHR_draco_mesh_compression)
+//   .drc                         via Draco
+//   .svm                         svokit's normalized mesh (formats/svm)
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+#include "svokit/mesh/mesh.hpp"
+
+namespace svokit {
+
+/// Extensions ImportMesh accepts, lower case without the dot.
+const std::vector<std::string>& SupportedMeshExtensions();
+
+/// Reads, triangulates and validates a mesh. Every error message starts with the file name.
+StatusOr<Mesh> ImportMesh(const std::filesystem::path& path);
+
+}  // namespace svokit
