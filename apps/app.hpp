@@ -4,7 +4,9 @@
 // stderr per error). Tools stay thin: options → library calls → report.
 
 #include <cstdio>
+#include <algorithm>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <new>
 #include <string>
@@ -12,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 
@@ -29,6 +32,24 @@ inline void AddCommonOptions(CLI::App& cli, CommonOptions& options) {
   cli.add_flag("-q,--quiet", options.quiet, "No progress output on stderr");
   cli.add_option("-j,--threads", options.threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 4096));
+}
+
+/// Checks an output path before any work is done: its extension is one of `extensions` and its
+/// directory exists, so a long run never ends in "cannot write".
+inline Status CheckOutputPath(const std::filesystem::path& path,
+                              const std::vector<std::string>& extensions) {
+  const std::string ext = LowerExtension(path);
+  if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+    std::string list;
+    for (const std::string& e : extensions) list += (list.empty() ? "." : ", .") + e;
+    return Status::BadInput("{}: output must be a {} file", path.string(), list);
+  }
+  const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return Status::BadInput("{}: output directory does not exist", path.string());
+  }
+  return Status::Ok();
 }
 
 /// Prints `status` as one line on stderr and returns its exit code.

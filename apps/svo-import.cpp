@@ -27,8 +27,8 @@ int main(int argc, char** argv) {
   app::AddCommonOptions(cli, common);
 
   return app::Run(tool, cli, argc, argv, [&] {
-    if (!output.empty() && LowerExtension(output) != "svm") {
-      return app::Fail(tool, Status::BadInput("{}: output must be a .svm file", output.string()));
+    if (!output.empty()) {
+      if (Status s = app::CheckOutputPath(output, {"svm"}); !s.ok()) return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
@@ -37,16 +37,21 @@ int main(int argc, char** argv) {
     {
       Progress::Stage stage(progress, "import", 1);
       mesh = ImportMesh(input);
+      if (!mesh.ok()) stage.Cancel();
       if (mesh.ok()) stage.SetSummary(fmt::format("{} triangles", mesh->triangle_count()));
     }
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
 
     const MeshReport report = AnalyzeMesh(*mesh, input.string(), report_options, progress);
     if (!output.empty()) {
-      Progress::Stage stage(progress, "write", 1);
-      const Status written = WriteSvm(*mesh, input.filename().string(), output);
+      Status written;
+      {
+        Progress::Stage stage(progress, "write", 1);
+        written = WriteSvm(*mesh, input.filename().string(), output);
+        if (!written.ok()) stage.Cancel();
+        stage.SetSummary(output.string());
+      }
       if (!written.ok()) return app::Fail(tool, written);
-      stage.SetSummary(output.string());
     }
     const std::string text = json ? FormatReportJson(report) : FormatReportText(report);
     std::fwrite(text.data(), 1, text.size(), stdout);

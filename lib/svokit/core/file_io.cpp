@@ -27,10 +27,11 @@ StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& p
 }
 
 std::string LowerExtension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string dotted = path.extension().string();
+  std::string ext;
+  for (std::size_t i = dotted.starts_with('.') ? 1 : 0; i < dotted.size(); ++i) {
+    ext.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(dotted[i]))));
+  }
   return ext;
 }
 
@@ -56,7 +57,8 @@ Status AtomicFileWriter::Open() {
   if (!std::filesystem::is_directory(dir, ec)) {
     return Status::BadInput("{}: output directory does not exist", path_.string());
   }
-  std::string templ = (dir / ("." + path_.filename().string() + ".tmp.XXXXXX")).string();
+  // Hidden, in the same directory (rename is atomic only within one file system).
+  std::string templ = fmt::format("{}/.{}.tmp.XXXXXX", dir.string(), path_.filename().string());
   const int fd = ::mkstemp(templ.data());
   if (fd < 0) {
     return Status::BadInput("{}: cannot create output ({})", path_.string(), std::strerror(errno));

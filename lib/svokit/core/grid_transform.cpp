@@ -9,6 +9,10 @@ namespace svokit {
 
 namespace {
 
+// Fitting to N voxels spans the longest extent over N − 2⁻¹⁰ voxels: 2⁻¹¹ voxel of air on both
+// sides, far above the rounding of the mapping (< 2⁻³² voxel even at 2²⁰ voxels).
+constexpr double kInsideMargin = 1.0 / 1024;
+
 StatusOr<GridTransform> FitCentred(const Box3d& bounds, double h, std::uint32_t pad) {
   if (bounds.empty() || !IsFinite(bounds.lo) || !IsFinite(bounds.hi)) {
     return Status::BadInput("cannot fit a grid to empty or non-finite bounds");
@@ -53,7 +57,7 @@ StatusOr<GridTransform> GridTransform::FitResolution(const Box3d& bounds, std::u
   if (bounds.empty() || !(longest > 0.0)) {
     return Status::BadInput("the mesh has no extent (all vertices coincide)");
   }
-  const double h = longest / resolution * (1.0 + std::ldexp(1.0, -20));
+  const double h = longest / (resolution - kInsideMargin);
   return FitCentred(bounds, h, pad);
 }
 

@@ -24,9 +24,9 @@ class GridTransform {
       : origin_(origin), voxel_size_(voxel_size), dims_(dims) {}
 
   /// A grid with `resolution` voxels along the longest axis of `bounds`, the mesh centred, plus
-  /// `pad` empty voxels on every side. The voxel size is stretched by 2^-20 (one part per million)
-  /// so the bounds lie strictly inside the grid: a conservative voxelization touches the closed
-  /// boxes of boundary voxels, and a vertex exactly on the outer face would need one more voxel.
+  /// `pad` empty voxels on every side. The longest extent spans N − 2⁻¹⁰ voxels, so the bounds lie
+  /// strictly inside the grid: a conservative voxelization touches the closed boxes of voxels, and
+  /// a vertex exactly on the grid's outer face would need one more layer.
   static StatusOr<GridTransform> FitResolution(const Box3d& bounds, std::uint32_t resolution,
                                                std::uint32_t pad = 0);
   /// A grid of voxels of size `voxel_size` around `bounds`, centred, plus `pad` voxels per side.

@@ -27,6 +27,10 @@ Progress::Stage::Stage(Progress& progress, std::string name, std::uint64_t total
 }
 
 Progress::Stage::~Stage() {
+  if (cancelled_) {
+    if (progress_.style_ == Style::kBar) fmt::print(progress_.out_, "\r\x1b[K");
+    return;
+  }
   done_ = total_;
   Draw(true);
 }

@@ -32,6 +32,8 @@ class Progress {
 
     /// Thread-safe; cheap enough to call from parallel loops once per chunk.
     void Advance(std::uint64_t units = 1);
+    /// The stage failed: no "done" line (a bar is erased instead).
+    void Cancel() { cancelled_ = true; }
     /// Text appended to the stage's final line (e.g. "1.2 M triangles").
     void SetSummary(std::string summary) { summary_ = std::move(summary); }
     double seconds() const;
@@ -43,6 +45,7 @@ class Progress {
     std::string name_;
     std::string summary_;
     std::uint64_t total_;
+    bool cancelled_ = false;
     std::atomic<std::uint64_t> done_{0};
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_draw_;

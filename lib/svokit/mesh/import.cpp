@@ -53,7 +53,10 @@ namespace detail {
 
 void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
                        Material& material, Mesh& mesh) {
-  std::filesystem::path file = uri;
+  // Windows exporters write "textures\\wood.jpg"; on POSIX that is one odd file name.
+  std::string portable = uri;
+  std::replace(portable.begin(), portable.end(), '\\', '/');
+  std::filesystem::path file = portable;
   if (file.is_relative()) file = base_dir / file;
   StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file);
   if (!bytes.ok() || bytes->empty()) {

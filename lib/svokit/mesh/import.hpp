@@ -1,6 +1,6 @@
 #pragma once
 // Mesh import: any supported file → Mesh, validated. The format is chosen by extension:
-//   .obj (+.mtl) .ply .off .stl  via OpenMesh's readers
+//   .obj (+.mtl) .ply .off .stl  svokit's own strict parsers (README: why not OpenMesh's)
 //   .gltf .glb                   via tinygltf (+ Draco for KHR_draco_mesh_compression)
 //   .drc                         via Draco
 //   .svm                         svokit's normalized mesh (formats/svm)

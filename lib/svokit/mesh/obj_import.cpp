@@ -200,7 +200,9 @@ class ObjParser {
           fmt::format("material library '{}' not found; its materials are white", file));
       return Status::Ok();
     }
-    TextScanner mtl(AsText(*bytes), mtl_path.string());
+    StatusOr<std::string_view> text = TextOf(*bytes, mtl_path.string());
+    if (!text.ok()) return text.status();
+    TextScanner mtl(*text, mtl_path.string());
     Material* m = nullptr;
     while (mtl.NextContentLine()) {
       const std::string_view key = mtl.Token();
@@ -290,7 +292,9 @@ class ObjParser {
 StatusOr<Mesh> ImportObj(const std::filesystem::path& path) {
   StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(path);
   if (!bytes.ok()) return bytes.status();
-  ObjParser parser(path, AsText(*bytes));
+  StatusOr<std::string_view> text = TextOf(*bytes, path.string());
+  if (!text.ok()) return text.status();
+  ObjParser parser(path, *text);
   return parser.Parse();
 }
 

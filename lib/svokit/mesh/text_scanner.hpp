@@ -115,4 +115,16 @@ inline std::string_view AsText(std::span<const std::uint8_t> bytes) {
   return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
 }
 
+/// Views a text file's bytes as UTF-8/ASCII text, skipping a UTF-8 byte order mark; UTF-16 files
+/// (which some Windows exporters write) are rejected with a clear message rather than misparsed.
+inline StatusOr<std::string_view> TextOf(std::span<const std::uint8_t> bytes,
+                                         const std::string& file) {
+  std::string_view text = AsText(bytes);
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  if (text.starts_with("\xFE\xFF") || text.starts_with("\xFF\xFE")) {
+    return Status::BadInput("{}: UTF-16 text is not supported (save the file as UTF-8)", file);
+  }
+  return text;
+}
+
 }  // namespace svokit::detail

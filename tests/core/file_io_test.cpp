@@ -1,0 +1,74 @@
+#include "svokit/core/file_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/test_util.hpp"
+
+namespace svokit {
+namespace {
+
+using test::TempDir;
+
+TEST(AtomicFileWriter, CommitPublishesCompleteFile) {
+  TempDir dir;
+  const auto target = dir / "out.bin";
+  AtomicFileWriter w(target);
+  ASSERT_TRUE(w.Open().ok());
+  ASSERT_TRUE(w.Write("hello ", 6).ok());
+  // Nothing is visible under the final name until Commit.
+  EXPECT_FALSE(std::filesystem::exists(target));
+  ASSERT_TRUE(w.Write("world", 5).ok());
+  ASSERT_TRUE(w.Commit().ok());
+  EXPECT_EQ(test::ReadText(target), "hello world");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.bin"});
+}
+
+TEST(AtomicFileWriter, AbandonedWriteLeavesNothing) {
+  TempDir dir;
+  {
+    AtomicFileWriter w(dir / "out.bin");
+    ASSERT_TRUE(w.Open().ok());
+    ASSERT_TRUE(w.Write("partial", 7).ok());
+  }
+  EXPECT_TRUE(dir.Files().empty());
+}
+
+TEST(AtomicFileWriter, AbandonedRewriteKeepsOldFile) {
+  TempDir dir;
+  const auto target = dir.Write("out.bin", std::string("old"));
+  {
+    AtomicFileWriter w(target);
+    ASSERT_TRUE(w.Open().ok());
+    ASSERT_TRUE(w.Write("new but unfinished", 18).ok());
+  }
+  EXPECT_EQ(test::ReadText(target), "old");
+}
+
+TEST(AtomicFileWriter, MissingDirectoryIsBadInput) {
+  TempDir dir;
+  AtomicFileWriter w(dir / "no" / "such" / "out.bin");
+  const Status s = w.Open();
+  EXPECT_EQ(s.code(), StatusCode::kBadInput);
+  EXPECT_NE(s.message().find("out.bin"), std::string::npos);
+}
+
+TEST(ReadFileBytes, ErrorsNameTheFile) {
+  TempDir dir;
+  const auto missing = dir / "missing.obj";
+  auto r = ReadFileBytes(missing);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
+  EXPECT_EQ(r.status().message().rfind(missing.string(), 0), 0u);
+  EXPECT_FALSE(ReadFileBytes(dir.path()).ok());
+  const auto p = dir.Write("x.bin", std::vector<std::uint8_t>{1, 2, 3});
+  EXPECT_EQ(*ReadFileBytes(p), (std::vector<std::uint8_t>{1, 2, 3}));
+}
+
+TEST(LowerExtension, Basics) {
+  EXPECT_EQ(LowerExtension("a/b/Model.OBJ"), "obj");
+  EXPECT_EQ(LowerExtension("x.tar.GZ"), "gz");
+  EXPECT_EQ(LowerExtension("noext"), "");
+}
+
+}  // namespace
+}  // namespace svokit

@@ -1,0 +1,120 @@
+#include "formats/svm/svm.hpp"
+
+#include <gtest/gtest.h>
+
+#include "svokit/core/file_io.hpp"
+#include "svokit/mesh/import.hpp"
+#include "tests/test_util.hpp"
+
+namespace svokit {
+namespace {
+
+Mesh RichMesh() {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1.0000000000000002}};
+  m.triangles = {{0, 1, 2}, {0, 1, 3}};
+  m.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, -1, 0}, {0, -1, 0}, {0, -1, 0}};
+  m.uvs = {{0, 0}, {1, 0}, {0, 1}, {0.25f, 0.5f}, {0.75f, 0.5f}, {1, 1}};
+  m.colors = std::vector<Rgba>(6, Rgba{0.5f, 0.25f, 0.125f, 1});
+  m.materials = {{.name = "plain", .base_color = {0.2f, 0.4f, 0.6f, 1}},
+                 {.name = "textured", .texture = 0},
+                 {.name = "lost", .missing_texture = "gone.png"}};
+  m.material_ids = {1, 0};
+  m.textures.emplace_back("tex.png", std::vector<std::uint8_t>{0x89, 'P', 'N', 'G', 1, 2, 3});
+  m.warnings = {"material 'lost': texture 'gone.png' not found, using base colour"};
+  return m;
+}
+
+void ExpectSameMesh(const Mesh& a, const Mesh& b) {
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.uvs, b.uvs);
+  EXPECT_EQ(a.colors, b.colors);
+  EXPECT_EQ(a.material_ids, b.material_ids);
+  EXPECT_EQ(a.materials, b.materials);
+  ASSERT_EQ(a.textures.size(), b.textures.size());
+  for (std::size_t i = 0; i < a.textures.size(); ++i) {
+    EXPECT_EQ(a.textures[i].name(), b.textures[i].name());
+    EXPECT_EQ(a.textures[i].encoded(), b.textures[i].encoded());
+    EXPECT_EQ(a.textures[i].srgb(), b.textures[i].srgb());
+  }
+  EXPECT_EQ(a.warnings, b.warnings);
+}
+
+TEST(Svm, RoundTripIsExactAndDeterministic) {
+  const Mesh m = RichMesh();
+  const auto bytes = EncodeSvm(m, "rich.obj");
+  EXPECT_EQ(EncodeSvm(m, "rich.obj"), bytes);
+  auto back = DecodeSvm(bytes, "mem.svm");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ExpectSameMesh(m, *back);
+}
+
+TEST(Svm, RoundTripWithoutOptionalAttributes) {
+  Mesh m = RichMesh();
+  m.normals.clear();
+  m.uvs.clear();
+  m.colors.clear();
+  auto back = DecodeSvm(EncodeSvm(m, "x"), "mem.svm");
+  ASSERT_TRUE(back.ok());
+  ExpectSameMesh(m, *back);
+}
+
+TEST(Svm, FileRoundTripOfImportedTexturedMesh) {
+  test::TempDir dir;
+  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_TRUE(WriteSvm(*mesh, "uv-torus.obj", dir / "t.svm").ok());
+  auto back = ImportMesh(dir / "t.svm");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ExpectSameMesh(*mesh, *back);
+  // The embedded texture still decodes after the trip.
+  auto image = back->textures.at(0).Decoded();
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  EXPECT_EQ((*image)->width, 64);
+}
+
+TEST(Svm, CorruptionAndTruncationAreBadInput) {
+  const auto clean = EncodeSvm(RichMesh(), "rich.obj");
+  int detected = 0;
+  for (std::size_t i = 0; i < clean.size(); i += 3) {
+    auto bytes = clean;
+    bytes[i] ^= 0x10;
+    auto r = DecodeSvm(bytes, "bad.svm");
+    if (!r.ok()) {
+      ++detected;
+      EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
+      EXPECT_EQ(r.status().message().rfind("bad.svm: ", 0), 0u) << r.status().message();
+    }
+  }
+  EXPECT_GT(detected, static_cast<int>(clean.size() / 3 * 7 / 10));  // all but alignment padding
+  for (std::size_t n : {std::size_t{0}, std::size_t{10}, clean.size() / 2, clean.size() - 1}) {
+    std::vector<std::uint8_t> cut(clean.begin(), clean.begin() + static_cast<std::ptrdiff_t>(n));
+    auto r = DecodeSvm(cut, "cut.svm");
+    ASSERT_FALSE(r.ok()) << n;
+    EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
+  }
+}
+
+TEST(Svm, InconsistentSectionSizesAreRejected) {
+  // A well-formed container whose MTID section disagrees with the triangle count.
+  container::Writer w(kSvmFormat, 0);
+  const std::vector<Vec3d> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<Triangle> tris = {{0, 1, 2}};
+  auto raw = [](const auto& v) {
+    const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
+    return std::vector<std::uint8_t>(p, p + v.size() * sizeof(v[0]));
+  };
+  w.AddSection(container::MakeTag("POSI"), raw(pos));
+  w.AddSection(container::MakeTag("TRIS"), raw(tris));
+  w.AddSection(container::MakeTag("MTID"), {0, 0});
+  w.AddSection(container::MakeTag("MATL"), {0, 0, 0, 0});
+  w.AddSection(container::MakeTag("TEXS"), {0, 0, 0, 0});
+  auto r = DecodeSvm(w.Serialize(), "odd.svm");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("MTID"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace svokit
