@@ -3,16 +3,16 @@
 // exit protocol (0 ok, 1 check failed, 2 bad input or usage, 3 internal error; one line on
 // stderr per error). Tools stay thin: options → library calls → report.
 
-#include <cstdio>
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <new>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
@@ -24,7 +24,9 @@ struct CommonOptions {
   bool quiet = false;
   std::size_t threads = 0;  // 0 = all cores
 
-  Progress MakeProgress() const { return Progress(quiet ? Progress::Style::kQuiet : Progress::Style::kAuto); }
+  Progress MakeProgress() const {
+    return Progress(quiet ? Progress::Style::kQuiet : Progress::Style::kAuto);
+  }
 };
 
 inline void AddCommonOptions(CLI::App& cli, CommonOptions& options) {

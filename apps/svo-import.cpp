@@ -12,9 +12,10 @@
 int main(int argc, char** argv) {
   using namespace svokit;
   const std::string tool = "svo-import";
-  CLI::App cli{"Reads a mesh (OBJ+MTL, PLY, OFF, STL, glTF/GLB incl. Draco, DRC, SVM), prints a "
-               "report and writes a normalized mesh (.svm) for svo-voxelize.",
-               tool};
+  CLI::App cli{
+      "Reads a mesh (OBJ+MTL, PLY, OFF, STL, glTF/GLB incl. Draco, DRC, SVM), prints a "
+      "report and writes a normalized mesh (.svm) for svo-voxelize.",
+      tool};
   std::filesystem::path input, output;
   bool json = false;
   ReportOptions report_options;

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -15,9 +15,15 @@
 
 namespace svokit::test {
 
-inline std::filesystem::path DataDir() { return SVOKIT_DATA_DIR; }
-inline std::filesystem::path CgalMeshes() { return SVOKIT_CGAL_MESHES; }
-inline std::filesystem::path AssimpModels() { return SVOKIT_ASSIMP_MODELS; }
+inline std::filesystem::path DataDir() {
+  return SVOKIT_DATA_DIR;
+}
+inline std::filesystem::path CgalMeshes() {
+  return SVOKIT_CGAL_MESHES;
+}
+inline std::filesystem::path AssimpModels() {
+  return SVOKIT_ASSIMP_MODELS;
+}
 
 /// A fresh directory under the system temp dir, removed with its contents on destruction.
 class TempDir {
@@ -80,12 +86,12 @@ inline bool TestDataRequired() {
 }
 
 /// Skips the test (or fails it, see TestDataRequired) when a Debian test-data file is absent.
-#define SVOKIT_REQUIRE_FILE(path)                                                    \
-  do {                                                                              \
-    if (!std::filesystem::exists(path)) {                                           \
-      if (::svokit::test::TestDataRequired()) FAIL() << "missing test data " << (path); \
+#define SVOKIT_REQUIRE_FILE(path)                                                          \
+  do {                                                                                     \
+    if (!std::filesystem::exists(path)) {                                                  \
+      if (::svokit::test::TestDataRequired()) FAIL() << "missing test data " << (path);    \
       GTEST_SKIP() << "missing test data " << (path) << " (run scripts/deps --test-data)"; \
-    }                                                                               \
+    }                                                                                      \
   } while (false)
 
 }  // namespace svokit::test

@@ -16,7 +16,9 @@ namespace svokit::container {
 
 namespace {
 
-std::size_t AlignUp(std::size_t n) { return (n + kAlignment - 1) / kAlignment * kAlignment; }
+std::size_t AlignUp(std::size_t n) {
+  return (n + kAlignment - 1) / kAlignment * kAlignment;
+}
 
 std::string TagString(Tag tag) {
   std::string s(tag.begin(), tag.end());

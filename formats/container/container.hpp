@@ -19,7 +19,9 @@ namespace svokit::container {
 
 using Tag = std::array<char, 4>;
 /// "ABCD" → Tag; the literal must have exactly four characters.
-constexpr Tag MakeTag(const char (&s)[5]) { return {s[0], s[1], s[2], s[3]}; }
+constexpr Tag MakeTag(const char (&s)[5]) {
+  return {s[0], s[1], s[2], s[3]};
+}
 
 inline constexpr std::size_t kHeaderSize = 32;
 inline constexpr std::size_t kSectionEntrySize = 32;

@@ -114,7 +114,8 @@ StatusOr<Mesh> DecodeSections(const StatusOr<container::Reader>& file) {
   if (auto s = file->Find(kNormals)) {
     SVOKIT_RETURN_IF_ERROR(ReadArray(*s, 3 * nt, "NORM", name, mesh.normals));
   }
-  if (auto s = file->Find(kUvs)) SVOKIT_RETURN_IF_ERROR(ReadArray(*s, 3 * nt, "TXCO", name, mesh.uvs));
+  if (auto s = file->Find(kUvs))
+    SVOKIT_RETURN_IF_ERROR(ReadArray(*s, 3 * nt, "TXCO", name, mesh.uvs));
   if (auto s = file->Find(kColors)) {
     SVOKIT_RETURN_IF_ERROR(ReadArray(*s, 3 * nt, "COLR", name, mesh.colors));
   }

@@ -32,12 +32,15 @@ struct ToolResult {
 
 inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args) {
   TempDir capture;
-  const std::string out_path = (capture / "stdout").string(), err_path = (capture / "stderr").string();
+  const std::string out_path = (capture / "stdout").string(),
+                    err_path = (capture / "stderr").string();
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
   const std::string exe = std::string(SVOKIT_BIN_DIR) + "/" + tool;
   std::vector<std::string> argv_storage = {exe};
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());

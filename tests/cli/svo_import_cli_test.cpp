@@ -39,8 +39,10 @@ TEST(SvoImportCli, WritesSvmAndReport) {
 TEST(SvoImportCli, OutputIsDeterministicForAnyThreadCount) {
   TempDir dir;
   const std::string in = (DataDir() / "uv-torus.obj").string();
-  ASSERT_EQ(RunTool("svo-import", {in, "-o", (dir / "a.svm").string(), "--threads", "1"}).exit_code, 0);
-  ASSERT_EQ(RunTool("svo-import", {in, "-o", (dir / "b.svm").string(), "--threads", "2"}).exit_code, 0);
+  ASSERT_EQ(RunTool("svo-import", {in, "-o", (dir / "a.svm").string(), "--threads", "1"}).exit_code,
+            0);
+  ASSERT_EQ(RunTool("svo-import", {in, "-o", (dir / "b.svm").string(), "--threads", "2"}).exit_code,
+            0);
   EXPECT_EQ(ReadText(dir / "a.svm"), ReadText(dir / "b.svm"));
   // The stored source name has no directories, so moving the input does not change the output.
   std::filesystem::copy_file(DataDir() / "uv-torus.obj", dir / "uv-torus.obj");
@@ -55,7 +57,8 @@ TEST(SvoImportCli, OutputIsDeterministicForAnyThreadCount) {
 TEST(SvoImportCli, MissingTextureIsAWarningNotAnError) {
   TempDir dir;
   dir.Write("m.mtl", "newmtl skin\nKd 0.5 0.5 0.5\nmap_Kd skin.png\n");
-  const auto in = dir.Write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n");
+  const auto in =
+      dir.Write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n");
   ToolResult r = RunTool("svo-import", {in.string(), "-o", (dir / "m.svm").string(), "-q"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("texture skin.png MISSING, base colour used"), std::string::npos) << r.out;
@@ -83,15 +86,18 @@ TEST(SvoImportCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {"empty.obj", "", normal, "has no triangles"},
       {"corrupt.svm", "\x89SVM\r\n\x1a\n garbage garbage garbage", normal, "corrupt.svm:"},
       {"ok.obj", tri + "f 1 2 3\n", {"{in}", "-o", "{dir}/wrong.ply"}, "must be a .svm file"},
-      {"ok.obj", tri + "f 1 2 3\n", {"{in}", "-o", "{dir}/no/dir/x.svm"}, "directory does not exist"},
+      {"ok.obj",
+       tri + "f 1 2 3\n",
+       {"{in}", "-o", "{dir}/no/dir/x.svm"},
+       "directory does not exist"},
       {"ok.obj", tri + "f 1 2 3\n", {"{in}", "--threads", "-4"}, "--threads"},
       {"ok.obj", tri + "f 1 2 3\n", {"{in}", "--no-such-option"}, "no-such-option"},
       {"ok.obj", tri + "f 1 2 3\n", {"-o", "{dir}/out.svm"}, "input is required"},
   };
   for (const BadCase& c : cases) {
     TempDir dir;
-    const std::string input = c.file.empty() ? (dir / "missing.obj").string()
-                                             : dir.Write(c.file, c.content).string();
+    const std::string input =
+        c.file.empty() ? (dir / "missing.obj").string() : dir.Write(c.file, c.content).string();
     std::vector<std::string> args;
     for (std::string a : c.args) {
       if (a == "{in}") a = input;

@@ -24,7 +24,9 @@ std::string Capture(Progress::Style style) {
   return s;
 }
 
-TEST(Progress, QuietPrintsNothing) { EXPECT_EQ(Capture(Progress::Style::kQuiet), ""); }
+TEST(Progress, QuietPrintsNothing) {
+  EXPECT_EQ(Capture(Progress::Style::kQuiet), "");
+}
 
 TEST(Progress, LinesPrintOneLinePerStage) {
   const std::string s = Capture(Progress::Style::kLines);

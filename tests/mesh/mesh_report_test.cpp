@@ -28,8 +28,8 @@ Mesh SplitCube() {
   for (const auto& f : faces) {
     const auto base = static_cast<std::uint32_t>(m.positions.size());
     for (const auto& c : f) {
-      m.positions.push_back({static_cast<double>(c[0]), static_cast<double>(c[1]),
-                             static_cast<double>(c[2])});
+      m.positions.push_back(
+          {static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2])});
     }
     m.triangles.push_back({base, base + 1, base + 2});
     m.triangles.push_back({base, base + 2, base + 3});
@@ -77,10 +77,10 @@ TEST(MeshReport, OpenNonManifoldAndFlippedEdges) {
 TEST(MeshReport, DegenerateTrianglesUseExactPredicates) {
   Mesh m = FromSoup({{0, 0, 0},
                      {1, 1, 1},
-                     {3, 3, 3},                    // collinear with the first two
-                     {3, 3, 3.0000000000000004},   // one ulp off the line: not degenerate
+                     {3, 3, 3},                   // collinear with the first two
+                     {3, 3, 3.0000000000000004},  // one ulp off the line: not degenerate
                      {1e-170, 0, 0},
-                     {0, 1e-170, 0}},              // cross product underflows to 0 in doubles
+                     {0, 1e-170, 0}},  // cross product underflows to 0 in doubles
                     {{0, 1, 2}, {0, 1, 3}, {0, 4, 5}, {0, 0, 1}});
   const MeshReport r = AnalyzeMesh(m, "degenerate", {});
   EXPECT_EQ(r.degenerate_triangles, 2u);  // the collinear one and the repeated-vertex one
@@ -88,8 +88,15 @@ TEST(MeshReport, DegenerateTrianglesUseExactPredicates) {
 
 TEST(MeshReport, ComponentsAndSelfIntersections) {
   // Two triangles piercing each other, plus a separate one far away.
-  Mesh m = FromSoup({{0, 0, 0}, {2, 0, 0}, {0, 2, 0},  {0.5, 0.5, -1}, {0.5, 0.5, 1},
-                     {1.5, -1, 0}, {10, 10, 10}, {11, 10, 10}, {10, 11, 10}},
+  Mesh m = FromSoup({{0, 0, 0},
+                     {2, 0, 0},
+                     {0, 2, 0},
+                     {0.5, 0.5, -1},
+                     {0.5, 0.5, 1},
+                     {1.5, -1, 0},
+                     {10, 10, 10},
+                     {11, 10, 10},
+                     {10, 11, 10}},
                     {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}});
   const MeshReport r = AnalyzeMesh(m, "pierce", {.self_intersections = true});
   EXPECT_EQ(r.components, 3u);

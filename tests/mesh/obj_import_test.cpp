@@ -195,8 +195,7 @@ TEST(ObjImport, BadInputIsOneLineErrorNamingFileAndLine) {
 TEST(ObjImport, AssimpInvalidFiles) {
   const auto dir = test::AssimpModels() / "invalid";
   SVOKIT_REQUIRE_FILE(dir / "malformed.obj");
-  EXPECT_NE(ImportError(dir / "malformed.obj").find("face refers to vertex 12"),
-            std::string::npos);
+  EXPECT_NE(ImportError(dir / "malformed.obj").find("face refers to vertex 12"), std::string::npos);
   EXPECT_NE(ImportError(dir / "malformed2.obj").find("face has 0 corners"), std::string::npos);
   EXPECT_NE(ImportError(dir / "empty.obj").find("no triangles"), std::string::npos);
   EXPECT_NE(ImportError(test::AssimpModels() / "OBJ" / "box_UTF16BE.obj").find("UTF-16"),

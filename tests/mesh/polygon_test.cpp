@@ -31,10 +31,17 @@ double PolygonArea(const std::vector<Vec3d>& p) {
 
 TEST(TriangulatePolygon, ConcaveShapesStayInsideTheirOutline) {
   const std::vector<std::vector<Vec3d>> shapes = {
-      {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {2, 1, 0}, {0, 4, 0}},                    // arrow
-      {{0, 0, 0}, {3, 0, 0}, {3, 1, 0}, {1, 1, 0}, {1, 3, 0}, {0, 3, 0}},         // L
-      {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {1, 0.5, 0}, {0, 2, 0}},                  // dart
-      {{0, 0, 0}, {5, 0, 0}, {5, 1, 0}, {1, 1, 0}, {1, 2, 0}, {5, 2, 0}, {5, 3, 0}, {0, 3, 0}},  // E-ish
+      {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {2, 1, 0}, {0, 4, 0}},             // arrow
+      {{0, 0, 0}, {3, 0, 0}, {3, 1, 0}, {1, 1, 0}, {1, 3, 0}, {0, 3, 0}},  // L
+      {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {1, 0.5, 0}, {0, 2, 0}},           // dart
+      {{0, 0, 0},
+       {5, 0, 0},
+       {5, 1, 0},
+       {1, 1, 0},
+       {1, 2, 0},
+       {5, 2, 0},
+       {5, 3, 0},
+       {0, 3, 0}},  // E-ish
   };
   for (const auto& p : shapes) {
     const auto tris = Triangulate(p);
@@ -62,8 +69,7 @@ TEST(TriangulatePolygon, ClockwiseAndTiltedPolygonsKeepTheirWinding) {
 TEST(TriangulatePolygon, DegenerateInputFallsBackToFan) {
   const std::vector<Vec3d> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
   EXPECT_EQ(Triangulate(line), (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
-  EXPECT_EQ(Triangulate({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}),
-            (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(Triangulate({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}), (std::vector<std::uint32_t>{0, 1, 2}));
 }
 
 }  // namespace

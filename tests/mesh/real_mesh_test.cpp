@@ -66,8 +66,8 @@ TEST(RealMeshes, SpiderAsciiAndBinaryStlAgreeWithObj) {
 TEST(RealMeshes, CgalDemoMeshesImportWithSoundReports) {
   const auto dir = test::CgalMeshes();
   SVOKIT_REQUIRE_FILE(dir / "armadillo.off");
-  for (const char* name : {"armadillo.off", "bunny00.off", "elephant.off",
-                           "ChineseDragon-10kv.off", "pig.stl"}) {
+  for (const char* name :
+       {"armadillo.off", "bunny00.off", "elephant.off", "ChineseDragon-10kv.off", "pig.stl"}) {
     const Mesh m = MustImport(dir / name);
     ASSERT_GT(m.triangle_count(), 1000u) << name;
     const MeshReport r = AnalyzeMesh(m, name, {});

@@ -34,9 +34,9 @@ std::uint32_t Crc32cPortable(const unsigned char* p, std::size_t n, std::uint32_
     std::uint64_t w;
     std::memcpy(&w, p, 8);  // little-endian hosts only (svokit's files are little-endian)
     w ^= crc;
-    crc = t[7][w & 0xff] ^ t[6][(w >> 8) & 0xff] ^ t[5][(w >> 16) & 0xff] ^
-          t[4][(w >> 24) & 0xff] ^ t[3][(w >> 32) & 0xff] ^ t[2][(w >> 40) & 0xff] ^
-          t[1][(w >> 48) & 0xff] ^ t[0][(w >> 56) & 0xff];
+    crc = t[7][w & 0xff] ^ t[6][(w >> 8) & 0xff] ^ t[5][(w >> 16) & 0xff] ^ t[4][(w >> 24) & 0xff] ^
+          t[3][(w >> 32) & 0xff] ^ t[2][(w >> 40) & 0xff] ^ t[1][(w >> 48) & 0xff] ^
+          t[0][(w >> 56) & 0xff];
     p += 8;
     n -= 8;
   }
@@ -46,7 +46,7 @@ std::uint32_t Crc32cPortable(const unsigned char* p, std::size_t n, std::uint32_
 
 #if defined(__x86_64__)
 __attribute__((target("sse4.2"))) std::uint32_t Crc32cHardware(const unsigned char* p,
-                                                                std::size_t n, std::uint32_t crc) {
+                                                               std::size_t n, std::uint32_t crc) {
   std::uint64_t c = crc;
   while (n >= 8) {
     std::uint64_t w;

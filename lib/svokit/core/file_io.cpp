@@ -37,7 +37,9 @@ std::string LowerExtension(const std::filesystem::path& path) {
 
 AtomicFileWriter::AtomicFileWriter(std::filesystem::path path) : path_(std::move(path)) {}
 
-AtomicFileWriter::~AtomicFileWriter() { Discard(); }
+AtomicFileWriter::~AtomicFileWriter() {
+  Discard();
+}
 
 void AtomicFileWriter::Discard() {
   if (file_) {

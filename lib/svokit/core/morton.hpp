@@ -41,13 +41,18 @@ struct MortonCoord {
 };
 
 constexpr MortonCoord MortonDecode(std::uint64_t key) {
-  return {detail::CompactBits3(key), detail::CompactBits3(key >> 1), detail::CompactBits3(key >> 2)};
+  return {detail::CompactBits3(key), detail::CompactBits3(key >> 1),
+          detail::CompactBits3(key >> 2)};
 }
 
 /// Key of the ancestor `levels` levels up (each level drops one bit per axis).
-constexpr std::uint64_t MortonParent(std::uint64_t key, int levels = 1) { return key >> (3 * levels); }
+constexpr std::uint64_t MortonParent(std::uint64_t key, int levels = 1) {
+  return key >> (3 * levels);
+}
 
 /// Which of the 8 children of its parent a key is (bit 0: x, bit 1: y, bit 2: z).
-constexpr unsigned MortonChildIndex(std::uint64_t key) { return static_cast<unsigned>(key & 7u); }
+constexpr unsigned MortonChildIndex(std::uint64_t key) {
+  return static_cast<unsigned>(key & 7u);
+}
 
 }  // namespace svokit

@@ -17,8 +17,8 @@ class ThreadLimit {
  public:
   explicit ThreadLimit(std::size_t threads) {
     if (threads > 0) {
-      control_ = std::make_unique<tbb::global_control>(
-          tbb::global_control::max_allowed_parallelism, threads);
+      control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                       threads);
     }
   }
 
@@ -31,9 +31,8 @@ template <class Body>
 void ParallelChunks(std::size_t n, std::size_t chunk, const Body& body) {
   chunk = std::max<std::size_t>(chunk, 1);
   const std::size_t chunks = (n + chunk - 1) / chunk;
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    body(c * chunk, std::min(n, (c + 1) * chunk));
-  });
+  tbb::parallel_for(std::size_t{0}, chunks,
+                    [&](std::size_t c) { body(c * chunk, std::min(n, (c + 1) * chunk)); });
 }
 
 /// Deterministic reduction: map(begin, end) → T per fixed chunk in parallel, then

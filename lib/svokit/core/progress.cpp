@@ -64,11 +64,13 @@ void Progress::Stage::Draw(bool final) {
     case Style::kBar: {
       constexpr int kWidth = 30;
       const double frac =
-          total_ == 0 ? 1.0 : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
+          total_ == 0
+              ? 1.0
+              : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
       const int filled = static_cast<int>(frac * kWidth);
-      fmt::print(out, "\r{:<12} [{}{}] {:3.0f}% {:.1f} s{}\x1b[K{}", name_, std::string(filled, '#'),
-                 std::string(kWidth - filled, '.'), frac * 100.0, seconds(), final ? tail : "",
-                 final ? "\n" : "");
+      fmt::print(out, "\r{:<12} [{}{}] {:3.0f}% {:.1f} s{}\x1b[K{}", name_,
+                 std::string(filled, '#'), std::string(kWidth - filled, '.'), frac * 100.0,
+                 seconds(), final ? tail : "", final ? "\n" : "");
       break;
     }
   }

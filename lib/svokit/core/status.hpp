@@ -54,7 +54,7 @@ class [[nodiscard]] Status {
 template <class T>
 class [[nodiscard]] StatusOr {
  public:
-  StatusOr(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  StatusOr(T value) : v_(std::move(value)) {}         // NOLINT(google-explicit-constructor)
   StatusOr(Status status) : v_(std::move(status)) {}  // NOLINT(google-explicit-constructor)
 
   bool ok() const { return std::holds_alternative<T>(v_); }
@@ -77,8 +77,8 @@ class [[nodiscard]] StatusOr {
 }  // namespace svokit
 
 /// Returns from the enclosing function if `expr` (a Status) is not ok.
-#define SVOKIT_RETURN_IF_ERROR(expr)     \
-  do {                                   \
-    ::svokit::Status _svokit_st = (expr); \
+#define SVOKIT_RETURN_IF_ERROR(expr)         \
+  do {                                       \
+    ::svokit::Status _svokit_st = (expr);    \
     if (!_svokit_st.ok()) return _svokit_st; \
   } while (false)

@@ -19,16 +19,18 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 
-Point ToPoint(const Vec3d& p) { return {p.x, p.y, p.z}; }
+Point ToPoint(const Vec3d& p) {
+  return {p.x, p.y, p.z};
+}
 }  // namespace
 
 std::vector<std::uint8_t> FindDegenerateTriangles(const Mesh& mesh) {
   std::vector<std::uint8_t> degenerate(mesh.triangles.size(), 0);
   tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t t) {
     const Triangle& tri = mesh.triangles[t];
-    degenerate[t] = CGAL::collinear(ToPoint(mesh.positions[tri[0]]),
-                                    ToPoint(mesh.positions[tri[1]]),
-                                    ToPoint(mesh.positions[tri[2]]));
+    degenerate[t] =
+        CGAL::collinear(ToPoint(mesh.positions[tri[0]]), ToPoint(mesh.positions[tri[1]]),
+                        ToPoint(mesh.positions[tri[2]]));
   });
   return degenerate;
 }

@@ -11,7 +11,7 @@
 namespace svokit {
 
 const std::vector<std::string>& SupportedMeshExtensions() {
-  static const std::vector<std::string> kExtensions = {"obj", "ply", "off", "stl",
+  static const std::vector<std::string> kExtensions = {"obj",  "ply", "off", "stl",
                                                        "gltf", "glb", "drc", "svm"};
   return kExtensions;
 }

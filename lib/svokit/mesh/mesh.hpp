@@ -16,7 +16,7 @@ namespace svokit {
 
 struct Material {
   std::string name;
-  Rgba base_color;         ///< linear RGBA; multiplies the texture and vertex colours
+  Rgba base_color;            ///< linear RGBA; multiplies the texture and vertex colours
   std::int32_t texture = -1;  ///< index into Mesh::textures, or -1
   /// A texture the source named but that could not be found: the material falls back to its
   /// base colour and the import report says so.

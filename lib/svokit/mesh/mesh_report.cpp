@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
-#include <nlohmann/json.hpp>
 #include <tbb/parallel_sort.h>
+#include <nlohmann/json.hpp>
 
 #include "svokit/core/parallel.hpp"
 
@@ -119,7 +119,8 @@ MeshReport AnalyzeMesh(const Mesh& mesh, const std::string& source, const Report
         [](double& acc, double part) { acc += part; });
     const std::vector<std::uint8_t> degenerate = detail::FindDegenerateTriangles(mesh);
     r.degenerate_triangles = std::count(degenerate.begin(), degenerate.end(), 1);
-    const std::vector<std::uint32_t> weld = WeldExactPositions(mesh.positions, r.distinct_positions);
+    const std::vector<std::uint32_t> weld =
+        WeldExactPositions(mesh.positions, r.distinct_positions);
     AnalyzeTopology(mesh, weld, r);
   }
 
@@ -156,9 +157,9 @@ std::string FormatReportText(const MeshReport& r) {
   line("mesh", r.source);
   line("triangles", fmt::format("{}", r.triangles));
   line("vertices", fmt::format("{} ({} distinct positions)", r.vertices, r.distinct_positions));
-  line("bounds", fmt::format("[{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}]", r.bounds.lo.x,
-                             r.bounds.lo.y, r.bounds.lo.z, r.bounds.hi.x, r.bounds.hi.y,
-                             r.bounds.hi.z));
+  line("bounds",
+       fmt::format("[{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}]", r.bounds.lo.x,
+                   r.bounds.lo.y, r.bounds.lo.z, r.bounds.hi.x, r.bounds.hi.y, r.bounds.hi.z));
   line("size", fmt::format("{:.9g} x {:.9g} x {:.9g}", size.x, size.y, size.z));
   line("surface area", fmt::format("{:.9g}", r.surface_area));
   std::string attrs;
@@ -173,9 +174,9 @@ std::string FormatReportText(const MeshReport& r) {
     std::string tex = "no texture";
     if (m.texture >= 0) {
       const TextureReport& t = r.textures[m.texture];
-      tex = t.error.empty() ? fmt::format("texture {} ({}x{}, {} ch)", t.name, t.width, t.height,
-                                          t.channels)
-                            : fmt::format("texture {} (undecodable)", t.name);
+      tex = t.error.empty()
+                ? fmt::format("texture {} ({}x{}, {} ch)", t.name, t.width, t.height, t.channels)
+                : fmt::format("texture {} (undecodable)", t.name);
     } else if (!m.missing_texture.empty()) {
       tex = fmt::format("texture {} MISSING, base colour used", m.missing_texture);
     }
@@ -184,8 +185,7 @@ std::string FormatReportText(const MeshReport& r) {
   }
   line("degenerate tris", fmt::format("{}", r.degenerate_triangles));
   line("edges", fmt::format("{} ({} boundary, {} non-manifold, {} inconsistently oriented)",
-                            r.edges, r.boundary_edges, r.non_manifold_edges,
-                            r.inconsistent_edges));
+                            r.edges, r.boundary_edges, r.non_manifold_edges, r.inconsistent_edges));
   line("surface", r.closed() ? "closed" : "open");
   line("components", fmt::format("{}", r.components));
   line("self-intersections", r.self_intersections
@@ -209,8 +209,7 @@ std::string FormatReportJson(const MeshReport& r) {
   j["bounds"] = {{"min", {r.bounds.lo.x, r.bounds.lo.y, r.bounds.lo.z}},
                  {"max", {r.bounds.hi.x, r.bounds.hi.y, r.bounds.hi.z}}};
   j["surface_area"] = r.surface_area;
-  j["attributes"] = {
-      {"normals", r.has_normals}, {"uvs", r.has_uvs}, {"colors", r.has_colors}};
+  j["attributes"] = {{"normals", r.has_normals}, {"uvs", r.has_uvs}, {"colors", r.has_colors}};
   j["materials"] = json::array();
   for (const MaterialReport& m : r.materials) {
     json jm = {{"name", m.name},

@@ -51,9 +51,8 @@ class ObjParser {
       // o, g, s, and unknown statements carry nothing svokit uses.
     }
     if (skipped_primitives_ > 0) {
-      mesh_.warnings.push_back(
-          fmt::format("{} line/point elements skipped (only faces are voxelized)",
-                      skipped_primitives_));
+      mesh_.warnings.push_back(fmt::format(
+          "{} line/point elements skipped (only faces are voxelized)", skipped_primitives_));
     }
     if (has_vertex_colors_) {
       mesh_.colors.reserve(3 * mesh_.triangles.size());
@@ -105,8 +104,7 @@ class ObjParser {
     }
     const std::int64_t resolved = i < 0 ? static_cast<std::int64_t>(count) + i : i - 1;
     if (i == 0 || resolved < 0 || resolved >= static_cast<std::int64_t>(count)) {
-      return scan_.Error("face refers to {} {}, but only {} are defined before it", what, i,
-                         count);
+      return scan_.Error("face refers to {} {}, but only {} are defined before it", what, i, count);
     }
     out = resolved;
     return Status::Ok();
@@ -250,9 +248,9 @@ class ObjParser {
       int min, max;
     };
     static const std::unordered_map<std::string_view, Arity> kOptions = {
-        {"-blendu", {1, 1}}, {"-blendv", {1, 1}}, {"-bm", {1, 1}},    {"-boost", {1, 1}},
+        {"-blendu", {1, 1}}, {"-blendv", {1, 1}}, {"-bm", {1, 1}},      {"-boost", {1, 1}},
         {"-cc", {1, 1}},     {"-clamp", {1, 1}},  {"-imfchan", {1, 1}}, {"-mm", {2, 2}},
-        {"-o", {1, 3}},      {"-s", {1, 3}},      {"-t", {1, 3}},     {"-texres", {1, 1}},
+        {"-o", {1, 3}},      {"-s", {1, 3}},      {"-t", {1, 3}},       {"-texres", {1, 1}},
         {"-type", {1, 1}}};
     TextScanner words(rest, "");
     words.NextLine();

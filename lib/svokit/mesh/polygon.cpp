@@ -38,8 +38,8 @@ void TriangulatePolygon(std::span<const Vec3d> positions, std::span<const std::u
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3d& a = positions[corners[i]];
     const Vec3d& b = positions[corners[(i + 1) % n]];
-    normal = normal + Vec3d{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x),
-                            (a.x - b.x) * (a.y + b.y)};
+    normal = normal +
+             Vec3d{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
   }
   int drop = 0;
   for (int a = 1; a < 3; ++a) {

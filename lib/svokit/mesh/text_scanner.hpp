@@ -98,7 +98,9 @@ class TextScanner {
   }
 
  private:
-  static bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+  static bool IsSpace(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+  }
   void SkipSpace() {
     while (!line_.empty() && IsSpace(line_.front())) line_.remove_prefix(1);
   }

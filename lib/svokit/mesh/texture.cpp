@@ -22,7 +22,8 @@ Texture::Texture(std::string name, std::vector<std::uint8_t> encoded, bool srgb)
 namespace {
 
 // Opens encoded bytes with OIIO. Most decoders read from memory through an IOProxy; for a format
-// whose plugin cannot, the bytes go through a temporary file. The name only serves as a format hint.
+// whose plugin cannot, the bytes go through a temporary file. The name only serves as a format
+// hint.
 class EncodedImageReader {
  public:
   EncodedImageReader(const std::string& name, const std::vector<std::uint8_t>& bytes)
