@@ -19,6 +19,7 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "svokit/mesh/importers.hpp"
 
@@ -510,6 +511,39 @@ TEST(GltfImport, NodeInstancedTwiceIsEmittedTwice) {
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();
   EXPECT_EQ(mesh->triangle_count(), 2u);
   EXPECT_EQ(mesh->Bounds().hi.x, 11.0);
+}
+
+// Nodes 0..n-1 each instance the next node twice; node n holds mesh 0.
+nlohmann::json DoublingNodes(int n) {
+  nlohmann::json nodes = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) nodes.push_back({{"children", {i + 1, i + 1}}});
+  nodes.push_back({{"mesh", 0}});
+  return nodes;
+}
+
+TEST(GltfImport, ExponentialInstancingIsRejectedBeforeEmitting) {
+  TempDir dir;
+  TriangleGltf gltf;
+  gltf.nodes = DoublingNodes(40).dump();  // 2^41 node instances
+  const fs::path path = gltf.Write(dir.path());
+  ExpectFileError(ImportGltf(path), path, "the node hierarchy expands to 2.2e+12 node instances");
+
+  // 2^15 instances of the 2304-triangle torus: few nodes, but too many repeated triangles.
+  nlohmann::json torus = nlohmann::json::parse(ReadAll(kData / "uv-torus.gltf"));
+  torus["nodes"] = DoublingNodes(15);
+  torus["scenes"] = {{{"nodes", {0}}}};
+  const fs::path torus_path = dir.path() / "torus.gltf";
+  WriteFile(torus_path, torus.dump());
+  ExpectFileError(ImportGltf(torus_path), torus_path,
+                  "node instancing repeats 7.55e+07 triangles (limit 67108864)");
+}
+
+TEST(GltfImport, DeeplyNestedJsonIsRejected) {
+  TempDir dir;
+  const fs::path path = dir.path() / "deep.gltf";
+  WriteFile(path, R"({"asset": {"version": "2.0"}, "extras": )" + std::string(100000, '[') +
+                      std::string(100000, ']') + "}");
+  ExpectFileError(ImportGltf(path), path, "JSON nested deeper than 128 levels");
 }
 
 TEST(GltfImport, CyclicNodesAreRejected) {

@@ -111,7 +111,6 @@ Status AppendDracoMesh(const draco::Mesh& in, std::uint32_t material, bool flip_
   }
 
   // Svokit vertices are Draco's position values, so corners sharing a position share a vertex.
-  mesh.positions.reserve(first_vertex + pos->size());
   for (std::uint32_t i = 0; i < pos->size(); ++i) {
     std::array<double, 3> p{};
     if (!pos->ConvertValue<double>(draco::AttributeValueIndex(i), 3, p.data())) {

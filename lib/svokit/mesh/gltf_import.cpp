@@ -37,10 +37,14 @@
 namespace svokit::detail {
 namespace {
 
-// Hostile files can make a small node graph expand exponentially (each node instancing its child
-// twice), and accessors without a buffer view can claim any element count without holding data.
+// Limits against hostile files. A small node graph can expand exponentially (each node instancing
+// its child twice), so node instances and the triangles that repeated instances add are capped (a
+// primitive's first instance is bounded by the file's size). Accessors without a buffer view can
+// claim any element count without holding data. tinygltf converts JSON values recursively.
 constexpr std::size_t kMaxNodeInstances = std::size_t{1} << 22;
+constexpr std::size_t kMaxInstancedTriangles = std::size_t{1} << 26;
 constexpr std::size_t kMaxZeroFilledElements = std::size_t{1} << 24;
+constexpr std::size_t kMaxJsonDepth = 128;
 
 // ---------------------------------------------------------------------------------------------
 // Loading
@@ -140,6 +144,21 @@ Status CheckVersion(const nlohmann::json& doc) {
   return Status::BadInput("unsupported glTF version (asset.version '{}')", version);
 }
 
+// Depth of the deepest JSON value, found without recursion.
+std::size_t JsonDepth(const nlohmann::json& doc) {
+  std::size_t deepest = 0;
+  std::vector<std::pair<const nlohmann::json*, std::size_t>> pending = {{&doc, 1}};
+  while (!pending.empty()) {
+    const auto [value, depth] = pending.back();
+    pending.pop_back();
+    deepest = std::max(deepest, depth);
+    if (value->is_structured()) {
+      for (const nlohmann::json& child : *value) pending.emplace_back(&child, depth + 1);
+    }
+  }
+  return deepest;
+}
+
 // External buffers are looked up here first: tinygltf would also search the working directory,
 // and its message does not say which buffer is missing.
 Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::path& base_dir) {
@@ -217,13 +236,16 @@ bool DropDracoIndices(nlohmann::json& doc) {
   return changed;
 }
 
-// Looks at the JSON before tinygltf does (CheckVersion, CheckExternalBuffers, CheckImageViews,
-// DropDracoIndices) and returns the JSON to load instead, if it had to change. JSON that does not
-// parse is left to tinygltf, whose message says where.
+// Looks at the JSON before tinygltf does (JsonDepth, CheckVersion, CheckExternalBuffers,
+// CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if it had to change.
+// JSON that does not parse is left to tinygltf, whose message says where.
 StatusOr<std::optional<std::string>> Preflight(std::string_view text,
                                                const std::filesystem::path& base_dir) {
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return std::optional<std::string>();
+  if (JsonDepth(doc) > kMaxJsonDepth) {
+    return Status::BadInput("JSON nested deeper than {} levels", kMaxJsonDepth);
+  }
   SVOKIT_RETURN_IF_ERROR(CheckVersion(doc));
   SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, base_dir));
   SVOKIT_RETURN_IF_ERROR(CheckImageViews(doc));
@@ -870,9 +892,11 @@ class GltfImporter {
 
   Status Run() {
     SVOKIT_RETURN_IF_ERROR(CheckRequiredExtensions());
-    SVOKIT_RETURN_IF_ERROR(CheckNodeGraph());
+    StatusOr<std::vector<std::size_t>> order = NodeOrder();
+    if (!order.ok()) return order.status();
     StatusOr<std::vector<int>> roots = RootNodes();
     if (!roots.ok()) return roots.status();
+    SVOKIT_RETURN_IF_ERROR(CheckInstancing(*roots, *order));
     for (int root : *roots) SVOKIT_RETURN_IF_ERROR(AppendNodeTree(root));
     return Status::Ok();
   }
@@ -894,12 +918,14 @@ class GltfImporter {
     return Status::Ok();
   }
 
-  // Iterative depth-first search over all nodes (a deep hierarchy must not overflow the stack): a
-  // child that is still on the search path is its own ancestor.
-  Status CheckNodeGraph() const {
+  // All nodes, every parent before its children (reverse post-order of an iterative depth-first
+  // search, so a deep hierarchy cannot overflow the stack). A child still on the search path is its
+  // own ancestor.
+  StatusOr<std::vector<std::size_t>> NodeOrder() const {
     const std::size_t n = model_.nodes.size();
     enum : std::uint8_t { kNew, kOnPath, kDone };
     std::vector<std::uint8_t> state(n, kNew);
+    std::vector<std::size_t> post_order;
     for (std::size_t start = 0; start < n; ++start) {
       if (state[start] != kNew) continue;
       std::vector<std::pair<std::size_t, std::size_t>> path = {{start, 0}};  // node, next child
@@ -909,6 +935,7 @@ class GltfImporter {
         const std::vector<int>& children = model_.nodes[node].children;
         if (next == children.size()) {
           state[node] = kDone;
+          post_order.push_back(node);
           path.pop_back();
           continue;
         }
@@ -932,6 +959,40 @@ class GltfImporter {
         return Status::BadInput("node {} refers to mesh {}, but there are only {} meshes", i, m,
                                 model_.meshes.size());
       }
+    }
+    return std::vector<std::size_t>(post_order.rbegin(), post_order.rend());
+  }
+
+  // Counts the instances of every node (its paths from the roots) before anything is emitted, so
+  // an exponentially instancing graph fails at once instead of after filling memory.
+  Status CheckInstancing(const std::vector<int>& roots, const std::vector<std::size_t>& order) {
+    std::vector<double> instances(model_.nodes.size(), 0.0);  // doubles: counts can be huge
+    std::vector<double> mesh_instances(model_.meshes.size(), 0.0);
+    for (int root : roots) instances[root] += 1;
+    double total = 0;
+    for (std::size_t node : order) {
+      total += instances[node];
+      for (int child : model_.nodes[node].children) instances[child] += instances[node];
+      if (model_.nodes[node].mesh >= 0) mesh_instances[model_.nodes[node].mesh] += instances[node];
+    }
+    if (total > static_cast<double>(kMaxNodeInstances)) {
+      return Status::BadInput("the node hierarchy expands to {:.3g} node instances (limit {})",
+                              total, kMaxNodeInstances);
+    }
+    double repeated = 0;  // triangles emitted by second and later instances
+    for (std::size_t m = 0; m < model_.meshes.size(); ++m) {
+      if (mesh_instances[m] <= 1) continue;
+      for (std::size_t p = 0; p < model_.meshes[m].primitives.size(); ++p) {
+        StatusOr<const draco::Mesh*> prim = Primitive(static_cast<int>(m), static_cast<int>(p));
+        if (!prim.ok()) {
+          return prim.status().WithContext(fmt::format("mesh {} primitive {}", m, p));
+        }
+        if (*prim) repeated += (mesh_instances[m] - 1) * (*prim)->num_faces();
+      }
+    }
+    if (repeated > static_cast<double>(kMaxInstancedTriangles)) {
+      return Status::BadInput("node instancing repeats {:.3g} triangles (limit {})", repeated,
+                              kMaxInstancedTriangles);
     }
     return Status::Ok();
   }
@@ -965,16 +1026,12 @@ class GltfImporter {
     return roots;
   }
 
-  // Appends every mesh instance below `root`; iterative, like CheckNodeGraph.
+  // Appends every mesh instance below `root`; iterative, like NodeOrder.
   Status AppendNodeTree(int root) {
     std::vector<std::pair<int, Mat4>> pending = {{root, kIdentity}};  // node, parent's world
     while (!pending.empty()) {
       const auto [index, parent] = pending.back();
       pending.pop_back();
-      if (++node_instances_ > kMaxNodeInstances) {
-        return Status::BadInput("the node hierarchy expands to more than {} node instances",
-                                kMaxNodeInstances);
-      }
       const tinygltf::Node& node = model_.nodes[index];
       StatusOr<Mat4> local = LocalMatrix(node, index);
       if (!local.ok()) return local.status();
@@ -1135,7 +1192,6 @@ class GltfImporter {
   std::vector<std::optional<std::uint32_t>> material_slots_;  // per glTF material, once converted
   std::optional<std::uint32_t> default_material_;
   std::map<int, std::int32_t> image_textures_;  // glTF image → index into mesh_.textures
-  std::size_t node_instances_ = 0;
 };
 
 }  // namespace
