@@ -1,0 +1,127 @@
+#include "formats/vfrag/vfrag.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "formats/container/bytes.hpp"
+#include "svokit/core/file_io.hpp"
+
+namespace svokit {
+
+namespace {
+
+using container::MakeTag;
+constexpr container::Tag kGrid = MakeTag("GRID");
+constexpr container::Tag kKeys = MakeTag("KEYS");
+constexpr container::Tag kMetadata = MakeTag("META");
+
+StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
+  if (!file.ok()) return file.status();
+  const std::string& name = file->name();
+  auto grid = file->Require(kGrid);
+  if (!grid.ok()) return grid.status();
+  auto keys = file->Require(kKeys);
+  if (!keys.ok()) return keys.status();
+
+  ByteReader g(*grid, name + ": GRID section");
+  Vec3d origin;
+  double h = 0;
+  std::array<std::uint32_t, 3> dims{};
+  std::uint32_t mode = 0;
+  SVOKIT_RETURN_IF_ERROR(g.Get(origin));
+  SVOKIT_RETURN_IF_ERROR(g.Get(h));
+  SVOKIT_RETURN_IF_ERROR(g.Get(dims));
+  SVOKIT_RETURN_IF_ERROR(g.Get(mode));
+  if (!IsFinite(origin) || !(h > 0) || !std::isfinite(h) || mode > 1) {
+    return Status::BadInput("{}: GRID section holds an invalid transform or mode", name);
+  }
+  for (std::uint32_t d : dims) {
+    if (d == 0 || d >= kMortonAxisLimit) {
+      return Status::BadInput("{}: grid dimension {} out of range", name, d);
+    }
+  }
+  if (keys->size() % sizeof(std::uint64_t) != 0) {
+    return Status::BadInput("{}: KEYS section size is not a multiple of 8", name);
+  }
+  VoxelSet set;
+  set.grid = GridTransform(origin, h, dims);
+  set.mode = static_cast<VoxelMode>(mode);
+  ByteReader k(*keys, name + ": KEYS section");
+  SVOKIT_RETURN_IF_ERROR(k.GetArray(set.keys, keys->size() / sizeof(std::uint64_t)));
+  for (std::size_t i = 0; i < set.keys.size(); ++i) {
+    if (i > 0 && set.keys[i] <= set.keys[i - 1]) {
+      return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
+    }
+    const MortonCoord c = MortonDecode(set.keys[i]);
+    if (set.keys[i] >> 63 || c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) {
+      return Status::BadInput("{}: voxel {} lies outside the {}x{}x{} grid", name, i, dims[0],
+                              dims[1], dims[2]);
+    }
+  }
+  return set;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
+  container::Writer file(kVfragFormat, 0);
+  ByteWriter g;
+  g.Put(set.grid.origin());
+  g.Put(set.grid.voxel_size());
+  g.Put(set.grid.dims());
+  g.Put(static_cast<std::uint32_t>(set.mode));
+  file.AddSection(kGrid, std::move(g.bytes()));
+  ByteWriter k;
+  k.PutArray<std::uint64_t>(set.keys);
+  file.AddSection(kKeys, std::move(k.bytes()));
+  const nlohmann::json j = {
+      {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
+  const std::string text = j.dump();
+  file.AddSection(kMetadata, std::vector<std::uint8_t>(text.begin(), text.end()));
+  return file.Serialize();
+}
+
+Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
+                  const std::filesystem::path& path) {
+  return WriteFileAtomic(path, EncodeVfrag(set, meta));
+}
+
+StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name) {
+  return DecodeSections(container::Reader::FromBytes(bytes, name, kVfragFormat));
+}
+
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path) {
+  return DecodeSections(container::Reader::Open(path, kVfragFormat));
+}
+
+Status WriteVoxelsXyz(const VoxelSet& set, const std::filesystem::path& path) {
+  const Vec3d& o = set.grid.origin();
+  const auto& d = set.grid.dims();
+  // {} prints the shortest representation that reads back to the same double.
+  std::string text = fmt::format("# origin {} {} {}\n# voxel_size {}\n# dims {} {} {}\n", o.x, o.y,
+                                 o.z, set.grid.voxel_size(), d[0], d[1], d[2]);
+  text.reserve(text.size() + set.keys.size() * 16);
+  for (std::uint64_t key : set.keys) {
+    const MortonCoord c = MortonDecode(key);
+    fmt::format_to(std::back_inserter(text), "{} {} {}\n", c.x, c.y, c.z);
+  }
+  return WriteFileAtomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path) {
+  ByteWriter w;
+  const std::string header = fmt::format(
+      "ply\nformat binary_little_endian 1.0\ncomment svokit voxel centres, voxel size {}\n"
+      "element vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+      set.grid.voxel_size(), set.keys.size());
+  w.PutArray<char>(std::span<const char>(header.data(), header.size()));
+  for (std::uint64_t key : set.keys) {
+    const MortonCoord c = MortonDecode(key);
+    const Vec3d p = set.grid.VoxelCenter({c.x, c.y, c.z});
+    w.Put(static_cast<float>(p.x));
+    w.Put(static_cast<float>(p.y));
+    w.Put(static_cast<float>(p.z));
+  }
+  return WriteFileAtomic(path, w.bytes());
+}
+
+}  // namespace svokit

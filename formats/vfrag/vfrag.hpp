@@ -1,0 +1,38 @@
+#pragma once
+// .vfrag — the voxel fragment list svo-voxelize writes and svo-build reads: a VoxelSet (sorted
+// unique Morton keys) with its GridTransform, in the shared container. Layout: README.md here.
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "formats/container/container.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+inline constexpr container::FormatId kVfragFormat{
+    {'\x89', 'V', 'F', 'R', '\r', '\n', '\x1a', '\n'}, 1, "svokit voxel fragment list (.vfrag)"};
+
+/// Provenance stored with the voxels (the `META` section).
+struct VfragMetadata {
+  std::string source;   ///< input file name, without directories
+  std::string options;  ///< the voxelization options, as the tool's command line spells them
+};
+
+std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta);
+Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
+                  const std::filesystem::path& path);
+StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name);
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path);
+
+/// Text export: "# origin X Y Z", "# voxel_size H", "# dims NX NY NZ" (round-trip precision),
+/// then "i j k" per voxel in Morton order.
+Status WriteVoxelsXyz(const VoxelSet& set, const std::filesystem::path& path);
+/// Binary little-endian PLY point cloud of voxel centres in world space.
+Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path);
+
+}  // namespace svokit

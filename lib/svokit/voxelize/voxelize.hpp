@@ -1,0 +1,31 @@
+#pragma once
+// Surface voxelization of a mesh into a VoxelSet: conservative (26-separating) or thin
+// (6-separating), by the triangle-parallel, fragment-parallel or hybrid method. All methods and
+// all thread counts produce the identical set: they only split the same exact per-column work
+// differently (see triangle_voxel_test.hpp).
+
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+enum class VoxelMethod {
+  kTriangle,  ///< one task per batch of triangles; each walks its whole footprint
+  kFragment,  ///< each triangle's footprint cut into tiles of columns; tiles spread over threads
+  kHybrid,    ///< small triangles by the triangle path, large ones (projected area) by fragments
+};
+
+struct VoxelizeOptions {
+  VoxelMode mode = VoxelMode::kConservative;
+  VoxelMethod method = VoxelMethod::kHybrid;
+  /// Hybrid: triangles whose dominant-axis projection covers more voxel² go the fragment path.
+  double hybrid_cutoff = 4096.0;
+};
+
+StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
+                            const VoxelizeOptions& options,
+                            Progress& progress = Progress::Silent());
+
+}  // namespace svokit

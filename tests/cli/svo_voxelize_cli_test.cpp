@@ -1,0 +1,99 @@
+// svo-voxelize as a user runs it: outputs, determinism across methods and threads, bad input.
+
+#include <gtest/gtest.h>
+
+#include "formats/vfrag/vfrag.hpp"
+#include "tests/cli/run_tool.hpp"
+
+namespace svokit::test {
+namespace {
+
+TEST(SvoVoxelizeCli, SvmInputAndEveryMethodAndThreadCountGiveTheSameFile) {
+  TempDir dir;
+  const std::string svm = (dir / "torus.svm").string();
+  ASSERT_EQ(
+      RunTool("svo-import", {(DataDir() / "uv-torus.obj").string(), "-o", svm, "-q"}).exit_code, 0);
+  std::string first;
+  for (const char* method : {"triangle", "fragment", "hybrid"}) {
+    for (const char* threads : {"1", "2"}) {
+      const std::string out = (dir / fmt::format("{}-{}.vfrag", method, threads)).string();
+      ToolResult r = RunTool("svo-voxelize", {svm, "-o", out, "-r", "96", "--method", method,
+                                              "--hybrid-cutoff", "8", "-j", threads, "-q"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const std::string bytes = ReadText(out);
+      if (first.empty()) first = bytes;
+      EXPECT_EQ(bytes, first) << method << " with " << threads << " threads";
+    }
+  }
+  auto set = ReadVfrag(dir / "hybrid-2.vfrag");
+  ASSERT_TRUE(set.ok()) << set.status().message();
+  EXPECT_EQ(set->grid.max_dim(), 96u);
+  EXPECT_GT(set->size(), 10000u);
+  // Importing directly from the OBJ gives the same voxels as from the .svm.
+  const std::string direct = (dir / "direct.vfrag").string();
+  ASSERT_EQ(RunTool("svo-voxelize",
+                    {(DataDir() / "uv-torus.obj").string(), "-o", direct, "-r", "96", "-q"})
+                .exit_code,
+            0);
+  EXPECT_EQ(ReadVfrag(direct)->keys, set->keys);
+}
+
+TEST(SvoVoxelizeCli, ThinIsASubsetAndXyzListsTheSameVoxels) {
+  TempDir dir;
+  const std::string in = (DataDir() / "uv-torus.obj").string();
+  ASSERT_EQ(
+      RunTool("svo-voxelize", {in, "-o", (dir / "c.vfrag").string(), "-r", "40", "-q"}).exit_code,
+      0);
+  ASSERT_EQ(RunTool("svo-voxelize",
+                    {in, "-o", (dir / "t.vfrag").string(), "-r", "40", "--mode", "thin", "-q"})
+                .exit_code,
+            0);
+  ToolResult r = RunTool("svo-voxelize", {in, "-o", (dir / "c.xyz").string(), "-r", "40", "-q"});
+  ASSERT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("voxels"), std::string::npos);
+  const auto c = ReadVfrag(dir / "c.vfrag"), t = ReadVfrag(dir / "t.vfrag");
+  ASSERT_TRUE(c.ok() && t.ok());
+  EXPECT_LT(t->size(), c->size());
+  EXPECT_TRUE(std::includes(c->keys.begin(), c->keys.end(), t->keys.begin(), t->keys.end()));
+  const std::string xyz = ReadText(dir / "c.xyz");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(xyz.begin(), xyz.end(), '\n')), c->size() + 3);
+}
+
+TEST(SvoVoxelizeCli, BadInputIsOneLineExitTwoAndNoOutput) {
+  const std::string mesh = (DataDir() / "tetra.off").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{mesh, "-o", "{dir}/v.vfrag"}, "--resolution N or --voxel-size S"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--voxel-size", "0.1"}, "excludes"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "0"}, "resolution"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "2000000"}, "resolution"},
+      {{mesh, "-o", "{dir}/v.vfrag", "--voxel-size", "-1"}, "voxel-size"},
+      {{mesh, "-o", "{dir}/v.vfrag", "--voxel-size", "1e-9"}, "exceeds the limit"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--mode", "fat"}, "--mode"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--method", "magic"}, "--method"},
+      {{mesh, "-o", "{dir}/v.obj", "-r", "8"}, "output must be a .vfrag, .xyz, .ply file"},
+      {{"{dir}/missing.svm", "-o", "{dir}/v.vfrag", "-r", "8"}, "missing.svm: no such file"},
+  };
+  for (const auto& [args_template, expect] : cases) {
+    TempDir dir;
+    std::vector<std::string> args;
+    for (std::string a : args_template) {
+      if (a.starts_with("{dir}")) a = dir.path().string() + a.substr(5);
+      args.push_back(a);
+    }
+    ToolResult r = RunTool("svo-voxelize", args);
+    EXPECT_EQ(r.exit_code, 2) << expect << ": " << r.err;
+    // Progress lines of finished stages may precede it; the error is the one last line.
+    const auto lines = r.ErrLines();
+    ASSERT_FALSE(lines.empty());
+    EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                            [](const std::string& l) { return l.starts_with("svo-voxelize: "); }),
+              1)
+        << r.err;
+    EXPECT_TRUE(lines.back().starts_with("svo-voxelize: ")) << r.err;
+    EXPECT_NE(lines.back().find(expect), std::string::npos) << r.err;
+    EXPECT_TRUE(dir.Files().empty()) << expect;
+  }
+}
+
+}  // namespace
+}  // namespace svokit::test
