@@ -31,12 +31,17 @@ std::string TagString(Tag tag) {
 }  // namespace
 
 void Writer::AddSection(Tag tag, std::vector<std::uint8_t> bytes) {
-  sections_.push_back({tag, std::move(bytes)});
+  sections_.push_back({tag, std::move(bytes), {}});
+  sections_.back().bytes = sections_.back().owned;
 }
 
-std::vector<std::uint8_t> Writer::Serialize() const {
+void Writer::AddSectionView(Tag tag, std::span<const std::uint8_t> bytes) {
+  sections_.push_back({tag, {}, bytes});
+}
+
+std::vector<std::uint8_t> Writer::HeaderAndTable(std::vector<std::uint64_t>& offsets) const {
   const std::size_t table_end = kHeaderSize + kSectionEntrySize * sections_.size();
-  std::vector<std::uint64_t> offsets;
+  offsets.clear();
   std::size_t end = AlignUp(table_end);
   for (const Section& s : sections_) {
     offsets.push_back(end);
@@ -66,16 +71,38 @@ std::vector<std::uint8_t> Writer::Serialize() const {
   std::uint32_t crc = Crc32c(out.data(), 28);
   crc = Crc32c(out.data() + kHeaderSize, out.size() - kHeaderSize, crc);
   std::memcpy(out.data() + 28, &crc, 4);
-  out.reserve(file_size);
+  return std::move(out);
+}
+
+template <class Sink>
+Status Writer::Emit(const Sink& sink) const {
+  std::vector<std::uint64_t> offsets;
+  const std::vector<std::uint8_t> head = HeaderAndTable(offsets);
+  SVOKIT_RETURN_IF_ERROR(sink(std::span<const std::uint8_t>(head)));
+  std::uint64_t pos = head.size();
+  static constexpr std::uint8_t kZeros[kAlignment] = {};
   for (std::size_t i = 0; i < sections_.size(); ++i) {
-    out.resize(offsets[i], 0);
-    out.insert(out.end(), sections_[i].bytes.begin(), sections_[i].bytes.end());
+    SVOKIT_RETURN_IF_ERROR(sink(std::span<const std::uint8_t>(kZeros, offsets[i] - pos)));
+    SVOKIT_RETURN_IF_ERROR(sink(sections_[i].bytes));
+    pos = offsets[i] + sections_[i].bytes.size();
   }
+  return Status::Ok();
+}
+
+std::vector<std::uint8_t> Writer::Serialize() const {
+  std::vector<std::uint8_t> out;
+  (void)Emit([&](std::span<const std::uint8_t> run) {
+    out.insert(out.end(), run.begin(), run.end());
+    return Status::Ok();
+  });
   return out;
 }
 
 Status Writer::WriteFile(const std::filesystem::path& path) const {
-  return WriteFileAtomic(path, Serialize());
+  AtomicFileWriter file(path);
+  SVOKIT_RETURN_IF_ERROR(file.Open());
+  SVOKIT_RETURN_IF_ERROR(Emit([&](std::span<const std::uint8_t> run) { return file.Write(run); }));
+  return file.Commit();
 }
 
 struct Reader::Mapping {

@@ -38,16 +38,25 @@ class Writer {
  public:
   Writer(const FormatId& format, std::uint32_t flags) : format_(format), flags_(flags) {}
   void AddSection(Tag tag, std::vector<std::uint8_t> bytes);
+  /// A section whose bytes stay owned by the caller (no copy of large arrays); they must outlive
+  /// the Writer.
+  void AddSectionView(Tag tag, std::span<const std::uint8_t> bytes);
   /// The whole file as bytes.
   std::vector<std::uint8_t> Serialize() const;
-  /// Writes atomically (temporary file + rename).
+  /// Streams the file to a temporary beside `path` and renames it into place.
   Status WriteFile(const std::filesystem::path& path) const;
 
  private:
   struct Section {
     Tag tag;
-    std::vector<std::uint8_t> bytes;
+    std::vector<std::uint8_t> owned;
+    std::span<const std::uint8_t> bytes;  // into `owned` or the caller's memory
   };
+  /// Header and section table, followed by each section's offset.
+  std::vector<std::uint8_t> HeaderAndTable(std::vector<std::uint64_t>& offsets) const;
+  /// Emits the file as a sequence of byte runs (header, padding, payloads).
+  template <class Sink>
+  Status Emit(const Sink& sink) const;
   FormatId format_;
   std::uint32_t flags_;
   std::vector<Section> sections_;

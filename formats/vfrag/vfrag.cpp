@@ -62,7 +62,10 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
 
 }  // namespace
 
-std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
+namespace {
+
+// The container borrows the keys (the largest array); `set` must outlive the returned writer.
+container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   container::Writer file(kVfragFormat, 0);
   ByteWriter g;
   g.Put(set.grid.origin());
@@ -70,19 +73,24 @@ std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& 
   g.Put(set.grid.dims());
   g.Put(static_cast<std::uint32_t>(set.mode));
   file.AddSection(kGrid, std::move(g.bytes()));
-  ByteWriter k;
-  k.PutArray<std::uint64_t>(set.keys);
-  file.AddSection(kKeys, std::move(k.bytes()));
+  file.AddSectionView(kKeys, {reinterpret_cast<const std::uint8_t*>(set.keys.data()),
+                              set.keys.size() * sizeof(std::uint64_t)});
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
   const std::string text = j.dump();
   file.AddSection(kMetadata, std::vector<std::uint8_t>(text.begin(), text.end()));
-  return file.Serialize();
+  return file;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
+  return MakeWriter(set, meta).Serialize();
 }
 
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
                   const std::filesystem::path& path) {
-  return WriteFileAtomic(path, EncodeVfrag(set, meta));
+  return MakeWriter(set, meta).WriteFile(path);
 }
 
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name) {

@@ -57,7 +57,16 @@ class MeshVoxelizer {
   VoxelMode mode_;
 };
 
-// Sorts and deduplicates each part, then merges: the result is independent of how work was split.
+// Neighbouring triangles share most of their voxels: deduplicating each task's keys before the
+// merge keeps the peak memory near the output size.
+void SortUnique(std::vector<std::uint64_t>& keys) {
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  keys.shrink_to_fit();
+}
+
+// Merges sorted unique parts into one sorted unique set, freeing each part once copied. The
+// result does not depend on how the work was split.
 std::vector<std::uint64_t> MergeUnique(std::vector<std::vector<std::uint64_t>>& parts) {
   std::size_t total = 0;
   for (auto& p : parts) total += p.size();
@@ -122,6 +131,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                      MeshVoxelizer::Emit(keys, x, y, z);
                    });
       }
+      SortUnique(keys);
       stage.Advance(end - begin);
     });
     for (auto& o : out) parts.push_back(std::move(o));
@@ -151,6 +161,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                      MeshVoxelizer::Emit(keys, x, y, z);
                    });
       }
+      SortUnique(keys);
     });
     stage.Advance(large.size());
     for (auto& o : out) parts.push_back(std::move(o));
