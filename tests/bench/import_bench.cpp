@@ -1,18 +1,17 @@
-// Import throughput on ≥1 M-triangle meshes, svokit's importers against OpenMesh's readers in the
-// same run. The inputs are a real mesh (CGAL's bunny by default) refined by Loop subdivision and
-// written as OBJ, binary PLY and ASCII PLY — all by OpenMesh, so the peer reads its own output.
+// Import throughput on ≥1 M-triangle meshes: svokit's importers against OpenMesh's readers on
+// the same files, in the same run. scripts/bench makes the inputs (a real mesh refined by Loop
+// subdivision, written by OpenMesh as OBJ, binary PLY and ASCII PLY).
 //
-//   build/tests/bench/import_bench [--mesh M.off] [--levels 2] [--cache DIR] [benchmark flags]
+//   import_bench FILE... [benchmark flags]
 
 #include <benchmark/benchmark.h>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 
-#include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "svokit/mesh/import.hpp"
 
@@ -20,37 +19,7 @@ namespace {
 
 using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
-std::filesystem::path g_cache = "build/bench-data";
-std::filesystem::path g_source = SVOKIT_CGAL_MESHES "/bunny00.off";
-int g_levels = 2;
-
-std::filesystem::path BenchFile(const std::string& ext) {
-  return g_cache / (g_source.stem().string() + "-loop" + std::to_string(g_levels) + ext);
-}
-
-// Writes the subdivided mesh once; later runs reuse the files.
-bool PrepareInputs() {
-  std::filesystem::create_directories(g_cache);
-  if (std::filesystem::exists(BenchFile(".ascii.ply"))) return true;
-  OmMesh mesh;
-  if (!OpenMesh::IO::read_mesh(mesh, g_source.string())) {
-    std::fprintf(stderr, "import_bench: cannot read %s\n", g_source.c_str());
-    return false;
-  }
-  OpenMesh::Subdivider::Uniform::LoopT<OmMesh> loop;
-  loop.attach(mesh);
-  loop(static_cast<std::size_t>(g_levels));
-  loop.detach();
-  std::fprintf(stderr, "import_bench: %s refined to %zu triangles\n", g_source.c_str(),
-               mesh.n_faces());
-  OpenMesh::IO::Options binary(OpenMesh::IO::Options::Binary);
-  return OpenMesh::IO::write_mesh(mesh, BenchFile(".obj").string()) &&
-         OpenMesh::IO::write_mesh(mesh, BenchFile(".ply").string(), binary) &&
-         OpenMesh::IO::write_mesh(mesh, BenchFile(".ascii.ply").string());
-}
-
-void SvokitImport(benchmark::State& state, const std::string& ext) {
-  const auto path = BenchFile(ext);
+void SvokitImport(benchmark::State& state, const std::filesystem::path& path) {
   std::size_t triangles = 0;
   for (auto _ : state) {
     auto mesh = svokit::ImportMesh(path);
@@ -67,12 +36,11 @@ void SvokitImport(benchmark::State& state, const std::string& ext) {
                           static_cast<std::int64_t>(std::filesystem::file_size(path)));
 }
 
-void OpenMeshRead(benchmark::State& state, const std::string& ext) {
-  const auto path = BenchFile(ext).string();
+void OpenMeshRead(benchmark::State& state, const std::filesystem::path& path) {
   std::size_t triangles = 0;
   for (auto _ : state) {
     OmMesh mesh;
-    if (!OpenMesh::IO::read_mesh(mesh, path)) {
+    if (!OpenMesh::IO::read_mesh(mesh, path.string())) {
       state.SkipWithError("OpenMesh could not read the file");
       return;
     }
@@ -86,26 +54,21 @@ void OpenMeshRead(benchmark::State& state, const std::string& ext) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Our own flags first; the rest go to Google Benchmark.
   std::vector<char*> rest = {argv[0]};
+  std::vector<std::filesystem::path> files;
   for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--mesh" && i + 1 < argc) {
-      g_source = argv[++i];
-    } else if (a == "--levels" && i + 1 < argc) {
-      g_levels = std::stoi(argv[++i]);
-    } else if (a == "--cache" && i + 1 < argc) {
-      g_cache = argv[++i];
-    } else {
+    if (std::string(argv[i]).rfind("--", 0) == 0) {
       rest.push_back(argv[i]);
+    } else {
+      files.emplace_back(argv[i]);
     }
   }
-  if (!PrepareInputs()) return 2;
-  for (const std::string ext : {".obj", ".ply", ".ascii.ply"}) {
-    benchmark::RegisterBenchmark(("svokit_import" + ext).c_str(), SvokitImport, ext)
+  for (const auto& f : files) {
+    const std::string name = f.filename().string();
+    benchmark::RegisterBenchmark(("svokit_import/" + name).c_str(), SvokitImport, f)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("openmesh_read" + ext).c_str(), OpenMeshRead, ext)
+    benchmark::RegisterBenchmark(("openmesh_read/" + name).c_str(), OpenMeshRead, f)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
