@@ -16,14 +16,19 @@ Int128 Max0(Int128 x) {
   return x > 0 ? x : 0;
 }
 
-// Floor and ceiling of a / b for b > 0.
+// Floor and ceiling of a / b for b > 0. A double quotient is exact to a few units at these
+// magnitudes; integer products then fix it up, avoiding a 128-bit division in the column loop.
 Int128 FloorDiv(Int128 a, Int128 b) {
-  Int128 q = a / b;
-  if ((a % b != 0) && (a < 0)) --q;
+  const double estimate = std::floor(static_cast<double>(a) / static_cast<double>(b));
+  if (!(std::abs(estimate) < 9.0e18)) {
+    Int128 q = a / b;
+    if ((a % b != 0) && (a < 0)) --q;
+    return q;
+  }
+  Int128 q = static_cast<std::int64_t>(estimate);
+  while (q * b > a) --q;
+  while ((q + 1) * b <= a) ++q;
   return q;
-}
-Int128 CeilDiv(Int128 a, Int128 b) {
-  return -FloorDiv(-a, b);
 }
 
 std::int64_t FloorDiv64(std::int64_t a, std::int64_t b) {
@@ -65,6 +70,32 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
     for (Int128& x : n_) x = -x;
   }
   d_ = n_[0] * a.x + n_[1] * a.y + n_[2] * a.z;
+  if (n_[w_] != 0) {
+    // Solve the plane test for the box's w index: plane_lo = ceil(..) = floor(.. + den − 1).
+    const Int128 nw = n_[w_];
+    if (mode_ == VoxelMode::kConservative) {
+      // min over the box of N·x ≤ d ≤ max over the box.
+      Int128 below = 0, above = 0;
+      for (int ax = 0; ax < 3; ++ax) {
+        below += std::min<Int128>(0, n_[ax]) * kS;
+        above += Max0(n_[ax]) * kS;
+      }
+      depth_den_ = nw * kS;
+      depth_a_lo_ = d_ - above + depth_den_ - 1;
+      depth_a_hi_ = d_ - below;
+      depth_b_ = n_[u_] * kS;
+      depth_c_ = n_[v_] * kS;
+    } else {
+      // |N·centre − d| ≤ ½·N_w (the plane crosses the voxel's centre line along w), doubled:
+      // −N_w·S ≤ 2N·P + S·ΣN − 2d ≤ N_w·S with P the box corner.
+      const Int128 k0 = kS * (n_[0] + n_[1] + n_[2]) - 2 * d_;
+      depth_den_ = 2 * nw * kS;
+      depth_a_lo_ = -nw * kS - k0 + depth_den_ - 1;
+      depth_a_hi_ = nw * kS - k0;
+      depth_b_ = 2 * n_[u_] * kS;
+      depth_c_ = 2 * n_[v_] * kS;
+    }
+  }
 
   // Projections onto (p, q) with r the dropped axis, (p, q, r) cyclic: slot 0 drops w (the
   // column footprint), slot 1 drops u, slot 2 drops v.
@@ -100,6 +131,21 @@ bool TriangleVoxelizer::ColumnInside(std::int64_t pu, std::int64_t pv) const {
   return true;
 }
 
+TriangleVoxelizer::SideRun TriangleVoxelizer::StartSideRun(std::int64_t pu, std::int64_t pv,
+                                                           std::int64_t pw) const {
+  SideRun run;
+  // Slot 1 projects onto (v, w): w is its second coordinate; slot 2 onto (w, u): w is the first.
+  for (int i = 0; i < 3; ++i) {
+    const Edge& e1 = edges_[1][i];
+    run.value[i] = e1.a * pv + e1.b * pw + e1.c;
+    run.step[i] = e1.b;
+    const Edge& e2 = edges_[2][i];
+    run.value[3 + i] = e2.a * pw + e2.b * pu + e2.c;
+    run.step[3 + i] = e2.a;
+  }
+  return run;
+}
+
 bool TriangleVoxelizer::SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const {
   // Slot 1 projects onto (v, w), slot 2 onto (w, u).
   for (const Edge& e : edges_[1]) {
@@ -111,37 +157,28 @@ bool TriangleVoxelizer::SideTests(std::int64_t pu, std::int64_t pv, std::int64_t
   return true;
 }
 
+TriangleVoxelizer::DepthCursor TriangleVoxelizer::StartDepth(std::int64_t pu,
+                                                             std::int64_t pv) const {
+  DepthCursor c;
+  c.has_plane = n_[w_] != 0;
+  if (!c.has_plane) return c;
+  const Int128 step = -depth_b_;
+  const Int128 dq = FloorDiv(step, depth_den_);
+  for (FloorCursor* f : {&c.lo, &c.hi}) {
+    const Int128 num = (f == &c.lo ? depth_a_lo_ : depth_a_hi_) - depth_b_ * pu - depth_c_ * pv;
+    f->den = depth_den_;
+    f->q = FloorDiv(num, depth_den_);
+    f->r = num - f->q * depth_den_;
+    f->dq = dq;
+    f->dr = step - dq * depth_den_;
+  }
+  return c;
+}
+
 bool TriangleVoxelizer::DepthRange(std::int64_t pu, std::int64_t pv, std::int64_t& w0,
                                    std::int64_t& w1) const {
-  const Int128 nw = n_[w_];
-  Int128 lo = lo_[w_], hi = hi_[w_] - 1;
-  bool single = false;
-  if (nw != 0) {
-    const Int128 base = (n_[u_] * pu + n_[v_] * pv) * kS;
-    Int128 plane_lo, plane_hi;
-    if (mode_ == VoxelMode::kConservative) {
-      // min over the box of N·x ≤ d ≤ max over the box, solved for the box's w index.
-      Int128 below = 0, above = 0;
-      for (int ax = 0; ax < 3; ++ax) {
-        below += std::min<Int128>(0, n_[ax]) * kS;
-        above += Max0(n_[ax]) * kS;
-      }
-      plane_lo = CeilDiv(d_ - base - above, nw * kS);
-      plane_hi = FloorDiv(d_ - base - below, nw * kS);
-      single = plane_lo == plane_hi;
-    } else {
-      // |N·centre − d| ≤ ½·|N_w| (the plane crosses the voxel's dominant-axis centre line),
-      // doubled: |2N·P + S·ΣN − 2d| ≤ N_w·S with P the box corner.
-      const Int128 k = 2 * base + kS * (n_[0] + n_[1] + n_[2]) - 2 * d_;
-      plane_lo = CeilDiv(-nw * kS - k, 2 * nw * kS);
-      plane_hi = FloorDiv(nw * kS - k, 2 * nw * kS);
-    }
-    lo = std::max(lo, plane_lo);
-    hi = std::min(hi, plane_hi);
-  }
-  w0 = static_cast<std::int64_t>(lo);
-  w1 = static_cast<std::int64_t>(hi);
-  return single;
+  const DepthCursor c = StartDepth(pu, pv);
+  return ClipDepth(c, w0, w1);
 }
 
 bool TriangleVoxelizer::Overlaps(std::int64_t x, std::int64_t y, std::int64_t z) const {

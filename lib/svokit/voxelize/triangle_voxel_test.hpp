@@ -51,6 +51,53 @@ class TriangleVoxelizer {
   struct Edge {
     Int128 a, b, c;
   };
+  // The six side-projection edge functions along one column, stepped incrementally along w.
+  struct SideRun {
+    Int128 value[6];
+    Int128 step[6];
+    bool Inside() const {
+      return value[0] >= 0 && value[1] >= 0 && value[2] >= 0 && value[3] >= 0 && value[4] >= 0 &&
+             value[5] >= 0;
+    }
+    void Step() {
+      for (int k = 0; k < 6; ++k) value[k] += step[k];
+    }
+  };
+  SideRun StartSideRun(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
+  // floor(num / den) for num stepping by a constant, tracked with adds only (den > 0).
+  struct FloorCursor {
+    Int128 q = 0, r = 0, den = 1, dq = 0, dr = 0;
+    void Step() {
+      q += dq;
+      r += dr;
+      if (r >= den) r -= den, ++q;
+    }
+  };
+  // The plane's run along w for the columns of one row, stepped along u. Without a plane
+  // (degenerate triangle) every w of the candidate range passes.
+  struct DepthCursor {
+    FloorCursor lo, hi;  // plane_lo = lo.q, plane_hi = hi.q
+    bool has_plane = false;
+    void Step() {
+      if (has_plane) lo.Step(), hi.Step();
+    }
+  };
+  DepthCursor StartDepth(std::int64_t pu, std::int64_t pv) const;
+  // The column's voxel run [w0, w1] (empty if w0 > w1) within the candidate range; true when the
+  // plane alone meets exactly one voxel of the column (conservative mode), which makes the side
+  // tests unnecessary: every triangle point in the column then lies in that voxel.
+  bool ClipDepth(const DepthCursor& c, std::int64_t& w0, std::int64_t& w1) const {
+    Int128 lo = lo_[w_], hi = hi_[w_] - 1;
+    bool single = false;
+    if (c.has_plane) {
+      single = mode_ == VoxelMode::kConservative && c.lo.q == c.hi.q;
+      lo = c.lo.q > lo ? c.lo.q : lo;
+      hi = c.hi.q < hi ? c.hi.q : hi;
+    }
+    w0 = static_cast<std::int64_t>(lo);
+    w1 = static_cast<std::int64_t>(hi < lo ? lo - 1 : hi);
+    return single;
+  }
   bool ColumnInside(std::int64_t pu, std::int64_t pv) const;
   bool DepthRange(std::int64_t pu, std::int64_t pv, std::int64_t& w0, std::int64_t& w1) const;
   bool SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
@@ -63,6 +110,8 @@ class TriangleVoxelizer {
   // Plane N·x = d in fixed-point units, oriented so N[w] ≥ 0.
   std::array<Int128, 3> n_{};
   Int128 d_ = 0;
+  // Per-triangle constants of the depth range: plane_lo/hi = floor((A_lo/hi − B·pu − C·pv) / den).
+  Int128 depth_den_ = 1, depth_a_lo_ = 0, depth_a_hi_ = 0, depth_b_ = 0, depth_c_ = 0;
   // Projected edges: [0] the (u,v) plane, [1] (v,w), [2] (w,u); three edges each.
   std::array<std::array<Edge, 3>, 3> edges_{};
 };

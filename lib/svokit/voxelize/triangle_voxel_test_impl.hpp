@@ -12,18 +12,33 @@ void TriangleVoxelizer::Columns(std::int64_t u0, std::int64_t u1, std::int64_t v
   if (empty_) return;
   u0 = std::max(u0, lo_[u_]), u1 = std::min(u1, hi_[u_]);
   v0 = std::max(v0, lo_[v_]), v1 = std::min(v1, hi_[v_]);
+  if (u0 >= u1) return;
+  const auto& foot = edges_[0];
   std::int64_t xyz[3];
   for (std::int64_t pv = v0; pv < v1; ++pv) {
-    for (std::int64_t pu = u0; pu < u1; ++pu) {
-      if (!ColumnInside(pu, pv)) continue;
+    // Footprint edge functions, stepped incrementally along u (exact integer adds).
+    Int128 e0 = foot[0].a * u0 + foot[0].b * pv + foot[0].c;
+    Int128 e1 = foot[1].a * u0 + foot[1].b * pv + foot[1].c;
+    Int128 e2 = foot[2].a * u0 + foot[2].b * pv + foot[2].c;
+    DepthCursor depth = StartDepth(u0, pv);
+    xyz[v_] = pv;
+    for (std::int64_t pu = u0; pu < u1;
+         ++pu, e0 += foot[0].a, e1 += foot[1].a, e2 += foot[2].a, depth.Step()) {
+      if (e0 < 0 || e1 < 0 || e2 < 0) continue;
       std::int64_t w0, w1;
-      const bool single = DepthRange(pu, pv, w0, w1);
+      const bool single = ClipDepth(depth, w0, w1);
+      if (w0 > w1) continue;
       xyz[u_] = pu;
-      xyz[v_] = pv;
-      for (std::int64_t pw = w0; pw <= w1; ++pw) {
+      if (single) {
         // A one-voxel plane run needs no side tests: the triangle's points in this column all lie
         // in that voxel (exact for conservative mode only).
-        if (!single && !SideTests(pu, pv, pw)) continue;
+        xyz[w_] = w0;
+        emit(xyz[0], xyz[1], xyz[2]);  // w0 == w1 here
+        continue;
+      }
+      SideRun run = StartSideRun(pu, pv, w0);
+      for (std::int64_t pw = w0; pw <= w1; ++pw, run.Step()) {
+        if (!run.Inside()) continue;
         xyz[w_] = pw;
         emit(xyz[0], xyz[1], xyz[2]);
       }

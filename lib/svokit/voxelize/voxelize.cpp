@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/parallel_sort.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include "svokit/core/parallel.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/voxel_bitset.hpp"
 
 namespace svokit {
 
@@ -44,10 +45,9 @@ class MeshVoxelizer {
     return 0.5 * std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
   }
 
-  static void Emit(std::vector<std::uint64_t>& out, std::int64_t x, std::int64_t y,
-                   std::int64_t z) {
-    out.push_back(MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                               static_cast<std::uint32_t>(z)));
+  static void Emit(VoxelBitSet& out, std::int64_t x, std::int64_t y, std::int64_t z) {
+    out.Insert(MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                            static_cast<std::uint32_t>(z)));
   }
 
  private:
@@ -56,31 +56,6 @@ class MeshVoxelizer {
   IBox3 box_;
   VoxelMode mode_;
 };
-
-// Neighbouring triangles share most of their voxels: deduplicating each task's keys before the
-// merge keeps the peak memory near the output size.
-void SortUnique(std::vector<std::uint64_t>& keys) {
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  keys.shrink_to_fit();
-}
-
-// Merges sorted unique parts into one sorted unique set, freeing each part once copied. The
-// result does not depend on how the work was split.
-std::vector<std::uint64_t> MergeUnique(std::vector<std::vector<std::uint64_t>>& parts) {
-  std::size_t total = 0;
-  for (auto& p : parts) total += p.size();
-  std::vector<std::uint64_t> keys;
-  keys.reserve(total);
-  for (auto& p : parts) {
-    keys.insert(keys.end(), p.begin(), p.end());
-    std::vector<std::uint64_t>().swap(p);
-  }
-  tbb::parallel_sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  keys.shrink_to_fit();
-  return keys;
-}
 
 }  // namespace
 
@@ -113,16 +88,15 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   }
 
   Progress::Stage stage(progress, "voxelize", n);
-  std::vector<std::vector<std::uint64_t>> parts;
+  // One bit set per worker thread; their union is the result, whatever the split or thread count.
+  tbb::enumerable_thread_specific<VoxelBitSet> parts;
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task.
   {
     std::vector<std::uint8_t> is_large(options.method == VoxelMethod::kTriangle ? 0 : n, 0);
     for (std::uint32_t t : large) is_large[t] = 1;
-    const std::size_t tasks = (n + kTrianglesPerTask - 1) / kTrianglesPerTask;
-    std::vector<std::vector<std::uint64_t>> out(tasks);
     ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-      auto& keys = out[begin / kTrianglesPerTask];
+      VoxelBitSet& keys = parts.local();
       for (std::size_t t = begin; t < end; ++t) {
         if (!is_large.empty() && is_large[t]) continue;
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
@@ -131,10 +105,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                      MeshVoxelizer::Emit(keys, x, y, z);
                    });
       }
-      SortUnique(keys);
       stage.Advance(end - begin);
     });
-    for (auto& o : out) parts.push_back(std::move(o));
   }
 
   // Fragment path: footprints of the large triangles cut into tiles; tiles spread over threads.
@@ -149,10 +121,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         }
       }
     }
-    const std::size_t tasks = (tiles.size() + kTilesPerTask - 1) / kTilesPerTask;
-    std::vector<std::vector<std::uint64_t>> out(tasks);
     ParallelChunks(tiles.size(), kTilesPerTask, [&](std::size_t begin, std::size_t end) {
-      auto& keys = out[begin / kTilesPerTask];
+      VoxelBitSet& keys = parts.local();
       for (std::size_t i = begin; i < end; ++i) {
         const Tile& tile = tiles[i];
         const TriangleVoxelizer tv = voxelizer.Triangle(tile.triangle);
@@ -161,16 +131,14 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                      MeshVoxelizer::Emit(keys, x, y, z);
                    });
       }
-      SortUnique(keys);
     });
     stage.Advance(large.size());
-    for (auto& o : out) parts.push_back(std::move(o));
   }
 
   VoxelSet set;
   set.grid = grid;
   set.mode = options.mode;
-  set.keys = MergeUnique(parts);
+  set.keys = VoxelBitSet::UnionKeys(parts);
   stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
   return set;
 }

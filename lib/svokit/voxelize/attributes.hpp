@@ -1,0 +1,71 @@
+#pragma once
+// Per-voxel attribute sampling: what one triangle contributes to one voxel it overlaps. The
+// triangle (snapped vertices, the same geometry the exact overlap test uses) is clipped to the
+// voxel's closed box, Sutherland–Hodgman, carrying each polygon vertex's barycentrics with respect
+// to the original triangle; the polygon's area, and the means of colour and shading normal over
+// it, follow exactly for the linearly interpolated attributes and by quadrature for the texture.
+// The voxelizer accumulates the samples (area-weighted) per voxel.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "svokit/core/vec.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/mesh/texture_sampler.hpp"
+#include "svokit/voxelize/voxel_space.hpp"
+
+namespace svokit {
+
+/// What one triangle contributes to one voxel.
+struct AttributeSample {
+  /// Area of the triangle clipped to the voxel's closed box [x,x+1]×[y,y+1]×[z,z+1], in voxel²
+  /// (voxel-space units). 0 when the triangle only touches the box (edge or point contact) or is
+  /// degenerate. A triangle lying exactly in a face shared by two voxels counts fully in both.
+  double area = 0;
+  /// Mean over the clipped polygon of material base colour × texture × vertex colour (linear light,
+  /// straight alpha; each factor's mean, multiplied). With zero area: the value at the contact
+  /// (midpoint of the contact segment or the contact point). Opaque white unless want_color.
+  Rgba color;
+  /// Mean shading normal over the clipped polygon (per-corner normals interpolated; unnormalized),
+  /// or the unit geometric normal (voxel space, counter-clockwise winding = front) when the mesh
+  /// has no normals or the mean is zero. Zero for a degenerate triangle without normals, and
+  /// unless want_normal.
+  Vec3f normal;
+};
+
+class AttributeSampler {
+ public:
+  /// `vertices`: the snapped voxel-space vertices the voxelizer uses (same indexing as
+  /// mesh.positions). Both are referenced, not copied: they must outlive the sampler. Decodes the
+  /// textures the colour needs and builds their mip pyramids (in parallel), so Sample() never
+  /// waits; a texture that cannot be decoded leaves its materials at their base colour (see
+  /// warnings()).
+  AttributeSampler(const Mesh& mesh, const std::vector<FixedPoint3>& vertices, bool want_color,
+                   bool want_normal);
+
+  /// What triangle `triangle` contributes to voxel (x, y, z). Thread-safe (const, no shared
+  /// mutable state) and allocation-free.
+  AttributeSample Sample(std::size_t triangle, std::int64_t x, std::int64_t y,
+                         std::int64_t z) const;
+
+  /// Textures that could not be decoded, one message each (their materials use the base colour).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  struct MaterialInfo {
+    Rgba base_color;
+    const TextureSampler* texture = nullptr;  // null: untextured, or the texture failed
+  };
+
+  const Mesh& mesh_;
+  const std::vector<FixedPoint3>& vertices_;
+  bool want_color_;
+  bool want_normal_;
+  std::vector<TextureSampler> textures_;  // per Mesh::textures entry; invalid when unused/failed
+  std::vector<MaterialInfo> materials_;   // per Mesh::materials entry
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace svokit
