@@ -43,6 +43,11 @@ int main(int argc, char** argv) {
                                              {"fragment", VoxelMethod::kFragment},
                                              {"hybrid", VoxelMethod::kHybrid}},
           CLI::ignore_case));
+  std::string attributes = "color,normal";
+  cli.add_option("--attributes", attributes,
+                 "Per-voxel attributes: color,normal (area-weighted, textures filtered), color, "
+                 "normal, or none (geometry only)")
+      ->check(CLI::IsMember({"color,normal", "normal,color", "color", "normal", "none"}));
   cli.add_option("--hybrid-cutoff", options.hybrid_cutoff,
                  "Hybrid: projected area (voxel²) above which a triangle takes the fragment path")
       ->check(CLI::NonNegativeNumber);
@@ -55,6 +60,8 @@ int main(int argc, char** argv) {
     if (Status s = app::CheckOutputPath(output, {"vfrag", "xyz", "ply"}); !s.ok()) {
       return app::Fail(tool, s);
     }
+    options.colors = attributes.find("color") != std::string::npos;
+    options.normals = attributes.find("normal") != std::string::npos;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
@@ -85,8 +92,8 @@ int main(int argc, char** argv) {
         const std::string grid_option = resolution > 0 ? fmt::format("--resolution {}", resolution)
                                                        : fmt::format("--voxel-size {}", voxel_size);
         const std::string recorded =
-            fmt::format("{} --pad {} --mode {}", grid_option, pad,
-                        options.mode == VoxelMode::kThin ? "thin" : "conservative");
+            fmt::format("{} --pad {} --mode {} --attributes {}", grid_option, pad,
+                        options.mode == VoxelMode::kThin ? "thin" : "conservative", attributes);
         written = WriteVfrag(*voxels, {input.filename().string(), recorded}, output);
       } else if (ext == "xyz") {
         written = WriteVoxelsXyz(*voxels, output);

@@ -1,5 +1,8 @@
 #include "formats/vfrag/vfrag.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "formats/container/bytes.hpp"
@@ -12,7 +15,30 @@ namespace {
 using container::MakeTag;
 constexpr container::Tag kGrid = MakeTag("GRID");
 constexpr container::Tag kKeys = MakeTag("KEYS");
+constexpr container::Tag kColors = MakeTag("COLR");
+constexpr container::Tag kNormals = MakeTag("NORM");
+constexpr container::Tag kCoverage = MakeTag("COVR");
 constexpr container::Tag kMetadata = MakeTag("META");
+
+template <class T>
+std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
+  return {reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)};
+}
+
+// An optional per-voxel array: absent, or exactly one T per voxel.
+template <class T>
+Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size_t voxels,
+                    std::vector<T>& out) {
+  const auto section = file.Find(tag);
+  if (!section) return Status::Ok();
+  if (section->size() != voxels * sizeof(T)) {
+    return Status::BadInput("{}: section '{}' holds {} bytes, expected {} for {} voxels",
+                            file.name(), std::string(tag.begin(), tag.end()), section->size(),
+                            voxels * sizeof(T), voxels);
+  }
+  ByteReader r(*section, file.name());
+  return r.GetArray(out, voxels);
+}
 
 StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
   if (!file.ok()) return file.status();
@@ -57,6 +83,17 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
                               dims[1], dims[2]);
     }
   }
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
+  for (const Rgba& c : set.colors) {
+    if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b) || !std::isfinite(c.a)) {
+      return Status::BadInput("{}: non-finite voxel colour", name);
+    }
+  }
+  for (const Vec3f& n : set.normals) {
+    if (!IsFinite(n)) return Status::BadInput("{}: non-finite voxel normal", name);
+  }
   return set;
 }
 
@@ -73,8 +110,10 @@ container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   g.Put(set.grid.dims());
   g.Put(static_cast<std::uint32_t>(set.mode));
   file.AddSection(kGrid, std::move(g.bytes()));
-  file.AddSectionView(kKeys, {reinterpret_cast<const std::uint8_t*>(set.keys.data()),
-                              set.keys.size() * sizeof(std::uint64_t)});
+  file.AddSectionView(kKeys, Bytes(set.keys));
+  if (set.has_colors()) file.AddSectionView(kColors, Bytes(set.colors));
+  if (set.has_normals()) file.AddSectionView(kNormals, Bytes(set.normals));
+  if (!set.coverage.empty()) file.AddSectionView(kCoverage, Bytes(set.coverage));
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
   const std::string text = j.dump();
@@ -117,17 +156,31 @@ Status WriteVoxelsXyz(const VoxelSet& set, const std::filesystem::path& path) {
 
 Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path) {
   ByteWriter w;
-  const std::string header = fmt::format(
+  std::string header = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment svokit voxel centres, voxel size {}\n"
-      "element vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+      "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
       set.grid.voxel_size(), set.keys.size());
+  if (set.has_normals()) header += "property float nx\nproperty float ny\nproperty float nz\n";
+  // PLY viewers expect 8-bit display (sRGB) colours.
+  if (set.has_colors()) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  header += "end_header\n";
   w.PutArray<char>(std::span<const char>(header.data(), header.size()));
-  for (std::uint64_t key : set.keys) {
-    const MortonCoord c = MortonDecode(key);
+  auto to_byte = [](float linear) {
+    return static_cast<std::uint8_t>(
+        std::lround(255.f * LinearToSrgb(std::clamp(linear, 0.f, 1.f))));
+  };
+  for (std::size_t i = 0; i < set.keys.size(); ++i) {
+    const MortonCoord c = MortonDecode(set.keys[i]);
     const Vec3d p = set.grid.VoxelCenter({c.x, c.y, c.z});
     w.Put(static_cast<float>(p.x));
     w.Put(static_cast<float>(p.y));
     w.Put(static_cast<float>(p.z));
+    if (set.has_normals()) w.Put(set.normals[i]);
+    if (set.has_colors()) {
+      w.Put(to_byte(set.colors[i].r));
+      w.Put(to_byte(set.colors[i].g));
+      w.Put(to_byte(set.colors[i].b));
+    }
   }
   return WriteFileAtomic(path, w.bytes());
 }

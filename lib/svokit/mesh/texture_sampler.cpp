@@ -25,8 +25,8 @@ std::vector<float> Downsample(const float* src, int w, int h, int nw, int nh) {
       for (int x = 0; x < nw; ++x) {
         const int x0 = 2 * x, x1 = std::min(x0 + 1, w - 1);
         for (int c = 0; c < 4; ++c) {
-          out[x * 4 + c] = 0.25f * (r0[x0 * 4 + c] + r0[x1 * 4 + c] + r1[x0 * 4 + c] +
-                                    r1[x1 * 4 + c]);
+          out[x * 4 + c] =
+              0.25f * (r0[x0 * 4 + c] + r0[x1 * 4 + c] + r1[x0 * 4 + c] + r1[x1 * 4 + c]);
         }
       }
     }

@@ -62,8 +62,7 @@ class TextureSampler {
     const float* rgba = nullptr;  // width·height·4, row-major, row 0 at the top
   };
   // Adds weight × the bilinear lookup at (u, v) to acc[4].
-  void AccumulateBilinear(const Level& level, double u, double v, float weight,
-                          float acc[4]) const;
+  void AccumulateBilinear(const Level& level, double u, double v, float weight, float acc[4]) const;
 
   std::vector<Level> levels_;
   std::vector<std::vector<float>> storage_;  // levels 1.. (level 0 is the caller's image)

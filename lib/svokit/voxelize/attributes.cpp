@@ -18,46 +18,112 @@ constexpr int kMaxPolygon = 16;
 // them: buffers have room for that past kMaxPolygon.
 constexpr int kClipCapacity = kMaxPolygon + 2;
 
+// A polygon vertex is carried as its barycentrics with respect to the original triangle, corners
+// 1 and 2 (b0 = 1 − b1 − b2): everything linear on the triangle (position, UV, colour, normal)
+// follows exactly, and a vertex is 16 bytes.
 struct ClipVertex {
-  double p[3];    // voxel-local coordinates: the box is [0, 1]³
-  double b1, b2;  // barycentrics of corners 1 and 2 of the original triangle (b0 = 1 − b1 − b2)
+  double b1, b2;
 };
 
-// Sutherland–Hodgman against one plane of the unit box: keeps p[axis] ≥ 0 (kUpper false) or
-// p[axis] ≤ 1. Vertices on the plane are kept; an edge yields an intersection only when it crosses
-// strictly, so touching never duplicates a vertex. Intersections are put exactly on the plane
-// (the clipped coordinate is set, not interpolated). Branch-free in the loop body: which vertices
-// survive depends on the voxel, and mispredicted branches would dominate the cost; every candidate
-// is written and the output count advanced only for the kept ones.
-template <bool kUpper>
-int ClipPlane(const ClipVertex* in, int n, ClipVertex* out, int axis) {
-  constexpr double kPlane = kUpper ? 1.0 : 0.0;
+// The triangle in voxel-local coordinates (the box is [0, 1]³): p(b) = a + b1·e1 + b2·e2. All
+// three are fixed-point differences, exact in doubles, so the original corners map back exactly.
+struct Frame {
+  double a[3], e1[3], e2[3];
+  template <int kAxis>
+  double Coord(const ClipVertex& q) const {
+    return a[kAxis] + q.b1 * e1[kAxis] + q.b2 * e2[kAxis];
+  }
+};
+
+// Sutherland–Hodgman against one plane of the unit box: keeps p[kAxis] ≥ 0 (kUpper false) or
+// p[kAxis] ≤ 1. Vertices on the plane are kept; an edge yields an intersection only when it
+// crosses strictly, so touching never duplicates a vertex (an edge or corner contact stays a
+// segment or a point, with zero area). Branch-free in the loop body: which vertices survive
+// depends on the voxel, and mispredicted branches would dominate the cost, so every candidate is
+// written and the output count advanced only for the kept ones.
+template <int kAxis, bool kUpper>
+int ClipPlane(const Frame& f, const ClipVertex* in, int n, ClipVertex* out) {
   int m = 0;
-  const ClipVertex* prev = &in[n - 1];
-  double dprev = kUpper ? 1.0 - prev->p[axis] : prev->p[axis];
+  ClipVertex prev = in[n - 1];
+  double dprev = kUpper ? 1.0 - f.Coord<kAxis>(prev) : f.Coord<kAxis>(prev);
   for (int i = 0; i < n; ++i) {
-    const ClipVertex& cur = in[i];
-    const double dcur = kUpper ? 1.0 - cur.p[axis] : cur.p[axis];
-    const bool crosses = (dprev > 0 && dcur < 0) || (dprev < 0 && dcur > 0);
-    // Never divides by zero: a zero denominator means no crossing; the value is then unused.
-    const double t = dprev / (crosses ? dprev - dcur : 1.0);
-    ClipVertex& v = out[m];
-    for (int a = 0; a < 3; ++a) v.p[a] = prev->p[a] + t * (cur.p[a] - prev->p[a]);
-    v.p[axis] = kPlane;
-    v.b1 = prev->b1 + t * (cur.b1 - prev->b1);
-    v.b2 = prev->b2 + t * (cur.b2 - prev->b2);
+    const ClipVertex cur = in[i];
+    const double dcur = kUpper ? 1.0 - f.Coord<kAxis>(cur) : f.Coord<kAxis>(cur);
+    // Strictly opposite signs. (A product underflowing to zero would only drop an intersection
+    // within 1e-150 of a kept vertex.)
+    const bool crosses = dprev * dcur < 0;
+    // Without a crossing the quotient may be ±inf or NaN (IEEE, no trap): the candidate written
+    // below is then overwritten, never read. No branch here: it would mispredict.
+    const double t = dprev / (dprev - dcur);
+    out[m] = {prev.b1 + t * (cur.b1 - prev.b1), prev.b2 + t * (cur.b2 - prev.b2)};
     m += crosses;
     out[m] = cur;
     m += dcur >= 0;
     m = std::min(m, kMaxPolygon);
-    prev = &cur;
+    prev = cur;
     dprev = dcur;
   }
   return m;
 }
 
-inline Vec3d Position(const ClipVertex& v) {
-  return {v.p[0], v.p[1], v.p[2]};
+// Clips against the planes of axis kAxis that the current polygon crosses (often none: a small
+// triangle inside the box, or the last axis once the other two have cut the polygon down).
+template <int kAxis>
+int ClipAxis(const Frame& f, ClipVertex*& poly, ClipVertex*& spare, int n) {
+  double lo = f.Coord<kAxis>(poly[0]), hi = lo;
+  for (int i = 1; i < n; ++i) {
+    const double c = f.Coord<kAxis>(poly[i]);
+    lo = std::min(lo, c);
+    hi = std::max(hi, c);
+  }
+  if (hi < 0 || lo > 1) return 0;
+  if (lo < 0) {
+    n = ClipPlane<kAxis, false>(f, poly, n, spare);
+    std::swap(poly, spare);
+  }
+  if (hi > 1 && n > 0) {
+    n = ClipPlane<kAxis, true>(f, poly, n, spare);
+    std::swap(poly, spare);
+  }
+  return n;
+}
+
+// Clips the triangle to the unit box; the polygon ends up in `poly`. The two other axes first,
+// the dominant axis of the normal (kW) last: once the polygon is cut to the voxel's column, its
+// extent along kW is at most about two voxels and often needs no clipping at all.
+//
+// Fast path, the common case for triangles much larger than a voxel: when the voxel's column
+// (its square in the (kU, kV) projection) lies inside the triangle's projection, the polygon is
+// the plane's section of the column, i.e. the square lifted onto the plane, and only the two kW
+// planes remain.
+template <int kU, int kV, int kW>
+int ClipToBox(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
+  const double det = f.e1[kU] * f.e2[kV] - f.e2[kU] * f.e1[kV];  // ±N[kW], largest of N
+  if (det != 0) {
+    const double inv = 1.0 / det;
+    constexpr double kSquareU[4] = {0, 1, 1, 0}, kSquareV[4] = {0, 0, 1, 1};
+    ClipVertex corner[4];
+    bool inside = true;
+    for (int k = 0; k < 4; ++k) {
+      const double du = kSquareU[k] - f.a[kU], dv = kSquareV[k] - f.a[kV];
+      const double b1 = (f.e2[kV] * du - f.e2[kU] * dv) * inv;
+      const double b2 = (f.e1[kU] * dv - f.e1[kV] * du) * inv;
+      inside &= (b1 >= 0) & (b2 >= 0) & (b1 + b2 <= 1);
+      corner[k] = {b1, b2};
+    }
+    if (inside) {
+      // Counter-clockwise in barycentric space, like the triangle itself (positive fan areas).
+      for (int k = 0; k < 4; ++k) poly[k] = corner[det > 0 ? k : 3 - k];
+      return ClipAxis<kW>(f, poly, spare, 4);
+    }
+  }
+  poly[0] = {0, 0};
+  poly[1] = {1, 0};
+  poly[2] = {0, 1};
+  int n = ClipAxis<kU>(f, poly, spare, 3);
+  if (n > 0) n = ClipAxis<kV>(f, poly, spare, n);
+  if (n > 0) n = ClipAxis<kW>(f, poly, spare, n);
+  return n;
 }
 
 }  // namespace
@@ -122,80 +188,67 @@ AttributeSample AttributeSampler::Sample(std::size_t triangle, std::int64_t x, s
   const std::int64_t origin[3] = {x * kFixedPointOne, y * kFixedPointOne, z * kFixedPointOne};
   constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
 
-  // The triangle in voxel-local coordinates: fixed-point differences, so exact in doubles.
+  // The triangle in voxel-local coordinates: fixed-point differences, exact in doubles.
+  const FixedPoint3& v0 = vertices_[tri[0]];
+  const FixedPoint3& v1 = vertices_[tri[1]];
+  const FixedPoint3& v2 = vertices_[tri[2]];
+  Frame f;
+  for (int a = 0; a < 3; ++a) {
+    f.a[a] = static_cast<double>(v0[a] - origin[a]) * kScale;
+    f.e1[a] = static_cast<double>(v1[a] - v0[a]) * kScale;
+    f.e2[a] = static_cast<double>(v2[a] - v0[a]) * kScale;
+  }
+  const Vec3d normal = Cross(Vec3d{f.e1[0], f.e1[1], f.e1[2]}, Vec3d{f.e2[0], f.e2[1], f.e2[2]});
+
   ClipVertex buffers[2][kClipCapacity];
   ClipVertex* poly = buffers[0];
   ClipVertex* spare = buffers[1];
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) {
-    const FixedPoint3& v = vertices_[tri[k]];
-    for (int a = 0; a < 3; ++a) poly[k].p[a] = static_cast<double>(v[a] - origin[a]) * kScale;
-    poly[k].b1 = k == 1 ? 1.0 : 0.0;
-    poly[k].b2 = k == 2 ? 1.0 : 0.0;
-  }
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = std::min({poly[0].p[a], poly[1].p[a], poly[2].p[a]});
-    hi[a] = std::max({poly[0].p[a], poly[1].p[a], poly[2].p[a]});
-  }
-  const Vec3d p0 = Position(poly[0]);
-  const Vec3d normal = Cross(Position(poly[1]) - p0, Position(poly[2]) - p0);
-
-  // Clip only against the planes the triangle crosses (a small triangle inside the box: none).
-  int n = 3;
-  for (int a = 0; a < 3 && n > 0; ++a) {
-    if (hi[a] < 0 || lo[a] > 1) {
-      n = 0;
-      break;
-    }
-    if (lo[a] < 0) {
-      n = ClipPlane<false>(poly, n, spare, a);
-      std::swap(poly, spare);
-    }
-    if (hi[a] > 1 && n > 0) {
-      n = ClipPlane<true>(poly, n, spare, a);
-      std::swap(poly, spare);
-    }
+  const double nx = std::abs(normal.x), ny = std::abs(normal.y), nz = std::abs(normal.z);
+  int n;
+  if (nx > ny && nx > nz) {
+    n = ClipToBox<1, 2, 0>(f, poly, spare);
+  } else if (ny > nz) {
+    n = ClipToBox<2, 0, 1>(f, poly, spare);
+  } else {
+    n = ClipToBox<0, 1, 2>(f, poly, spare);
   }
 
-  // Area and area centroid (in barycentrics) from the fan around poly[0]. Fan triangle i has
-  // weight w_i = cross_i · N = 2·area_i·|N| (all fan triangles lie in the triangle's plane).
+  // Area and area centroid from the fan around poly[0], in barycentric space: the map to the
+  // triangle's plane is affine with area factor |N| (N = e1 × e2), so fan triangle i has area
+  // |N|·alpha_i/2 with alpha_i its barycentric cross product (positive: clipping keeps the
+  // orientation), and its centroid is the mean of its corners.
   AttributeSample out;
   double weights[kMaxPolygon];
   double total = 0, centroid_total = 0, cb1 = 0, cb2 = 0;
-  if (n >= 3) {
-    const Vec3d q0 = Position(poly[0]);
-    Vec3d prev = Position(poly[1]) - q0;
-    for (int i = 1; i + 1 < n; ++i) {
-      const Vec3d next = Position(poly[i + 1]) - q0;
-      const double w = Dot(Cross(prev, next), normal);
-      weights[i - 1] = w;
-      total += w;
-      // Rounding can give slivers a tiny negative weight; the centroid uses only the positive
-      // ones so it stays inside the polygon.
-      if (w > 0) {
-        centroid_total += w;
-        cb1 += w * (poly[i].b1 + poly[i + 1].b1);
-        cb2 += w * (poly[i].b2 + poly[i + 1].b2);
-      }
-      prev = next;
-    }
+  for (int i = 1; i + 1 < n; ++i) {
+    const double u1 = poly[i].b1 - poly[0].b1, u2 = poly[i].b2 - poly[0].b2;
+    const double w1 = poly[i + 1].b1 - poly[0].b1, w2 = poly[i + 1].b2 - poly[0].b2;
+    const double alpha = u1 * w2 - u2 * w1;
+    weights[i - 1] = alpha;
+    total += alpha;
+    // Rounding can give slivers a tiny negative weight; the centroid uses only the positive ones
+    // so that it stays inside the polygon.
+    const double w = std::max(alpha, 0.0);
+    centroid_total += w;
+    cb1 += w * (u1 + w1);
+    cb2 += w * (u2 + w2);
   }
   const double normal_length = Length(normal);
-  const bool has_area = total > 0 && centroid_total > 0;
+  const bool has_area = total > 0 && centroid_total > 0 && normal_length > 0;
   double b1, b2;  // the barycentrics the linear attributes are evaluated at
   if (has_area) {
-    out.area = total / (2 * normal_length);
-    // Fan triangle centroid = (q0 + qi + qi+1) / 3.
-    b1 = (poly[0].b1 * centroid_total + cb1) / (3 * centroid_total);
-    b2 = (poly[0].b2 * centroid_total + cb2) / (3 * centroid_total);
+    out.area = 0.5 * normal_length * total;
+    b1 = poly[0].b1 + cb1 / (3 * centroid_total);
+    b2 = poly[0].b2 + cb2 / (3 * centroid_total);
   } else if (n > 0) {
-    // Contact only (a segment or a point): the midpoint of its two farthest vertices.
+    // Contact only (a segment or a point), or a degenerate triangle: the midpoint of the two
+    // farthest vertices (an affine map keeps which pair of collinear points is farthest).
     int ia = 0, ib = 0;
     double best = -1;
     for (int i = 0; i < n; ++i) {
       for (int j = i + 1; j < n; ++j) {
-        const Vec3d d = Position(poly[i]) - Position(poly[j]);
-        if (Dot(d, d) > best) best = Dot(d, d), ia = i, ib = j;
+        const double d1 = poly[i].b1 - poly[j].b1, d2 = poly[i].b2 - poly[j].b2;
+        if (d1 * d1 + d2 * d2 > best) best = d1 * d1 + d2 * d2, ia = i, ib = j;
       }
     }
     b1 = 0.5 * (poly[ia].b1 + poly[ib].b1);

@@ -43,8 +43,30 @@ class VoxelBitSet {
   const Brick& brick(std::size_t i) const { return bricks_[i]; }
 
   /// The union of `sets` as sorted unique Morton keys (thread-count independent).
+  /// Where each voxel of a union sits in its sorted key array: bricks with the index of their
+  /// first voxel, so Rank() is a hash lookup plus popcounts.
+  struct Ranks {
+    std::unordered_map<std::uint64_t, std::uint32_t> brick_slot;
+    std::vector<std::uint64_t> first;  // per slot: index of the brick's first voxel
+    std::vector<Brick> bits;           // per slot: the brick's voxels
+    /// Index of `key` in the union's key array; the key must be in the union.
+    std::uint64_t Rank(std::uint64_t key) const {
+      const std::uint32_t slot = brick_slot.at(key >> kBrickBits);
+      const std::uint32_t local = static_cast<std::uint32_t>(key) & ((1u << kBrickBits) - 1);
+      const Brick& b = bits[slot];
+      std::uint64_t rank = first[slot];
+      for (std::uint32_t w = 0; w < (local >> 6); ++w) {
+        rank += static_cast<std::uint64_t>(std::popcount(b[w]));
+      }
+      const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
+      return rank + static_cast<std::uint64_t>(std::popcount(b[local >> 6] & below));
+    }
+  };
+
+  /// The union of `sets` as sorted unique Morton keys (thread-count independent); fills `ranks`
+  /// when given.
   template <class Sets>
-  static std::vector<std::uint64_t> UnionKeys(const Sets& sets);
+  static std::vector<std::uint64_t> UnionKeys(const Sets& sets, Ranks* ranks = nullptr);
 
  private:
   std::unordered_map<std::uint64_t, std::size_t> index_;
@@ -61,7 +83,7 @@ class VoxelBitSet {
 // Union of bit sets: group bricks by key, OR each group, and write every brick's keys at its
 // prefix-sum offset. The result does not depend on how voxels were spread over the sets.
 template <class Sets>
-std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
+std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks) {
   // Every (brick key, bitmap) of every set, grouped by key; pointers only, no copies.
   struct Ref {
     std::uint64_t key;
@@ -104,6 +126,14 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
       }
     }
   });
+  if (ranks) {
+    ranks->first.assign(offset.begin(), offset.end() - 1);
+    ranks->brick_slot.reserve(bricks);
+    for (std::size_t b = 0; b < bricks; ++b) {
+      ranks->brick_slot.emplace(refs[starts[b]].key, static_cast<std::uint32_t>(b));
+    }
+    ranks->bits = std::move(merged);
+  }
   return keys;
 }
 

@@ -7,6 +7,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/core/vec.hpp"
 
 namespace svokit {
 
@@ -19,8 +20,16 @@ struct VoxelSet {
   GridTransform grid;
   VoxelMode mode = VoxelMode::kConservative;
   std::vector<std::uint64_t> keys;  ///< sorted ascending, unique
+  /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
+  /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
+  /// voxel² (its coverage). Empty when not requested.
+  std::vector<Rgba> colors;
+  std::vector<Vec3f> normals;
+  std::vector<float> coverage;
 
   std::size_t size() const { return keys.size(); }
+  bool has_colors() const { return !colors.empty(); }
+  bool has_normals() const { return !normals.empty(); }
 };
 
 }  // namespace svokit

@@ -1,11 +1,14 @@
 #include "svokit/voxelize/voxelize.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
 
 #include <tbb/enumerable_thread_specific.h>
 
 #include "svokit/core/parallel.hpp"
+#include "svokit/voxelize/attributes.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
 
@@ -55,6 +58,65 @@ class MeshVoxelizer {
   const std::vector<FixedPoint3>& vertices_;
   IBox3 box_;
   VoxelMode mode_;
+};
+
+// Per-voxel sums of weighted attributes in 2⁻³² fixed point: integer addition is associative, so
+// the totals do not depend on which thread added which triangle in which order.
+class AttributeAccumulator {
+ public:
+  static constexpr int kFields = 9;  // weight, r, g, b, a, nx, ny, nz, contributions
+  explicit AttributeAccumulator(std::size_t voxels)
+      : sums_(new std::atomic<std::int64_t>[voxels * kFields]()), voxels_(voxels) {}
+
+  // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
+  // only that way still averages its contacts.
+  static constexpr double kMinWeight = 1.0 / (1 << 20);
+
+  void Add(std::uint64_t voxel, const AttributeSample& s) {
+    const double w = s.area + kMinWeight;
+    const double values[kFields] = {w,
+                                    s.color.r * w,
+                                    s.color.g * w,
+                                    s.color.b * w,
+                                    s.color.a * w,
+                                    s.normal.x * w,
+                                    s.normal.y * w,
+                                    s.normal.z * w,
+                                    0.0};
+    std::atomic<std::int64_t>* sum = &sums_[voxel * kFields];
+    for (int f = 0; f + 1 < kFields; ++f) {
+      sum[f].fetch_add(std::llround(values[f] * kScale), std::memory_order_relaxed);
+    }
+    sum[kFields - 1].fetch_add(1, std::memory_order_relaxed);
+  }
+
+  void Finish(VoxelSet& set, bool colors, bool normals) const {
+    if (colors) set.colors.resize(voxels_);
+    if (normals) set.normals.resize(voxels_);
+    set.coverage.resize(voxels_);
+    ParallelChunks(voxels_, 1 << 14, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v) {
+        const std::atomic<std::int64_t>* sum = &sums_[v * kFields];
+        const double w = static_cast<double>(sum[0].load()) / kScale;
+        const double contacts = static_cast<double>(sum[kFields - 1].load());
+        set.coverage[v] = static_cast<float>(std::max(0.0, w - contacts * kMinWeight));
+        auto mean = [&](int f) {
+          return w > 0 ? static_cast<float>(static_cast<double>(sum[f].load()) / kScale / w) : 0.f;
+        };
+        if (colors) set.colors[v] = {mean(1), mean(2), mean(3), mean(4)};
+        if (normals) {
+          const Vec3f n{mean(5), mean(6), mean(7)};
+          const float len = Length(n);
+          set.normals[v] = len > 0 ? n / len : Vec3f{};
+        }
+      }
+    });
+  }
+
+ private:
+  static constexpr double kScale = 4294967296.0;  // 2³²
+  std::unique_ptr<std::atomic<std::int64_t>[]> sums_;
+  std::size_t voxels_;
 };
 
 }  // namespace
@@ -138,7 +200,30 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   VoxelSet set;
   set.grid = grid;
   set.mode = options.mode;
-  set.keys = VoxelBitSet::UnionKeys(parts);
+  const bool attributes = options.colors || options.normals;
+  VoxelBitSet::Ranks ranks;
+  set.keys = VoxelBitSet::UnionKeys(parts, attributes ? &ranks : nullptr);
+  parts.clear();
+  if (attributes) {
+    // Second walk over every triangle's voxels, now that each voxel has its index.
+    Progress::Stage attr_stage(progress, "attributes", n);
+    const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
+    AttributeAccumulator sums(set.keys.size());
+    ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const TriangleVoxelizer tv = voxelizer.Triangle(t);
+        tv.Columns(tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(),
+                   [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+                     const std::uint64_t key =
+                         MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                      static_cast<std::uint32_t>(z));
+                     sums.Add(ranks.Rank(key), sampler.Sample(t, x, y, z));
+                   });
+      }
+      attr_stage.Advance(end - begin);
+    });
+    sums.Finish(set, options.colors, options.normals);
+  }
   stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
   return set;
 }

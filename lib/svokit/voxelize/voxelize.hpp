@@ -22,6 +22,9 @@ struct VoxelizeOptions {
   VoxelMethod method = VoxelMethod::kHybrid;
   /// Hybrid: triangles whose dominant-axis projection covers more voxel² go the fragment path.
   double hybrid_cutoff = 4096.0;
+  /// Per-voxel attributes (VoxelSet::colors / normals, and coverage with either).
+  bool colors = false;
+  bool normals = false;
 };
 
 StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
