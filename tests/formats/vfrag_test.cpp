@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -30,6 +31,29 @@ TEST(Vfrag, RoundTripIsExact) {
   EXPECT_EQ(back->grid, s.grid);
   EXPECT_EQ(back->mode, s.mode);
   EXPECT_EQ(back->keys, s.keys);
+}
+
+TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
+  VoxelSet s = Sample();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const float f = static_cast<float>(i) / static_cast<float>(s.size());
+    s.colors.push_back({f, 1 - f, 0.5f, 1});
+    s.normals.push_back({0, f, 1});
+    s.coverage.push_back(f * 2);
+  }
+  auto back = DecodeVfrag(EncodeVfrag(s, {}), "attr.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_EQ(back->normals, s.normals);
+  EXPECT_EQ(back->coverage, s.coverage);
+  s.colors.pop_back();
+  auto bad = DecodeVfrag(EncodeVfrag(s, {}), "short.vfrag");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("section 'COLR'"), std::string::npos);
+  s.colors.push_back({std::nanf(""), 0, 0, 1});
+  bad = DecodeVfrag(EncodeVfrag(s, {}), "nan.vfrag");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("non-finite"), std::string::npos);
 }
 
 TEST(Vfrag, RejectsUnsortedOrOutOfGridKeysAndCorruption) {

@@ -68,8 +68,11 @@ void TextureSampler::AccumulateBilinear(const Level& l, double u, double v, floa
                                         float acc[4]) const {
   // REPEAT: reduce to [0, 1) first (UVs may be far outside), then to texel space where texel
   // centres are at integers: s ∈ [−0.5, width − 0.5).
-  const double fu = u - std::floor(u);
-  const double fv = (1.0 - v) - std::floor(1.0 - v);
+  double fu = u - std::floor(u);
+  double fv = (1.0 - v) - std::floor(1.0 - v);
+  // Non-finite input (never from a validated mesh) must not index out of bounds.
+  if (!(fu >= 0 && fu <= 1)) fu = 0;
+  if (!(fv >= 0 && fv <= 1)) fv = 0;
   const double s = fu * l.width - 0.5, t = fv * l.height - 0.5;
   // s + 1 > 0, so truncation is floor.
   int x0 = static_cast<int>(s + 1.0) - 1, y0 = static_cast<int>(t + 1.0) - 1;

@@ -30,8 +30,8 @@ struct AttributeSample {
   Rgba color;
   /// Mean shading normal over the clipped polygon (per-corner normals interpolated; unnormalized),
   /// or the unit geometric normal (voxel space, counter-clockwise winding = front) when the mesh
-  /// has no normals or the mean is zero. Zero for a degenerate triangle without normals, and
-  /// unless want_normal.
+  /// has no normals or the mean is (nearly) zero, |mean| ≤ 1e-6. Zero for a degenerate triangle
+  /// without normals, and unless want_normal.
   Vec3f normal;
 };
 
@@ -41,7 +41,7 @@ class AttributeSampler {
   /// mesh.positions). Both are referenced, not copied: they must outlive the sampler. Decodes the
   /// textures the colour needs and builds their mip pyramids (in parallel), so Sample() never
   /// waits; a texture that cannot be decoded leaves its materials at their base colour (see
-  /// warnings()).
+  /// warnings()), and so does a mesh without UVs.
   AttributeSampler(const Mesh& mesh, const std::vector<FixedPoint3>& vertices, bool want_color,
                    bool want_normal);
 
