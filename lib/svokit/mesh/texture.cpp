@@ -2,8 +2,7 @@
 
 #include <mutex>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
+#include "svokit/mesh/image_codec.hpp"
 
 namespace svokit {
 
@@ -19,87 +18,29 @@ Texture::Texture(std::string name, std::vector<std::uint8_t> encoded, bool srgb)
       srgb_(srgb),
       cache_(std::make_shared<Cache>()) {}
 
-namespace {
-
-// Opens encoded bytes with OIIO. Most decoders read from memory through an IOProxy; for a format
-// whose plugin cannot, the bytes go through a temporary file. The name only serves as a format
-// hint.
-class EncodedImageReader {
- public:
-  EncodedImageReader(const std::string& name, const std::vector<std::uint8_t>& bytes)
-      : reader_(bytes.data(), bytes.size()) {
-    std::string ext = OIIO::Filesystem::extension(name);
-    auto probe = OIIO::ImageInput::create(ext.empty() ? name : ext);
-    if (probe && probe->supports("ioproxy")) {
-      OIIO::ImageSpec config;
-      OIIO::Filesystem::IOProxy* proxy = &reader_;
-      config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-      input_ = OIIO::ImageInput::open(name, &config, proxy);
-    } else {
-      temp_ = OIIO::Filesystem::unique_path(OIIO::Filesystem::temp_directory_path() +
-                                            "/svokit-%%%%-%%%%" + ext);
-      if (OIIO::Filesystem::write_binary_file(temp_, bytes)) {
-        input_ = OIIO::ImageInput::open(temp_);
-      }
-    }
-    if (!input_) error_ = OIIO::geterror();
-    if (error_.empty() && !input_) error_ = "unknown or unsupported image format";
-  }
-  ~EncodedImageReader() {
-    input_.reset();
-    if (!temp_.empty()) OIIO::Filesystem::remove(temp_);
-  }
-  EncodedImageReader(const EncodedImageReader&) = delete;
-  EncodedImageReader& operator=(const EncodedImageReader&) = delete;
-
-  OIIO::ImageInput* input() { return input_.get(); }
-  const std::string& error() const { return error_; }
-
- private:
-  OIIO::Filesystem::IOMemReader reader_;
-  std::string temp_;
-  std::unique_ptr<OIIO::ImageInput> input_;
-  std::string error_;
-};
-
-}  // namespace
-
 StatusOr<Texture::Info> Texture::ReadInfo() const {
-  EncodedImageReader reader(name_, encoded_);
-  OIIO::ImageInput* input = reader.input();
-  if (!input) return Status::BadInput("texture '{}': cannot decode ({})", name_, reader.error());
-  const OIIO::ImageSpec& spec = input->spec();
-  return Info{spec.width, spec.height, spec.nchannels, input->format_name()};
+  StatusOr<ImageHeader> h = ReadImageHeader(name_, encoded_);
+  if (!h.ok()) return h.status();
+  return Info{h->width, h->height, h->channels, h->format};
 }
 
 StatusOr<const Image*> Texture::Decoded() const {
   if (!cache_) return Status::BadInput("texture '{}' has no data", name_);
   std::call_once(cache_->once, [this] {
-    EncodedImageReader reader(name_, encoded_);
-    OIIO::ImageInput* input = reader.input();
-    if (!input) {
-      cache_->status = Status::BadInput("texture '{}': cannot decode ({})", name_, reader.error());
+    ImageHeader header;
+    StatusOr<std::vector<float>> decoded = DecodeImagePixels(name_, encoded_, header);
+    if (!decoded.ok()) {
+      cache_->status = decoded.status();
       return;
     }
-    const OIIO::ImageSpec& spec = input->spec();
-    const int nc = spec.nchannels;
-    if (spec.width <= 0 || spec.height <= 0 || nc <= 0) {
-      cache_->status = Status::BadInput("texture '{}': empty image", name_);
-      return;
-    }
-    std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * nc);
-    if (!input->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data())) {
-      cache_->status =
-          Status::BadInput("texture '{}': cannot decode ({})", name_, input->geterror());
-      return;
-    }
+    const std::vector<float>& pixels = *decoded;
+    const int nc = header.channels;
     Image& img = cache_->image;
-    img.width = spec.width;
-    img.height = spec.height;
+    img.width = header.width;
+    img.height = header.height;
     img.rgba.resize(static_cast<std::size_t>(img.width) * img.height * 4);
     // Grey, grey+alpha, RGB and RGBA all become linear RGBA; alpha is never sRGB-encoded.
-    const bool decode_srgb = srgb_ && spec.format.basetype != OIIO::TypeDesc::FLOAT &&
-                             spec.format.basetype != OIIO::TypeDesc::HALF;
+    const bool decode_srgb = srgb_ && !header.is_float;
     const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
     for (std::size_t i = 0; i < n; ++i) {
       const float* src = &pixels[i * nc];

@@ -1,0 +1,90 @@
+#include "svokit/mesh/image_codec.hpp"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <climits>
+#include <filesystem>
+#include <mutex>
+
+namespace svokit {
+
+namespace {
+
+constexpr const char* kPluginName = "libsvokit_oiio.so";
+
+struct Plugin {
+  SvokitDecodeFn decode = nullptr;
+  std::string error;
+};
+
+// Candidates, in order: $SVOKIT_PLUGIN_DIR, the running executable's ../lib and its own folder,
+// the build tree this library was built in, then the dynamic loader's search path.
+const Plugin& LoadPlugin() {
+  static Plugin plugin;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::vector<std::string> candidates;
+    if (const char* dir = std::getenv("SVOKIT_PLUGIN_DIR")) {
+      candidates.push_back(std::string(dir) + "/" + kPluginName);
+    }
+    char exe[PATH_MAX];
+    const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n > 0) {
+      const std::filesystem::path dir = std::filesystem::path(std::string(exe, n)).parent_path();
+      candidates.push_back((dir.parent_path() / "lib" / kPluginName).string());
+      candidates.push_back((dir / kPluginName).string());
+    }
+#ifdef SVOKIT_PLUGIN_BUILD_DIR
+    candidates.push_back(std::string(SVOKIT_PLUGIN_BUILD_DIR) + "/" + kPluginName);
+#endif
+    candidates.push_back(kPluginName);
+    for (const std::string& path : candidates) {
+      void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) continue;
+      plugin.decode = reinterpret_cast<SvokitDecodeFn>(::dlsym(handle, "svokit_oiio_decode"));
+      if (plugin.decode) return;
+    }
+    plugin.error = std::string("the image decoding plugin ") + kPluginName +
+                   " was not found (set SVOKIT_PLUGIN_DIR)";
+  });
+  return plugin;
+}
+
+Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageHeader& header,
+            float* pixels, std::size_t pixel_count) {
+  const Plugin& plugin = LoadPlugin();
+  if (!plugin.decode) return Status::Internal("texture '{}': {}", name, plugin.error);
+  SvokitImageHeader h{};
+  char error[512] = {};
+  if (plugin.decode(name.c_str(), bytes.data(), bytes.size(), &h, pixels, pixel_count, error,
+                    sizeof error) != 0) {
+    return Status::BadInput("texture '{}': cannot decode ({})", name, error);
+  }
+  header = {h.width, h.height, h.channels, h.is_float != 0, h.format};
+  if (h.width <= 0 || h.height <= 0 || h.channels <= 0) {
+    return Status::BadInput("texture '{}': empty image", name);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<ImageHeader> ReadImageHeader(const std::string& name,
+                                      std::span<const std::uint8_t> bytes) {
+  ImageHeader header;
+  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, nullptr, 0));
+  return header;
+}
+
+StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
+                                               std::span<const std::uint8_t> bytes,
+                                               ImageHeader& header) {
+  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, nullptr, 0));
+  std::vector<float> pixels(static_cast<std::size_t>(header.width) * header.height *
+                            header.channels);
+  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, pixels.data(), pixels.size()));
+  return pixels;
+}
+
+}  // namespace svokit
