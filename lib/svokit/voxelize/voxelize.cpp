@@ -6,6 +6,7 @@
 #include <memory>
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_sort.h>
 
 #include "svokit/core/parallel.hpp"
 #include "svokit/voxelize/attributes.hpp"
@@ -60,63 +61,79 @@ class MeshVoxelizer {
   VoxelMode mode_;
 };
 
-// Per-voxel sums of weighted attributes in 2⁻³² fixed point: integer addition is associative, so
-// the totals do not depend on which thread added which triangle in which order.
-class AttributeAccumulator {
- public:
-  static constexpr int kFields = 9;  // weight, r, g, b, a, nx, ny, nz, contributions
-  explicit AttributeAccumulator(std::size_t voxels)
-      : sums_(new std::atomic<std::int64_t>[voxels * kFields]()), voxels_(voxels) {}
+// Which triangles touch which 16³ brick: attributes are accumulated brick by brick, each voxel's
+// contributions summed in triangle order, so the result does not depend on threads or method.
+struct BrickTriangle {
+  std::uint64_t brick;
+  std::uint32_t triangle;
+  bool operator<(const BrickTriangle& o) const {
+    return brick != o.brick ? brick < o.brick : triangle < o.triangle;
+  }
+  bool operator==(const BrickTriangle&) const = default;
+};
 
+// Records the bricks one triangle's voxels fall in (consecutive voxels mostly share a brick).
+class BrickRecorder {
+ public:
+  void Voxel(std::uint64_t key) {
+    const std::uint64_t brick = key >> VoxelBitSet::kBrickBits;
+    if (bricks_.empty() || bricks_.back() != brick) bricks_.push_back(brick);
+  }
+  void EndTriangle(std::uint32_t triangle, std::vector<BrickTriangle>& out) {
+    std::sort(bricks_.begin(), bricks_.end());
+    bricks_.erase(std::unique(bricks_.begin(), bricks_.end()), bricks_.end());
+    for (std::uint64_t b : bricks_) out.push_back({b, triangle});
+    bricks_.clear();
+  }
+
+ private:
+  std::vector<std::uint64_t> bricks_;
+};
+
+// Area-weighted sums for the voxels of one brick, indexed by local Morton code.
+class BrickAccumulator {
+ public:
+  static constexpr std::size_t kVoxels = std::size_t{1} << VoxelBitSet::kBrickBits;
   // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
   // only that way still averages its contacts.
   static constexpr double kMinWeight = 1.0 / (1 << 20);
 
-  void Add(std::uint64_t voxel, const AttributeSample& s) {
+  void Add(std::uint32_t local, const AttributeSample& s) {
+    Sum& sum = sums_[local];
     const double w = s.area + kMinWeight;
-    const double values[kFields] = {w,
-                                    s.color.r * w,
-                                    s.color.g * w,
-                                    s.color.b * w,
-                                    s.color.a * w,
-                                    s.normal.x * w,
-                                    s.normal.y * w,
-                                    s.normal.z * w,
-                                    0.0};
-    std::atomic<std::int64_t>* sum = &sums_[voxel * kFields];
-    for (int f = 0; f + 1 < kFields; ++f) {
-      sum[f].fetch_add(std::llround(values[f] * kScale), std::memory_order_relaxed);
-    }
-    sum[kFields - 1].fetch_add(1, std::memory_order_relaxed);
+    sum.weight += w;
+    sum.area += s.area;
+    sum.r += s.color.r * w, sum.g += s.color.g * w, sum.b += s.color.b * w, sum.a += s.color.a * w;
+    sum.nx += s.normal.x * w, sum.ny += s.normal.y * w, sum.nz += s.normal.z * w;
   }
-
-  void Finish(VoxelSet& set, bool colors, bool normals) const {
-    if (colors) set.colors.resize(voxels_);
-    if (normals) set.normals.resize(voxels_);
-    set.coverage.resize(voxels_);
-    ParallelChunks(voxels_, 1 << 14, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t v = begin; v < end; ++v) {
-        const std::atomic<std::int64_t>* sum = &sums_[v * kFields];
-        const double w = static_cast<double>(sum[0].load()) / kScale;
-        const double contacts = static_cast<double>(sum[kFields - 1].load());
-        set.coverage[v] = static_cast<float>(std::max(0.0, w - contacts * kMinWeight));
-        auto mean = [&](int f) {
-          return w > 0 ? static_cast<float>(static_cast<double>(sum[f].load()) / kScale / w) : 0.f;
-        };
-        if (colors) set.colors[v] = {mean(1), mean(2), mean(3), mean(4)};
-        if (normals) {
-          const Vec3f n{mean(5), mean(6), mean(7)};
-          const float len = Length(n);
-          set.normals[v] = len > 0 ? n / len : Vec3f{};
+  // Writes the brick's voxels (in key order, from `first` on) and clears the sums.
+  void Finish(const VoxelBitSet::Brick& bits, std::uint64_t first, VoxelSet& set) {
+    std::uint64_t index = first;
+    for (std::size_t w = 0; w < bits.size(); ++w) {
+      for (std::uint64_t word = bits[w]; word != 0; word &= word - 1, ++index) {
+        Sum& sum = sums_[w * 64 + static_cast<std::size_t>(std::countr_zero(word))];
+        const double inv = sum.weight > 0 ? 1.0 / sum.weight : 0.0;
+        set.coverage[index] = static_cast<float>(sum.area);
+        if (set.has_colors()) {
+          set.colors[index] = {static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
+                               static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)};
         }
+        if (set.has_normals()) {
+          const Vec3f n{static_cast<float>(sum.nx), static_cast<float>(sum.ny),
+                        static_cast<float>(sum.nz)};
+          const float len = Length(n);
+          set.normals[index] = len > 0 ? n / len : Vec3f{};
+        }
+        sum = {};
       }
-    });
+    }
   }
 
  private:
-  static constexpr double kScale = 4294967296.0;  // 2³²
-  std::unique_ptr<std::atomic<std::int64_t>[]> sums_;
-  std::size_t voxels_;
+  struct Sum {
+    double weight = 0, area = 0, r = 0, g = 0, b = 0, a = 0, nx = 0, ny = 0, nz = 0;
+  };
+  std::array<Sum, kVoxels> sums_{};
 };
 
 }  // namespace
@@ -152,20 +169,39 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   Progress::Stage stage(progress, "voxelize", n);
   // One bit set per worker thread; their union is the result, whatever the split or thread count.
   tbb::enumerable_thread_specific<VoxelBitSet> parts;
+  const bool attributes = options.colors || options.normals;
+  tbb::enumerable_thread_specific<std::vector<BrickTriangle>> bins;
+  tbb::enumerable_thread_specific<BrickRecorder> recorders;
+  // Walks columns [u0,u1)×[v0,v1) of triangle t into this thread's bit set (and brick bins).
+  auto walk = [&](std::size_t t, const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1,
+                  std::int64_t v0, std::int64_t v1) {
+    VoxelBitSet& keys = parts.local();
+    if (!attributes) {
+      tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+        MeshVoxelizer::Emit(keys, x, y, z);
+      });
+      return;
+    }
+    BrickRecorder& recorder = recorders.local();
+    tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      const std::uint64_t key =
+          MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                       static_cast<std::uint32_t>(z));
+      keys.Insert(key);
+      recorder.Voxel(key);
+    });
+    recorder.EndTriangle(static_cast<std::uint32_t>(t), bins.local());
+  };
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task.
   {
     std::vector<std::uint8_t> is_large(options.method == VoxelMethod::kTriangle ? 0 : n, 0);
     for (std::uint32_t t : large) is_large[t] = 1;
     ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-      VoxelBitSet& keys = parts.local();
       for (std::size_t t = begin; t < end; ++t) {
         if (!is_large.empty() && is_large[t]) continue;
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
-        tv.Columns(tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(),
-                   [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                     MeshVoxelizer::Emit(keys, x, y, z);
-                   });
+        walk(t, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
       }
       stage.Advance(end - begin);
     });
@@ -184,14 +220,10 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
       }
     }
     ParallelChunks(tiles.size(), kTilesPerTask, [&](std::size_t begin, std::size_t end) {
-      VoxelBitSet& keys = parts.local();
       for (std::size_t i = begin; i < end; ++i) {
         const Tile& tile = tiles[i];
         const TriangleVoxelizer tv = voxelizer.Triangle(tile.triangle);
-        tv.Columns(tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns,
-                   [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                     MeshVoxelizer::Emit(keys, x, y, z);
-                   });
+        walk(tile.triangle, tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
       }
     });
     stage.Advance(large.size());
@@ -200,29 +232,56 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   VoxelSet set;
   set.grid = grid;
   set.mode = options.mode;
-  const bool attributes = options.colors || options.normals;
   VoxelBitSet::Ranks ranks;
   set.keys = VoxelBitSet::UnionKeys(parts, attributes ? &ranks : nullptr);
   parts.clear();
   if (attributes) {
-    // Second walk over every triangle's voxels, now that each voxel has its index.
-    Progress::Stage attr_stage(progress, "attributes", n);
+    // Brick by brick: every triangle of the brick's bin, in index order, walks the brick's
+    // columns and adds its samples; each voxel's sums thus have one fixed order.
+    Progress::Stage attr_stage(progress, "attributes", ranks.first.size());
+    std::vector<BrickTriangle> pairs;
+    for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
+    bins.clear();
+    tbb::parallel_sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::vector<std::size_t> starts;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
+    }
+    starts.push_back(pairs.size());
+
     const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
-    AttributeAccumulator sums(set.keys.size());
-    ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t t = begin; t < end; ++t) {
-        const TriangleVoxelizer tv = voxelizer.Triangle(t);
-        tv.Columns(tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(),
-                   [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                     const std::uint64_t key =
-                         MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                                      static_cast<std::uint32_t>(z));
-                     sums.Add(ranks.Rank(key), sampler.Sample(t, x, y, z));
-                   });
+    if (options.colors) set.colors.resize(set.keys.size());
+    if (options.normals) set.normals.resize(set.keys.size());
+    set.coverage.resize(set.keys.size());
+    tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
+        [] { return std::make_unique<BrickAccumulator>(); });
+    ParallelChunks(starts.size() - 1, 16, [&](std::size_t begin, std::size_t end) {
+      BrickAccumulator& acc = *accumulators.local();
+      for (std::size_t g = begin; g < end; ++g) {
+        const std::uint64_t brick = pairs[starts[g]].brick;
+        const MortonCoord bc = MortonDecode(brick);
+        const std::int64_t lo[3] = {std::int64_t{bc.x} << 4, std::int64_t{bc.y} << 4,
+                                    std::int64_t{bc.z} << 4};
+        for (std::size_t i = starts[g]; i < starts[g + 1]; ++i) {
+          const std::uint32_t t = pairs[i].triangle;
+          const TriangleVoxelizer tv = voxelizer.Triangle(t);
+          const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
+          tv.Columns(lo[u], lo[u] + 16, lo[v], lo[v] + 16,
+                     [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+                       const std::int64_t c[3] = {x, y, z};
+                       if (c[w] < lo[w] || c[w] >= lo[w] + 16) return;
+                       const auto local = static_cast<std::uint32_t>(MortonEncode(
+                           static_cast<std::uint32_t>(x & 15), static_cast<std::uint32_t>(y & 15),
+                           static_cast<std::uint32_t>(z & 15)));
+                       acc.Add(local, sampler.Sample(t, x, y, z));
+                     });
+        }
+        const std::uint32_t slot = ranks.brick_slot.at(brick);
+        acc.Finish(ranks.bits[slot], ranks.first[slot], set);
       }
       attr_stage.Advance(end - begin);
     });
-    sums.Finish(set, options.colors, options.normals);
   }
   stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
   return set;
