@@ -606,6 +606,9 @@ NamedMesh Armadillo() {
 NamedMesh Bunny() {
   return {"bunny00", test::CgalMeshes() / "bunny00.off"};
 }
+NamedMesh Dragon() {
+  return {"ChineseDragon-10kv", test::CgalMeshes() / "ChineseDragon-10kv.off"};
+}
 NamedMesh Wuson() {
   return {"WusonOBJ", test::AssimpModels() / "OBJ" / "WusonOBJ.obj"};
 }
@@ -802,6 +805,9 @@ SVOKIT_MESH_TEST(MeshFidelity, Armadillo, Armadillo, 128)
 SVOKIT_MESH_TEST(MeshFidelity, Bunny00, Bunny, 32)
 SVOKIT_MESH_TEST(MeshFidelity, Bunny00, Bunny, 64)
 SVOKIT_MESH_TEST(MeshFidelity, Bunny00, Bunny, 128)
+SVOKIT_MESH_TEST(MeshFidelity, Dragon, Dragon, 32)
+SVOKIT_MESH_TEST(MeshFidelity, Dragon, Dragon, 64)
+SVOKIT_MESH_TEST(MeshFidelity, Dragon, Dragon, 128)
 SVOKIT_MESH_TEST(MeshFidelity, Wuson, Wuson, 32)
 SVOKIT_MESH_TEST(MeshFidelity, Wuson, Wuson, 64)
 SVOKIT_MESH_TEST(MeshFidelity, Wuson, Wuson, 128)
@@ -814,6 +820,8 @@ SVOKIT_MESH_TEST(SlowMeshFidelity, Armadillo, Armadillo, 256)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Armadillo, Armadillo, 512)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Bunny00, Bunny, 256)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Bunny00, Bunny, 512)
+SVOKIT_MESH_TEST(SlowMeshFidelity, Dragon, Dragon, 256)
+SVOKIT_MESH_TEST(SlowMeshFidelity, Dragon, Dragon, 512)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Wuson, Wuson, 256)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Wuson, Wuson, 512)
 SVOKIT_MESH_TEST(SlowMeshFidelity, Spider, Spider, 256)
