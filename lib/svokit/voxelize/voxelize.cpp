@@ -153,17 +153,18 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   const MeshVoxelizer voxelizer(mesh, vertices, grid, options.mode);
   const std::size_t n = mesh.triangles.size();
 
-  // Triangles for the fragment path, in index order.
-  std::vector<std::uint32_t> large;
-  if (options.method == VoxelMethod::kFragment) {
-    large.resize(n);
-    for (std::size_t t = 0; t < n; ++t) large[t] = static_cast<std::uint32_t>(t);
-  } else if (options.method == VoxelMethod::kHybrid) {
-    for (std::size_t t = 0; t < n; ++t) {
-      if (voxelizer.ProjectedArea(t) > options.hybrid_cutoff) {
-        large.push_back(static_cast<std::uint32_t>(t));
+  // Which triangles take the fragment path (classified in parallel; listed in index order).
+  std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
+  if (options.method == VoxelMethod::kHybrid) {
+    ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        is_large[t] = voxelizer.ProjectedArea(t) > options.hybrid_cutoff;
       }
-    }
+    });
+  }
+  std::vector<std::uint32_t> large;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (is_large[t]) large.push_back(static_cast<std::uint32_t>(t));
   }
 
   Progress::Stage stage(progress, "voxelize", n);
@@ -195,11 +196,9 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task.
   {
-    std::vector<std::uint8_t> is_large(options.method == VoxelMethod::kTriangle ? 0 : n, 0);
-    for (std::uint32_t t : large) is_large[t] = 1;
     ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
-        if (!is_large.empty() && is_large[t]) continue;
+        if (is_large[t]) continue;
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
         walk(t, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
       }
