@@ -17,6 +17,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/mesh/import.hpp"
 
 namespace svokit::app {
 
@@ -52,6 +53,18 @@ inline Status CheckOutputPath(const std::filesystem::path& path,
     return Status::BadInput("{}: output directory does not exist", path.string());
   }
   return Status::Ok();
+}
+
+/// Imports `input` as the "import" stage of `progress` (no "done" line when it fails).
+inline StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& input) {
+  Progress::Stage stage(progress, "import", 1);
+  StatusOr<Mesh> mesh = ImportMesh(input);
+  if (mesh.ok()) {
+    stage.SetSummary(fmt::format("{} triangles", mesh->triangle_count()));
+  } else {
+    stage.Cancel();
+  }
+  return mesh;
 }
 
 /// Prints `status` as one line on stderr and returns its exit code.

@@ -34,13 +34,7 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Mesh> mesh = Status::Ok();
-    {
-      Progress::Stage stage(progress, "import", 1);
-      mesh = ImportMesh(input);
-      if (!mesh.ok()) stage.Cancel();
-      if (mesh.ok()) stage.SetSummary(fmt::format("{} triangles", mesh->triangle_count()));
-    }
+    StatusOr<Mesh> mesh = app::ImportStage(progress, input);
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
 
     const MeshReport report = AnalyzeMesh(*mesh, input.string(), report_options, progress);

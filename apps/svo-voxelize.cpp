@@ -65,12 +65,7 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Mesh> mesh = Status::Ok();
-    {
-      Progress::Stage stage(progress, "import", 1);
-      mesh = ImportMesh(input);
-      if (!mesh.ok()) stage.Cancel();
-    }
+    StatusOr<Mesh> mesh = app::ImportStage(progress, input);
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
 
     const Box3d bounds = mesh->Bounds();
