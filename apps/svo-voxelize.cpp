@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
     StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, options, progress);
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
 
+    for (const std::string& w : voxels->warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
     Status written;
     {
       Progress::Stage stage(progress, "write", 1);

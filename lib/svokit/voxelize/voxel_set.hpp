@@ -3,6 +3,7 @@
 // grid that maps them back to world space (and, when requested, per-voxel attributes).
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "svokit/core/grid_transform.hpp"
@@ -26,6 +27,9 @@ struct VoxelSet {
   std::vector<Rgba> colors;
   std::vector<Vec3f> normals;
   std::vector<float> coverage;
+  /// Non-fatal findings of the voxelization (e.g. a texture that could not be decoded, so its
+  /// materials used their base colour). Not stored in files.
+  std::vector<std::string> warnings;
 
   std::size_t size() const { return keys.size(); }
   bool has_colors() const { return !colors.empty(); }

@@ -250,6 +250,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     starts.push_back(pairs.size());
 
     const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
+    set.warnings = sampler.warnings();
     if (options.colors) set.colors.resize(set.keys.size());
     if (options.normals) set.normals.resize(set.keys.size());
     set.coverage.resize(set.keys.size());
