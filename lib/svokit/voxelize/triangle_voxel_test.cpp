@@ -95,6 +95,10 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
       depth_b_ = 2 * n_[u_] * kS;
       depth_c_ = 2 * n_[v_] * kS;
     }
+    for (auto [step, delta] : {std::pair{&depth_step_u_, -depth_b_}, {&depth_step_v_, -depth_c_}}) {
+      step->dq = FloorDiv(delta, depth_den_);
+      step->dr = delta - step->dq * depth_den_;
+    }
   }
 
   // Projections onto (p, q) with r the dropped axis, (p, q, r) cyclic: slot 0 drops w (the
@@ -162,15 +166,10 @@ TriangleVoxelizer::DepthCursor TriangleVoxelizer::StartDepth(std::int64_t pu,
   DepthCursor c;
   c.has_plane = n_[w_] != 0;
   if (!c.has_plane) return c;
-  const Int128 step = -depth_b_;
-  const Int128 dq = FloorDiv(step, depth_den_);
   for (FloorCursor* f : {&c.lo, &c.hi}) {
     const Int128 num = (f == &c.lo ? depth_a_lo_ : depth_a_hi_) - depth_b_ * pu - depth_c_ * pv;
-    f->den = depth_den_;
     f->q = FloorDiv(num, depth_den_);
     f->r = num - f->q * depth_den_;
-    f->dq = dq;
-    f->dr = step - dq * depth_den_;
   }
   return c;
 }

@@ -64,25 +64,29 @@ class TriangleVoxelizer {
     }
   };
   SideRun StartSideRun(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
-  // floor(num / den) for num stepping by a constant, tracked with adds only (den > 0).
+  // floor(num / den) as quotient and remainder (0 ≤ r < den), for num stepping by constants.
   struct FloorCursor {
-    Int128 q = 0, r = 0, den = 1, dq = 0, dr = 0;
-    void Step() {
-      q += dq;
-      r += dr;
-      if (r >= den) r -= den, ++q;
-    }
+    Int128 q = 0, r = 0;
   };
-  // The plane's run along w for the columns of one row, stepped along u. Without a plane
+  // A constant step of the numerator, split the same way: step = dq·den + dr, 0 ≤ dr < den.
+  struct FloorStep {
+    Int128 dq = 0, dr = 0;
+  };
+  // The plane's run along w at one column: plane_lo = lo.q, plane_hi = hi.q. Without a plane
   // (degenerate triangle) every w of the candidate range passes.
   struct DepthCursor {
-    FloorCursor lo, hi;  // plane_lo = lo.q, plane_hi = hi.q
+    FloorCursor lo, hi;
     bool has_plane = false;
-    void Step() {
-      if (has_plane) lo.Step(), hi.Step();
-    }
   };
   DepthCursor StartDepth(std::int64_t pu, std::int64_t pv) const;
+  void Step(DepthCursor& c, const FloorStep& s) const {
+    if (!c.has_plane) return;
+    for (FloorCursor* f : {&c.lo, &c.hi}) {
+      f->q += s.dq;
+      f->r += s.dr;
+      if (f->r >= depth_den_) f->r -= depth_den_, ++f->q;
+    }
+  }
   // The column's voxel run [w0, w1] (empty if w0 > w1) within the candidate range; true when the
   // plane alone meets exactly one voxel of the column (conservative mode), which makes the side
   // tests unnecessary: every triangle point in the column then lies in that voxel.
@@ -112,6 +116,7 @@ class TriangleVoxelizer {
   Int128 d_ = 0;
   // Per-triangle constants of the depth range: plane_lo/hi = floor((A_lo/hi − B·pu − C·pv) / den).
   Int128 depth_den_ = 1, depth_a_lo_ = 0, depth_a_hi_ = 0, depth_b_ = 0, depth_c_ = 0;
+  FloorStep depth_step_u_, depth_step_v_;  // one column along u, one row along v
   // Projected edges: [0] the (u,v) plane, [1] (v,w), [2] (w,u); three edges each.
   std::array<std::array<Edge, 3>, 3> edges_{};
 };

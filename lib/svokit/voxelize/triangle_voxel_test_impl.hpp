@@ -15,15 +15,16 @@ void TriangleVoxelizer::Columns(std::int64_t u0, std::int64_t u1, std::int64_t v
   if (u0 >= u1) return;
   const auto& foot = edges_[0];
   std::int64_t xyz[3];
-  for (std::int64_t pv = v0; pv < v1; ++pv) {
+  DepthCursor row = StartDepth(u0, v0);
+  for (std::int64_t pv = v0; pv < v1; ++pv, Step(row, depth_step_v_)) {
     // Footprint edge functions, stepped incrementally along u (exact integer adds).
     Int128 e0 = foot[0].a * u0 + foot[0].b * pv + foot[0].c;
     Int128 e1 = foot[1].a * u0 + foot[1].b * pv + foot[1].c;
     Int128 e2 = foot[2].a * u0 + foot[2].b * pv + foot[2].c;
-    DepthCursor depth = StartDepth(u0, pv);
+    DepthCursor depth = row;
     xyz[v_] = pv;
     for (std::int64_t pu = u0; pu < u1;
-         ++pu, e0 += foot[0].a, e1 += foot[1].a, e2 += foot[2].a, depth.Step()) {
+         ++pu, e0 += foot[0].a, e1 += foot[1].a, e2 += foot[2].a, Step(depth, depth_step_u_)) {
       if (e0 < 0 || e1 < 0 || e2 < 0) continue;
       std::int64_t w0, w1;
       const bool single = ClipDepth(depth, w0, w1);
