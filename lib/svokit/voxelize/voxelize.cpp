@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
@@ -167,7 +168,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     if (is_large[t]) large.push_back(static_cast<std::uint32_t>(t));
   }
 
-  Progress::Stage stage(progress, "voxelize", n);
+  // The geometry stage ends once the voxel set is known; attributes report as a stage of their own.
+  std::optional<Progress::Stage> stage(std::in_place, progress, "voxelize", n);
   // One bit set per worker thread; their union is the result, whatever the split or thread count.
   tbb::enumerable_thread_specific<VoxelBitSet> parts;
   const bool attributes = options.colors || options.normals;
@@ -202,7 +204,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
         walk(t, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
       }
-      stage.Advance(end - begin);
+      stage->Advance(end - begin);
     });
   }
 
@@ -225,7 +227,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         walk(tile.triangle, tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
       }
     });
-    stage.Advance(large.size());
+    stage->Advance(large.size());
   }
 
   VoxelSet set;
@@ -234,6 +236,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   VoxelBitSet::Ranks ranks;
   set.keys = VoxelBitSet::UnionKeys(parts, attributes ? &ranks : nullptr);
   parts.clear();
+  stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
+  stage.reset();
   if (attributes) {
     // Brick by brick: every triangle of the brick's bin, in index order, walks the brick's
     // columns and adds its samples; each voxel's sums thus have one fixed order.
@@ -283,7 +287,6 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
       attr_stage.Advance(end - begin);
     });
   }
-  stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
   return set;
 }
 
