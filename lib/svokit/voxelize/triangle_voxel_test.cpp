@@ -126,39 +126,40 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
       }
     }
   }
+  Localize();
+}
+
+void TriangleVoxelizer::Localize() {
+  if (empty_) return;
+  // Move the edge functions' origin to the candidate box's low corner, then see whether every
+  // value the walk can reach (one step past the box included) fits in 63 bits.
+  origin_ = lo_;
+  constexpr Int128 kLimit = Int128{1} << 62;
+  fits_int64_ = true;
+  const int axes[3][2] = {{u_, v_}, {v_, w_}, {w_, u_}};
+  for (int slot = 0; slot < 3; ++slot) {
+    const int p = axes[slot][0], q = axes[slot][1];
+    const Int128 ext_p = hi_[p] - lo_[p] + 1, ext_q = hi_[q] - lo_[q] + 1;
+    for (int i = 0; i < 3; ++i) {
+      Edge& e = edges_[slot][i];
+      e.c += e.a * origin_[p] + e.b * origin_[q];
+      if (Abs(e.a) * ext_p + Abs(e.b) * ext_q + Abs(e.c) >= kLimit) fits_int64_ = false;
+      edges64_[slot][i] = {static_cast<std::int64_t>(e.a), static_cast<std::int64_t>(e.b),
+                           static_cast<std::int64_t>(e.c)};
+    }
+  }
 }
 
 bool TriangleVoxelizer::ColumnInside(std::int64_t pu, std::int64_t pv) const {
+  const std::int64_t lu = pu - origin_[u_], lv = pv - origin_[v_];
   for (const Edge& e : edges_[0]) {
-    if (e.a * pu + e.b * pv + e.c < 0) return false;
+    if (e.a * lu + e.b * lv + e.c < 0) return false;
   }
   return true;
-}
-
-TriangleVoxelizer::SideRun TriangleVoxelizer::StartSideRun(std::int64_t pu, std::int64_t pv,
-                                                           std::int64_t pw) const {
-  SideRun run;
-  // Slot 1 projects onto (v, w): w is its second coordinate; slot 2 onto (w, u): w is the first.
-  for (int i = 0; i < 3; ++i) {
-    const Edge& e1 = edges_[1][i];
-    run.value[i] = e1.a * pv + e1.b * pw + e1.c;
-    run.step[i] = e1.b;
-    const Edge& e2 = edges_[2][i];
-    run.value[3 + i] = e2.a * pw + e2.b * pu + e2.c;
-    run.step[3 + i] = e2.a;
-  }
-  return run;
 }
 
 bool TriangleVoxelizer::SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const {
-  // Slot 1 projects onto (v, w), slot 2 onto (w, u).
-  for (const Edge& e : edges_[1]) {
-    if (e.a * pv + e.b * pw + e.c < 0) return false;
-  }
-  for (const Edge& e : edges_[2]) {
-    if (e.a * pw + e.b * pu + e.c < 0) return false;
-  }
-  return true;
+  return StartSideRun(edges_, pu, pv, pw).Inside();
 }
 
 TriangleVoxelizer::DepthCursor TriangleVoxelizer::StartDepth(std::int64_t pu,

@@ -47,14 +47,21 @@ class TriangleVoxelizer {
 
  private:
   // Edge function of one projected edge, scaled so evaluation at integer voxel coordinates stays
-  // integer: value(p, q) = a·p + b·q + c ≥ 0 means "inside" for the tested corner or diamond.
-  struct Edge {
-    Int128 a, b, c;
+  // integer, relative to the local origin o (the candidate box's low corner):
+  // value(p, q) = a·(p − o_p) + b·(q − o_q) + c ≥ 0 means "inside" for the tested corner/diamond.
+  template <class Int>
+  struct EdgeT {
+    Int a, b, c;
   };
+  using Edge = EdgeT<Int128>;
+  // [slot][edge]: slot 0 projects onto (u, v), slot 1 onto (v, w), slot 2 onto (w, u).
+  template <class Int>
+  using EdgeSet = std::array<std::array<EdgeT<Int>, 3>, 3>;
   // The six side-projection edge functions along one column, stepped incrementally along w.
+  template <class Int>
   struct SideRun {
-    Int128 value[6];
-    Int128 step[6];
+    Int value[6];
+    Int step[6];
     bool Inside() const {
       return value[0] >= 0 && value[1] >= 0 && value[2] >= 0 && value[3] >= 0 && value[4] >= 0 &&
              value[5] >= 0;
@@ -63,7 +70,12 @@ class TriangleVoxelizer {
       for (int k = 0; k < 6; ++k) value[k] += step[k];
     }
   };
-  SideRun StartSideRun(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
+  template <class Int>
+  SideRun<Int> StartSideRun(const EdgeSet<Int>& edges, std::int64_t pu, std::int64_t pv,
+                            std::int64_t pw) const;
+  template <class Int, class Emit>
+  void ColumnsWith(const EdgeSet<Int>& edges, std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                   std::int64_t v1, const Emit& emit) const;
   // floor(num / den) as quotient and remainder (0 ≤ r < den), for num stepping by constants.
   struct FloorCursor {
     Int128 q = 0, r = 0;
@@ -102,6 +114,7 @@ class TriangleVoxelizer {
     w1 = static_cast<std::int64_t>(hi < lo ? lo - 1 : hi);
     return single;
   }
+  void Localize();
   bool ColumnInside(std::int64_t pu, std::int64_t pv) const;
   bool DepthRange(std::int64_t pu, std::int64_t pv, std::int64_t& w0, std::int64_t& w1) const;
   bool SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
@@ -118,7 +131,12 @@ class TriangleVoxelizer {
   Int128 depth_den_ = 1, depth_a_lo_ = 0, depth_a_hi_ = 0, depth_b_ = 0, depth_c_ = 0;
   FloorStep depth_step_u_, depth_step_v_;  // one column along u, one row along v
   // Projected edges: [0] the (u,v) plane, [1] (v,w), [2] (w,u); three edges each.
-  std::array<std::array<Edge, 3>, 3> edges_{};
+  EdgeSet<Int128> edges_{};
+  // The same edges in 64 bits, used when every value over the candidate box fits (footprints up
+  // to some thousand voxels): the column walk then runs on native integers.
+  EdgeSet<std::int64_t> edges64_{};
+  bool fits_int64_ = false;
+  std::array<std::int64_t, 3> origin_{};
 };
 
 }  // namespace svokit
