@@ -1,6 +1,7 @@
 // Wavefront OBJ + MTL. Faces are polygons (triangulated by ear clipping); corners reference
 // positions, texture coordinates and normals independently, so attributes become per-corner.
-// Material colours (Kd) are taken as linear values; map_Kd images as sRGB (the usual convention).
+// Material colours (Kd) are taken as linear values; map_Kd images and "v x y z r g b" vertex
+// colours as sRGB (the usual conventions, as for PLY colours).
 
 #include <unordered_map>
 
