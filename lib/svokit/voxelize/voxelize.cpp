@@ -1,7 +1,6 @@
 #include "svokit/voxelize/voxelize.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -24,6 +23,11 @@ constexpr std::int64_t kCoordinateLimit = std::int64_t{1} << (22 + kFixedPointBi
 constexpr std::int64_t kTileColumns = 32;
 constexpr std::size_t kTrianglesPerTask = 512;
 constexpr std::size_t kTilesPerTask = 16;
+
+std::uint64_t VoxelKey(std::int64_t x, std::int64_t y, std::int64_t z) {
+  return MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                      static_cast<std::uint32_t>(z));
+}
 
 struct Tile {
   std::uint32_t triangle;
@@ -48,11 +52,6 @@ class MeshVoxelizer {
                 c = FixedToVoxel(vertices_[tri[2]]);
     const Vec3d n = Cross(b - a, c - a);
     return 0.5 * std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
-  }
-
-  static void Emit(VoxelBitSet& out, std::int64_t x, std::int64_t y, std::int64_t z) {
-    out.Insert(MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                            static_cast<std::uint32_t>(z)));
   }
 
  private:
@@ -181,15 +180,13 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     VoxelBitSet& keys = parts.local();
     if (!attributes) {
       tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-        MeshVoxelizer::Emit(keys, x, y, z);
+        keys.Insert(VoxelKey(x, y, z));
       });
       return;
     }
     BrickRecorder& recorder = recorders.local();
     tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-      const std::uint64_t key =
-          MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                       static_cast<std::uint32_t>(z));
+      const std::uint64_t key = VoxelKey(x, y, z);
       keys.Insert(key);
       recorder.Voxel(key);
     });
@@ -275,9 +272,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                      [&](std::int64_t x, std::int64_t y, std::int64_t z) {
                        const std::int64_t c[3] = {x, y, z};
                        if (c[w] < lo[w] || c[w] >= lo[w] + 16) return;
-                       const auto local = static_cast<std::uint32_t>(MortonEncode(
-                           static_cast<std::uint32_t>(x & 15), static_cast<std::uint32_t>(y & 15),
-                           static_cast<std::uint32_t>(z & 15)));
+                       // The low 12 key bits are the voxel's Morton code inside its brick.
+                       const auto local = static_cast<std::uint32_t>(VoxelKey(x, y, z) & 4095u);
                        acc.Add(local, sampler.Sample(t, x, y, z));
                      });
         }
