@@ -68,6 +68,7 @@ TEST(SvoVoxelizeCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{mesh, "-o", "{dir}/v.vfrag", "-r", "2000000"}, "resolution"},
       {{mesh, "-o", "{dir}/v.vfrag", "--voxel-size", "-1"}, "voxel-size"},
       {{mesh, "-o", "{dir}/v.vfrag", "--voxel-size", "1e-9"}, "exceeds the limit"},
+      {{mesh, "-o", "{dir}/v.vfrag", "--voxel-size", "2e-6"}, "would hold about"},
       {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--mode", "fat"}, "--mode"},
       {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--method", "magic"}, "--method"},
       {{mesh, "-o", "{dir}/v.obj", "-r", "8"}, "output must be a .vfrag, .xyz, .ply file"},

@@ -19,6 +19,8 @@ namespace {
 
 // Snapped coordinates beyond ±2²² voxels could overflow the 128-bit plane test.
 constexpr std::int64_t kCoordinateLimit = std::int64_t{1} << (22 + kFixedPointBits);
+// Voxel sets beyond 2³² voxels (32 GiB of keys alone) are refused.
+constexpr double kMaxVoxels = 4294967296.0;
 // Fragment path: a triangle's footprint is cut into tiles of this many columns per side.
 constexpr std::int64_t kTileColumns = 32;
 constexpr std::size_t kTrianglesPerTask = 512;
@@ -152,6 +154,23 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   }
   const MeshVoxelizer voxelizer(mesh, vertices, grid, options.mode);
   const std::size_t n = mesh.triangles.size();
+
+  // A surface of area A voxel² fills roughly 1.5·A voxels (at most ~3·A): refuse, up front, grids
+  // whose output could not be held rather than run for hours into an out-of-memory failure.
+  const double projected_area = OrderedReduce(
+      n, 1 << 14, 0.0,
+      [&](std::size_t begin, std::size_t end) {
+        double area = 0;
+        for (std::size_t t = begin; t < end; ++t) area += voxelizer.ProjectedArea(t);
+        return area;
+      },
+      [](double& acc, double part) { acc += part; });
+  const double estimate = 3.0 * projected_area + static_cast<double>(n);
+  if (estimate > kMaxVoxels) {
+    return Status::BadInput(
+        "this grid would hold about {:.3g} voxels (limit {:.3g}); use a coarser resolution",
+        estimate, kMaxVoxels);
+  }
 
   // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
