@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/container/bytes.hpp"
+#include "formats/container/grid_section.hpp"
 #include "svokit/core/file_io.hpp"
 
 namespace svokit {
@@ -40,7 +41,7 @@ Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size
   return r.GetArray(out, voxels);
 }
 
-StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
+StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, VfragMetadata* meta) {
   if (!file.ok()) return file.status();
   const std::string& name = file->name();
   auto grid = file->Require(kGrid);
@@ -48,29 +49,12 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
   auto keys = file->Require(kKeys);
   if (!keys.ok()) return keys.status();
 
-  ByteReader g(*grid, name + ": GRID section");
-  Vec3d origin;
-  double h = 0;
-  std::array<std::uint32_t, 3> dims{};
-  std::uint32_t mode = 0;
-  SVOKIT_RETURN_IF_ERROR(g.Get(origin));
-  SVOKIT_RETURN_IF_ERROR(g.Get(h));
-  SVOKIT_RETURN_IF_ERROR(g.Get(dims));
-  SVOKIT_RETURN_IF_ERROR(g.Get(mode));
-  if (!IsFinite(origin) || !(h > 0) || !std::isfinite(h) || mode > 1) {
-    return Status::BadInput("{}: GRID section holds an invalid transform or mode", name);
-  }
-  for (std::uint32_t d : dims) {
-    if (d == 0 || d >= kMortonAxisLimit) {
-      return Status::BadInput("{}: grid dimension {} out of range", name, d);
-    }
-  }
+  VoxelSet set;
+  SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, name, set.grid, set.mode));
+  const auto& dims = set.grid.dims();
   if (keys->size() % sizeof(std::uint64_t) != 0) {
     return Status::BadInput("{}: KEYS section size is not a multiple of 8", name);
   }
-  VoxelSet set;
-  set.grid = GridTransform(origin, h, dims);
-  set.mode = static_cast<VoxelMode>(mode);
   ByteReader k(*keys, name + ": KEYS section");
   SVOKIT_RETURN_IF_ERROR(k.GetArray(set.keys, keys->size() / sizeof(std::uint64_t)));
   for (std::size_t i = 0; i < set.keys.size(); ++i) {
@@ -94,6 +78,16 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file) {
   for (const Vec3f& n : set.normals) {
     if (!IsFinite(n)) return Status::BadInput("{}: non-finite voxel normal", name);
   }
+  if (meta != nullptr) {
+    *meta = {};
+    if (const auto text = file->Find(kMetadata)) {
+      const nlohmann::json j = nlohmann::json::parse(text->begin(), text->end(), nullptr, false);
+      if (j.is_object()) {
+        meta->source = j.value("source", "");
+        meta->options = j.value("options", "");
+      }
+    }
+  }
   return set;
 }
 
@@ -104,12 +98,7 @@ namespace {
 // The container borrows the keys (the largest array); `set` must outlive the returned writer.
 container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   container::Writer file(kVfragFormat, 0);
-  ByteWriter g;
-  g.Put(set.grid.origin());
-  g.Put(set.grid.voxel_size());
-  g.Put(set.grid.dims());
-  g.Put(static_cast<std::uint32_t>(set.mode));
-  file.AddSection(kGrid, std::move(g.bytes()));
+  file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
   file.AddSectionView(kKeys, Bytes(set.keys));
   if (set.has_colors()) file.AddSectionView(kColors, Bytes(set.colors));
   if (set.has_normals()) file.AddSectionView(kNormals, Bytes(set.normals));
@@ -132,12 +121,13 @@ Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
   return MakeWriter(set, meta).WriteFile(path);
 }
 
-StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name) {
-  return DecodeSections(container::Reader::FromBytes(bytes, name, kVfragFormat));
+StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
+                               VfragMetadata* meta) {
+  return DecodeSections(container::Reader::FromBytes(bytes, name, kVfragFormat), meta);
 }
 
-StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path) {
-  return DecodeSections(container::Reader::Open(path, kVfragFormat));
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta) {
+  return DecodeSections(container::Reader::Open(path, kVfragFormat), meta);
 }
 
 Status WriteVoxelsXyz(const VoxelSet& set, const std::filesystem::path& path) {

@@ -26,8 +26,10 @@ struct VfragMetadata {
 std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta);
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
                   const std::filesystem::path& path);
-StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name);
-StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path);
+/// Verifies and decodes; fills `meta` (when given) from the META section.
+StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
+                               VfragMetadata* meta = nullptr);
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta = nullptr);
 
 /// Text export: "# origin X Y Z", "# voxel_size H", "# dims NX NY NZ" (round-trip precision),
 /// then "i j k" per voxel in Morton order.

@@ -29,6 +29,11 @@ struct Box3d {
   }
   Vec3d extent() const { return empty() ? Vec3d{} : hi - lo; }
   Vec3d center() const { return (lo + hi) * 0.5; }
+  /// Whether `b` lies inside this closed box.
+  bool Contains(const Box3d& b) const {
+    return b.lo.x >= lo.x && b.lo.y >= lo.y && b.lo.z >= lo.z && b.hi.x <= hi.x && b.hi.y <= hi.y &&
+           b.hi.z <= hi.z;
+  }
   bool operator==(const Box3d&) const = default;
 };
 

@@ -14,6 +14,8 @@ Progress::Progress(Style style, std::FILE* out) : style_(style), out_(out) {
 
 Progress& Progress::Silent() {
   static Progress silent(Style::kQuiet);
+  static const bool unrecorded = (silent.record_ = false, true);  // shared by all: keep nothing
+  (void)unrecorded;
   return silent;
 }
 
@@ -33,6 +35,15 @@ Progress::Stage::~Stage() {
   }
   done_ = total_;
   Draw(true);
+  if (progress_.record_) {
+    std::lock_guard lock(progress_.timings_mutex_);
+    progress_.timings_.push_back({name_, seconds()});
+  }
+}
+
+std::vector<Progress::Timing> Progress::timings() const {
+  std::lock_guard lock(timings_mutex_);
+  return timings_;
 }
 
 double Progress::Stage::seconds() const {

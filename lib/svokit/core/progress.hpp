@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <mutex>
 #include <string>
+#include <vector>
 
 namespace svokit {
 
@@ -21,6 +22,13 @@ class Progress {
   static Progress& Silent();
 
   Style style() const { return style_; }
+
+  /// Name and wall time of every stage that finished (not cancelled), in finishing order.
+  struct Timing {
+    std::string stage;
+    double seconds;
+  };
+  std::vector<Timing> timings() const;
 
   /// One named stage with `total` work units; finishes (and prints its line) on destruction.
   class Stage {
@@ -55,6 +63,9 @@ class Progress {
  private:
   Style style_;
   std::FILE* out_;
+  bool record_ = true;  // false for the shared Silent() reporter
+  mutable std::mutex timings_mutex_;
+  std::vector<Timing> timings_;
 };
 
 }  // namespace svokit

@@ -1,0 +1,81 @@
+// svo-build: voxel fragment list (.vfrag) → sparse voxel octree (.svo) with filtered bricks and
+// contours fitted to the mesh the voxels came from.
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/app.hpp"
+#include "apps/chain_options.hpp"
+#include "formats/svo/svo_file.hpp"
+#include "formats/vfrag/vfrag.hpp"
+#include "svokit/core/parallel.hpp"
+
+int main(int argc, char** argv) {
+  using namespace svokit;
+  const std::string tool = "svo-build";
+  CLI::App cli{
+      "Builds a sparse voxel octree from a voxel fragment list: nodes level by level, 3x3x3 "
+      "bricks of filtered opacity, colour and normal at every level, and ESVO contour slabs "
+      "fitted to the surface (these need --mesh).",
+      tool};
+  std::filesystem::path input, output, mesh_path;
+  app::BuildCli build;
+  app::CommonOptions common;
+  cli.add_option("input", input, "Voxel fragment list (.vfrag from svo-voxelize)")->required();
+  cli.add_option("-o,--output", output, "Output .svo")->required();
+  cli.add_option("--mesh", mesh_path,
+                 "The mesh that was voxelized (.svm or any mesh file), for the contours");
+  build.Add(cli);
+  app::AddCommonOptions(cli, common);
+
+  return app::Run(tool, cli, argc, argv, [&] {
+    if (Status s = app::CheckOutputPath(output, {"svo"}); !s.ok()) return app::Fail(tool, s);
+    if (build.contours && mesh_path.empty()) {
+      return app::Fail(tool, Status::BadInput("{}: contours are fitted to the surface: give the "
+                                              "voxelized mesh with --mesh, or --no-contours",
+                                              input.string()));
+    }
+    ThreadLimit threads(common.threads);
+    Progress progress = common.MakeProgress();
+    VfragMetadata source;
+    StatusOr<VoxelSet> voxels = [&] {
+      Progress::Stage stage(progress, "read", 1);
+      StatusOr<VoxelSet> v = ReadVfrag(input, &source);
+      if (!v.ok()) stage.Cancel();
+      return v;
+    }();
+    if (!voxels.ok()) return app::Fail(tool, voxels.status());
+    std::optional<Mesh> mesh;
+    if (!mesh_path.empty()) {
+      StatusOr<Mesh> m = app::ImportStage(progress, mesh_path);
+      if (!m.ok()) return app::Fail(tool, m.status());
+      if (!voxels->grid.GridBounds().Contains(m->Bounds())) {
+        return app::Fail(tool, Status::BadInput("{}: the mesh lies outside {}'s grid: not the "
+                                                "mesh that was voxelized",
+                                                mesh_path.string(), input.string()));
+      }
+      mesh = std::move(*m);
+    }
+    const nlohmann::json meta = {{"source", source.source},
+                                 {"voxelize", source.options},
+                                 {"build", build.Recorded()},
+                                 {"generator", "svokit " SVOKIT_VERSION}};
+    StatusOr<Svo> svo =
+        BuildSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta.dump(), progress);
+    if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
+    Status written;
+    {
+      Progress::Stage stage(progress, "write", 1);
+      written = WriteSvo(*svo, output);
+      if (!written.ok()) stage.Cancel();
+    }
+    if (!written.ok()) return app::Fail(tool, written);
+    fmt::print("input       {} ({} voxels)\n", input.string(), voxels->size());
+    fmt::print("octree      depth {}, bricks {}, contours {}\n", svo->depth, build.bricks,
+               build.contours ? "on" : "off");
+    fmt::print("{}", LevelTable(*svo));
+    fmt::print("output      {} ({} bytes)\n", output.string(), std::filesystem::file_size(output));
+    return 0;
+  });
+}

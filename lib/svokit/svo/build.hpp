@@ -1,0 +1,33 @@
+#pragma once
+// svo-build: a VoxelSet → an Svo, bottom-up from the sorted Morton keys, one linear pass per
+// level; bricks filtered level by level (bricks.hpp), contours fitted to the mesh (contour.hpp).
+
+#include <cstdint>
+
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/contour.hpp"
+#include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+struct BuildOptions {
+  std::uint32_t brick_side = 3;  ///< 3, 2 or 0 (no bricks)
+  bool contours = true;          ///< needs the mesh
+  ContourOptions contour;
+};
+
+/// The octree of `voxels`; `mesh` (the surface the voxels came from, in the same world space) is
+/// required when options.contours is set. `metadata` is stored verbatim (JSON).
+StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
+                       std::string metadata = "{}", Progress& progress = Progress::Silent());
+
+/// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending.
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(const std::vector<std::uint64_t>& keys,
+                                                            std::uint32_t depth);
+/// The depth whose 2^depth cube encloses the grid.
+std::uint32_t OctreeDepth(const GridTransform& grid);
+
+}  // namespace svokit

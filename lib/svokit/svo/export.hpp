@@ -1,0 +1,48 @@
+#pragma once
+// svo-export's writers: an Svo (or one of its coarser levels) as OpenVDB grids, binvox,
+// MagicaVoxel .vox, PLY points or xyz text, chosen by the output extension.
+//
+// Every format goes through one VoxelSet: the nodes of the exported level as voxels of that
+// level's node size, on the octree's origin, so all writers agree on coordinates and attributes.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+#include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+struct ExportOptions {
+  /// The octree level whose nodes become the exported voxels; the finest (voxel) level if unset.
+  std::optional<std::uint32_t> level;
+};
+
+/// The extensions ExportSvo understands, lower case, without the dot.
+const std::vector<std::string>& ExportExtensions();
+
+/// Writes `svo` to `path` in the format its extension names (.vdb, .binvox, .vox, .ply, .xyz),
+/// atomically; an unknown extension or an impossible level is a bad-input error.
+Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options);
+
+/// The nodes of `level` (≤ svo.depth, and loaded) as voxels: grid origin = the octree's, voxel
+/// size = NodeSize(level), dims = the leaf grid's rounded up to whole nodes; keys = LevelKeys.
+/// A node's colour and normal are its brick's centre sample (side 3) or the opacity-weighted mean
+/// of its 8 corners (side 2); without bricks only occupancy.
+VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level);
+
+/// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
+/// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).
+Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path);
+/// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
+/// scene graph at its grid position; colours median-cut into at most 255 palette entries.
+Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
+/// OpenVDB: BoolGrid "occupancy", Vec3f grids "color" (linear RGB) and "normal" when present, all
+/// sharing a transform whose voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp).
+Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path);
+
+}  // namespace svokit
