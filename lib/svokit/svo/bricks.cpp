@@ -91,119 +91,165 @@ void Accumulate(PremultipliedSample& acc, const PremultipliedSample& v, float w)
   acc.nz += w * v.nz;
 }
 
-void Store(const Svo& svo, const BrickSample& s, std::size_t at, SvoLevel& out) {
-  out.opacity[at] = EncodeUnorm8(s.opacity);
-  if (svo.has_color) out.color[at] = EncodeColor(s.color);
-  if (svo.has_normal) out.normal[at] = EncodeNormal(s.normal);
+struct EncodedSample {
+  std::uint8_t opacity;
+  std::uint32_t color;
+  std::uint16_t normal;
+};
+
+EncodedSample Encode(const Svo& svo, const PremultipliedSample& p) {
+  const BrickSample s = Unpremultiply(p);
+  return {EncodeUnorm8(s.opacity), svo.has_color ? EncodeColor(s.color) : 0u,
+          svo.has_normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
+}
+
+void Store(const EncodedSample& e, std::size_t at, SvoLevel& out) {
+  out.opacity[at] = e.opacity;
+  if (!out.color.empty()) out.color[at] = e.color;
+  if (!out.normal.empty()) out.normal[at] = e.normal;
 }
 
 // Voxel-level bricks of the children of `node` (level depth − 1), from the voxels' own attributes.
+// The samples of all children lie on one lattice of (2·side − 1)³ points: each point is computed
+// and encoded once, then copied into every child brick that holds it.
 void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint64_t node) {
-  const std::uint32_t side = svo.brick_side;
-  const int step = side == 3 ? 1 : 2;  // sample spacing in half voxels
-  SvoLevel& out = svo.levels[svo.depth];
-  const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
-  for (unsigned ch = 0; ch < 8; ++ch) {
-    if (!(parent.child_mask & (1u << ch))) continue;
-    const int ex = static_cast<int>(ch & 1) + 1, ey = static_cast<int>((ch >> 1) & 1) + 1,
-              ez = static_cast<int>((ch >> 2) & 1) + 1;
-    const std::uint64_t voxel = parent.Child(ch);
-    for (std::uint32_t s = 0; s < svo.brick_samples(); ++s) {
-      const int t[3] = {static_cast<int>(s % side) * step,
-                        static_cast<int>((s / side) % side) * step,
-                        static_cast<int>(s / (side * side)) * step};
-      // Per axis, the block cells whose closed cube holds the sample, in ascending position
-      // (the same order for every voxel sharing the sample).
-      int lo[3], hi[3];
-      const int e[3] = {ex, ey, ez};
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = t[a] == 0 ? e[a] - 1 : e[a];
-        hi[a] = t[a] == 2 ? e[a] + 1 : e[a];
-      }
-      PremultipliedSample acc;
-      int cells = 0;
-      for (int z = lo[2]; z <= hi[2]; ++z) {
-        for (int y = lo[1]; y <= hi[1]; ++y) {
-          for (int x = lo[0]; x <= hi[0]; ++x) {
-            ++cells;
-            const std::int64_t v = block[static_cast<std::size_t>(x + 4 * (y + 4 * z))];
-            if (v < 0) continue;
-            BrickSample b;
-            b.opacity = 1;
-            if (svo.has_color) b.color = voxels.colors[static_cast<std::size_t>(v)];
-            if (svo.has_normal) b.normal = voxels.normals[static_cast<std::size_t>(v)];
-            Accumulate(acc, Premultiply(b), 1.f);
+  const int side = static_cast<int>(svo.brick_side);
+  const int points = 2 * side - 1;     // per axis, over the 2 children
+  const int step = side == 3 ? 1 : 2;  // point spacing in half voxels
+  std::array<PremultipliedSample, 64> cells;
+  for (std::size_t c = 0; c < 64; ++c) {
+    if (block[c] < 0) continue;
+    BrickSample b;
+    b.opacity = 1;
+    if (svo.has_color) b.color = voxels.colors[static_cast<std::size_t>(block[c])];
+    if (svo.has_normal) b.normal = voxels.normals[static_cast<std::size_t>(block[c])];
+    cells[c] = Premultiply(b);
+  }
+  std::array<EncodedSample, 125> encoded;
+  for (int z = 0; z < points; ++z) {
+    for (int y = 0; y < points; ++y) {
+      for (int x = 0; x < points; ++x) {
+        // Per axis, the block cells whose closed cube holds the point, in ascending position (the
+        // same operands in the same order for every node that computes this point).
+        int lo[3], hi[3];
+        const int t[3] = {x * step, y * step, z * step};  // half voxels from the children's min
+        for (int a = 0; a < 3; ++a) {  // block cell j spans half voxels [2j − 2, 2j]
+          lo[a] = (t[a] + 1) / 2;
+          hi[a] = t[a] / 2 + 1;
+        }
+        PremultipliedSample sum;
+        for (int cz = lo[2]; cz <= hi[2]; ++cz) {
+          for (int cy = lo[1]; cy <= hi[1]; ++cy) {
+            for (int cx = lo[0]; cx <= hi[0]; ++cx) {
+              const std::size_t c = static_cast<std::size_t>(cx + 4 * (cy + 4 * cz));
+              if (block[c] >= 0) Accumulate(sum, cells[c], 1.f);
+            }
           }
         }
+        const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+        PremultipliedSample mean;
+        Accumulate(mean, sum, 1.f / static_cast<float>(count));
+        encoded[static_cast<std::size_t>(x + points * (y + points * z))] = Encode(svo, mean);
       }
-      const float w = 1.f / static_cast<float>(cells);
-      PremultipliedSample mean;
-      Accumulate(mean, acc, w);
-      Store(svo, Unpremultiply(mean), voxel * svo.brick_samples() + s, out);
+    }
+  }
+  SvoLevel& out = svo.levels[svo.depth];
+  const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
+  const int span = side - 1;  // points per voxel edge
+  for (unsigned ch = 0; ch < 8; ++ch) {
+    if (!(parent.child_mask & (1u << ch))) continue;
+    const int ex = static_cast<int>(ch & 1) * span, ey = static_cast<int>((ch >> 1) & 1) * span,
+              ez = static_cast<int>((ch >> 2) & 1) * span;
+    const std::size_t base = parent.Child(ch) * static_cast<std::size_t>(svo.brick_samples());
+    for (int sz = 0; sz < side; ++sz) {
+      for (int sy = 0; sy < side; ++sy) {
+        for (int sx = 0; sx < side; ++sx) {
+          const int p = (ex + sx) + points * ((ey + sy) + points * (ez + sz));
+          Store(encoded[static_cast<std::size_t>(p)],
+                base + static_cast<std::size_t>(sx + side * (sy + side * sz)), out);
+        }
+      }
     }
   }
 }
 
-// The brick of `node` at `level` from the level + 1 bricks in `block`.
+// The brick of `node` at `level` from the level + 1 bricks in `block`: the finer bricks are
+// decoded onto one lattice over the block, then filtered by the separable tent.
 void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_t node) {
   const int side = static_cast<int>(svo.brick_side);
-  const int span = 2 * side + 1;  // finer samples per axis under the tent: −1 .. 2·side − 1
-  const int cell = side - 1;      // finer node size in finer sample spacings
-  std::vector<PremultipliedSample> fine(static_cast<std::size_t>(span * span * span));
-  for (int z = 0; z < span; ++z) {
-    for (int y = 0; y < span; ++y) {
-      for (int x = 0; x < span; ++x) {
-        // Any finer node whose closed cube holds the point has the same sample there.
-        const int u[3] = {x - 1, y - 1, z - 1};
-        int b0[3], n0[3];
-        bool border[3];
-        for (int a = 0; a < 3; ++a) {
-          const int q = (u[a] + cell) / cell - 1;  // floor(u / cell) for u ≥ −1
-          b0[a] = q + 1;
-          border[a] = u[a] - q * cell == 0;
-          n0[a] = u[a] - q * cell;
-        }
-        PremultipliedSample value;
-        for (int alt = 0; alt < 8; ++alt) {
-          int b[3], n[3];
-          bool valid = true;
-          for (int a = 0; a < 3; ++a) {
-            const bool down = (alt >> a) & 1;
-            if (down && !border[a]) valid = false;
-            b[a] = b0[a] - (down ? 1 : 0);
-            n[a] = down ? cell : n0[a];
-            if (b[a] < 0 || b[a] > 3) valid = false;
-          }
-          if (!valid) continue;
-          const std::int64_t f = block[static_cast<std::size_t>(b[0] + 4 * (b[1] + 4 * b[2]))];
-          if (f < 0) continue;
-          const std::uint32_t sample =
-              static_cast<std::uint32_t>(n[0] + side * (n[1] + side * n[2]));
-          value = Premultiply(svo.Sample(level + 1, static_cast<std::uint64_t>(f), sample));
-          break;
-        }
-        fine[static_cast<std::size_t>(x + span * (y + span * z))] = value;
-      }
-    }
-  }
-  static constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};
-  SvoLevel& out = svo.levels[level];
-  for (int sz = 0; sz < side; ++sz) {
-    for (int sy = 0; sy < side; ++sy) {
-      for (int sx = 0; sx < side; ++sx) {
-        PremultipliedSample acc;
-        for (int dz = 0; dz < 3; ++dz) {
-          for (int dy = 0; dy < 3; ++dy) {
-            for (int dx = 0; dx < 3; ++dx) {
-              const int x = 2 * sx + dx, y = 2 * sy + dy, z = 2 * sz + dz;
-              Accumulate(acc, fine[static_cast<std::size_t>(x + span * (y + span * z))],
-                         kTent[dx] * kTent[dy] * kTent[dz]);
+  const int cell = side - 1;  // finer node edge in finer sample spacings
+  // Parent sample k sits at lattice index cell + 2k over the block; its tent reads indices
+  // [cell − 1, cell − 1 + n): only those lattice points are decoded.
+  const int lo = cell - 1, n = 2 * side + 1;
+  static thread_local std::vector<PremultipliedSample> lattice;
+  lattice.assign(static_cast<std::size_t>(n * n * n), PremultipliedSample{});
+  const auto at = [n](int x, int y, int z) {
+    return static_cast<std::size_t>(x + n * (y + n * z));
+  };
+  const std::uint32_t samples = svo.brick_samples();
+  const SvoLevel& finer = svo.levels[level + 1];
+  for (int bz = 0; bz < 4; ++bz) {
+    for (int by = 0; by < 4; ++by) {
+      for (int bx = 0; bx < 4; ++bx) {
+        const std::int64_t f = block[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))];
+        if (f < 0) continue;
+        // Samples shared with a neighbour brick are equal, so overwriting is harmless.
+        const std::size_t first = static_cast<std::size_t>(f) * samples;
+        for (int nz = 0; nz < side; ++nz) {
+          const int z = bz * cell + nz - lo;
+          if (z < 0 || z >= n) continue;
+          for (int ny = 0; ny < side; ++ny) {
+            const int y = by * cell + ny - lo;
+            if (y < 0 || y >= n) continue;
+            for (int nx = 0; nx < side; ++nx) {
+              const int x = bx * cell + nx - lo;
+              const std::size_t i = first + static_cast<std::size_t>(nx + side * (ny + side * nz));
+              if (x < 0 || x >= n || finer.opacity[i] == 0) continue;
+              BrickSample s;
+              s.opacity = DecodeUnorm8(finer.opacity[i]);
+              if (svo.has_color) s.color = DecodeColor(finer.color[i]);
+              if (svo.has_normal) s.normal = DecodeNormal(finer.normal[i]);
+              lattice[at(x, y, z)] = Premultiply(s);
             }
           }
         }
-        const std::size_t at =
-            node * svo.brick_samples() + static_cast<std::size_t>(sx + side * (sy + side * sz));
-        Store(svo, Unpremultiply(acc), at, out);
+      }
+    }
+  }
+  // Separable tent, one axis at a time (x, then y, then z): every shared sample is the same sum
+  // of the same values in the same order, whichever parent computes it.
+  static constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};
+  std::array<PremultipliedSample, 7 * 7 * 3> fx{};
+  std::array<PremultipliedSample, 7 * 3 * 3> fy{};
+  for (int z = 0; z < n; ++z) {
+    for (int y = 0; y < n; ++y) {
+      for (int k = 0; k < side; ++k) {
+        PremultipliedSample& o = fx[static_cast<std::size_t>(k + side * (y + n * z))];
+        for (int d = 0; d < 3; ++d) Accumulate(o, lattice[at(2 * k + d, y, z)], kTent[d]);
+      }
+    }
+  }
+  for (int z = 0; z < n; ++z) {
+    for (int k = 0; k < side; ++k) {
+      for (int x = 0; x < side; ++x) {
+        PremultipliedSample& o = fy[static_cast<std::size_t>(x + side * (k + side * z))];
+        for (int d = 0; d < 3; ++d) {
+          Accumulate(o, fx[static_cast<std::size_t>(x + side * (2 * k + d + n * z))], kTent[d]);
+        }
+      }
+    }
+  }
+  SvoLevel& out = svo.levels[level];
+  for (int k = 0; k < side; ++k) {
+    for (int y = 0; y < side; ++y) {
+      for (int x = 0; x < side; ++x) {
+        PremultipliedSample o;
+        for (int d = 0; d < 3; ++d) {
+          Accumulate(o, fy[static_cast<std::size_t>(x + side * (y + side * (2 * k + d)))],
+                     kTent[d]);
+        }
+        Store(Encode(svo, o), node * samples + static_cast<std::size_t>(x + side * (y + side * k)),
+              out);
       }
     }
   }

@@ -63,11 +63,7 @@ std::string LevelTable(const Svo& svo) {
 }
 
 std::uint8_t EncodeUnorm8(float v) {
-  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f));
-}
-
-float DecodeUnorm8(std::uint8_t v) {
-  return static_cast<float>(v) / 255.f;
+  return static_cast<std::uint8_t>(std::clamp(v, 0.f, 1.f) * 255.f + 0.5f);
 }
 
 namespace {
@@ -81,9 +77,16 @@ const std::array<float, 256>& SrgbDecodeTable() {
   return table;
 }
 
+// Nearest 8-bit sRGB code: the codes' midpoints, converted to linear once, are searched instead of
+// calling pow per channel (the bricks encode millions of samples).
 std::uint32_t EncodeSrgb8(float linear) {
-  return static_cast<std::uint32_t>(
-      std::lround(LinearToSrgb(std::clamp(linear, 0.f, 1.f)) * 255.f));
+  static const std::array<float, 255> midpoints = [] {
+    std::array<float, 255> m{};
+    for (int i = 0; i < 255; ++i) m[i] = SrgbToLinear((static_cast<float>(i) + 0.5f) / 255.f);
+    return m;
+  }();
+  return static_cast<std::uint32_t>(std::upper_bound(midpoints.begin(), midpoints.end(), linear) -
+                                    midpoints.begin());
 }
 
 std::uint32_t EncodeSnorm8(float v) {  // [−1, 1] → [1, 255]; 0 stays free for "no normal"
@@ -121,7 +124,9 @@ std::uint16_t EncodeNormal(const Vec3f& n) {
   return static_cast<std::uint16_t>(EncodeSnorm8(x) | EncodeSnorm8(y) << 8);
 }
 
-Vec3f DecodeNormal(std::uint16_t oct) {
+namespace {
+
+Vec3f ComputeDecodedNormal(std::uint16_t oct) {
   if (oct == 0) return {0, 0, 0};
   float x = DecodeSnorm8(oct & 0xffu), y = DecodeSnorm8(oct >> 8);
   const float z = 1.f - std::abs(x) - std::abs(y);
@@ -133,6 +138,19 @@ Vec3f DecodeNormal(std::uint16_t oct) {
   }
   const float len = std::sqrt(x * x + y * y + z * z);
   return {x / len, y / len, z / len};
+}
+
+}  // namespace
+
+Vec3f DecodeNormal(std::uint16_t oct) {
+  static const std::vector<Vec3f> table = [] {
+    std::vector<Vec3f> t(65536);
+    for (std::uint32_t i = 0; i < t.size(); ++i) {
+      t[i] = ComputeDecodedNormal(static_cast<std::uint16_t>(i));
+    }
+    return t;
+  }();
+  return table[oct];
 }
 
 }  // namespace svokit

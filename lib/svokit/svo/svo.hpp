@@ -99,7 +99,9 @@ std::string LevelTable(const Svo& svo);
 
 // Brick sample quantization, shared by the builder, the reader's checks and the exporters.
 std::uint8_t EncodeUnorm8(float v);
-float DecodeUnorm8(std::uint8_t v);
+inline float DecodeUnorm8(std::uint8_t v) {
+  return static_cast<float>(v) * (1.f / 255.f);
+}
 std::uint32_t EncodeColor(const Rgba& linear);  ///< sRGB RGB, linear A, 8 bits each
 Rgba DecodeColor(std::uint32_t rgba8);
 std::uint16_t EncodeNormal(const Vec3f& n);  ///< octahedral snorm8 ([1, 255]); 0 for a zero normal
