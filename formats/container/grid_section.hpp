@@ -1,6 +1,6 @@
 #pragma once
 // The GRID section every voxel format stores (.vfrag, .svo): origin (3 × f64), voxel size (f64),
-// dims (3 × u32), voxelization mode (u32) — 44 bytes, little-endian.
+// dims (3 × u32), voxelization mode (u32) — 48 bytes, little-endian (formats/vfrag/README.md).
 
 #include <array>
 #include <cmath>
