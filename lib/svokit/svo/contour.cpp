@@ -1,0 +1,524 @@
+#include "svokit/svo/contour.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "svokit/core/morton.hpp"
+
+namespace svokit {
+
+std::uint32_t EncodeContour(const Contour& c) {
+  const auto field = [](int v, int bits) {
+    return static_cast<std::uint32_t>(v) & ((1u << bits) - 1u);
+  };
+  return field(c.thickness, 7) << 25 | field(c.position, 7) << 18 | field(c.nx, 6) << 12 |
+         field(c.ny, 6) << 6 | field(c.nz, 6);
+}
+
+Contour DecodeContour(std::uint32_t word) {
+  // Sign-extend a `bits`-wide two's complement field.
+  const auto sfield = [word](int shift, int bits) {
+    const int v = static_cast<int>((word >> shift) & ((1u << bits) - 1u));
+    return v >= (1 << (bits - 1)) ? v - (1 << bits) : v;
+  };
+  Contour c;
+  c.thickness = static_cast<int>(word >> 25);
+  c.position = sfield(18, 7);
+  c.nx = sfield(12, 6);
+  c.ny = sfield(6, 6);
+  c.nz = sfield(0, 6);
+  return c;
+}
+
+ContourSpan ClippedSpan(const Contour& c) {
+  ContourSpan s;
+  s.l1 = std::abs(c.nx) + std::abs(c.ny) + std::abs(c.nz);
+  s.l2 = std::sqrt(double(c.nx * c.nx + c.ny * c.ny + c.nz * c.nz));
+  s.low = std::clamp(c.Low(), -0.5 * s.l1, 0.5 * s.l1);
+  s.high = std::clamp(c.High(), -0.5 * s.l1, 0.5 * s.l1);
+  return s;
+}
+
+std::vector<ContourLevelStats> ComputeContourStats(
+    const std::vector<std::vector<std::uint32_t>>& contours) {
+  std::vector<ContourLevelStats> stats(contours.size());
+  for (std::size_t level = 0; level < contours.size(); ++level) {
+    ContourLevelStats& st = stats[level];
+    double sum_rel = 0, sum_ext = 0;
+    for (const std::uint32_t w : contours[level]) {
+      ++st.nodes;
+      if (w == 0) continue;
+      const ContourSpan s = ClippedSpan(DecodeContour(w));
+      ++st.with_contour;
+      sum_rel += (s.high - s.low) / s.l2;
+      sum_ext += (s.high - s.low) / s.l1;
+    }
+    if (st.with_contour > 0) {
+      st.mean_relative_thickness = sum_rel / static_cast<double>(st.with_contour);
+      st.mean_extent_fraction = sum_ext / static_cast<double>(st.with_contour);
+    }
+  }
+  return stats;
+}
+
+namespace {
+
+// Margin added to both sides of a fitted slab, in node sizes: far above the rounding error of
+// clipping and of evaluating n·u (~1e-13), far below the quantization step (~1/250).
+constexpr double kSlabMargin = 1e-6;
+// Quantization step of Low/High: Low = 0.375·(2·pos − thick), High = 0.375·(2·pos + thick).
+constexpr double kStep = 0.375;
+// Nodes with at least this many pieces hand their children to TBB; below, a subtree is one task.
+constexpr std::size_t kParallelPieces = 512;
+// Nodes with this many pieces run the hill climb from the 4 best of 15 starting normals.
+constexpr std::size_t kMultiStartPieces = 64;
+// Point budget of the normal search in one node (see FitNode).
+constexpr std::size_t kSearchPoints = 4096;
+// Bound on hill-climbing steps; leaves converge in 1–3, the root in ~10.
+constexpr int kMaxSearchSteps = 32;
+
+// Convex polygons (triangles clipped to boxes), flat: piece i is verts[begin, begin + count).
+struct Piece {
+  std::uint32_t tri;
+  std::uint32_t begin;
+  std::uint32_t count;
+};
+struct Pieces {
+  std::vector<Vec3d> verts;
+  std::vector<Piece> pieces;
+  void clear() {
+    verts.clear();
+    pieces.clear();
+  }
+  void Add(std::uint32_t tri, const Vec3d* v, std::size_t n) {
+    pieces.push_back(
+        {tri, static_cast<std::uint32_t>(verts.size()), static_cast<std::uint32_t>(n)});
+    verts.insert(verts.end(), v, v + n);
+  }
+};
+
+// Sutherland–Hodgman against one closed axis half-space: keeps p[axis] ≤ value (keep_low) or
+// ≥ value. Points on the plane are kept, so geometry in a shared face goes to both sides; new
+// vertices are snapped onto the plane. Exact consecutive duplicates are dropped.
+void ClipAxis(const std::vector<Vec3d>& in, int axis, double value, bool keep_low,
+              std::vector<Vec3d>& out) {
+  out.clear();
+  const std::size_t n = in.size();
+  const auto dist = [&](const Vec3d& p) { return keep_low ? p[axis] - value : value - p[axis]; };
+  const auto push = [&](const Vec3d& p) {
+    if (out.empty() || !(out.back() == p)) out.push_back(p);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3d& a = in[i];
+    const Vec3d& b = in[(i + 1) % n];
+    const double da = dist(a), db = dist(b);
+    if (da <= 0) push(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      Vec3d p = a + (b - a) * (da / (da - db));
+      p[axis] = value;
+      push(p);
+    }
+  }
+  if (out.size() > 1 && out.front() == out.back()) out.pop_back();
+}
+
+struct Fit {
+  double cost = std::numeric_limits<double>::infinity();  // clipped thickness / node size
+  Contour c;
+};
+
+struct Scratch {
+  std::vector<Vec3d> a, b;
+  std::array<std::vector<Vec3d>, 2> x;
+  std::array<std::vector<Vec3d>, 4> xy;
+  std::vector<Vec3d> u;  // fit points in node units
+  std::vector<float> uf;
+  std::vector<Fit> starts;
+  std::vector<Vec3d> sub;
+};
+
+// Splits every piece of `in` among the children present in `out` by the node's mid-planes. The
+// half-spaces overlap by eps so that rounding can never drop geometry lying on a mid-plane.
+void SplitPieces(const Pieces& in, const Vec3d& mid, double eps, std::array<Pieces*, 8>& out,
+                 Scratch& s) {
+  for (const Piece& pc : in.pieces) {
+    const Vec3d* v = in.verts.data() + pc.begin;
+    Vec3d lo = v[0], hi = v[0];
+    for (std::uint32_t i = 1; i < pc.count; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], v[i][a]);
+        hi[a] = std::max(hi[a], v[i][a]);
+      }
+    }
+    std::array<unsigned, 3> sides{};  // bit 0: low half touched, bit 1: high half touched
+    unsigned single = 0;
+    bool one_child = true;
+    for (int a = 0; a < 3; ++a) {
+      sides[static_cast<std::size_t>(a)] =
+          (lo[a] <= mid[a] + eps ? 1u : 0u) | (hi[a] >= mid[a] - eps ? 2u : 0u);
+      if (sides[static_cast<std::size_t>(a)] == 3u) one_child = false;
+      if (sides[static_cast<std::size_t>(a)] == 2u) single |= 1u << a;
+    }
+    if (one_child) {
+      if (out[single]) out[single]->Add(pc.tri, v, pc.count);
+      continue;
+    }
+    s.a.assign(v, v + pc.count);
+    // Stage x → up to 2 polygons, y → up to 4, z → up to 8; a side the piece does not reach
+    // (or whose children are all absent) is skipped.
+    for (unsigned cx = 0; cx < 2; ++cx) {
+      if (!(sides[0] >> cx & 1u)) continue;
+      auto& px = s.x[cx];
+      if (sides[0] == 3u) {
+        ClipAxis(s.a, 0, cx ? mid.x - eps : mid.x + eps, cx == 0, px);
+      } else {
+        px = s.a;
+      }
+      if (px.empty()) continue;
+      for (unsigned cy = 0; cy < 2; ++cy) {
+        if (!(sides[1] >> cy & 1u)) continue;
+        auto& pxy = s.xy[cx * 2 + cy];
+        if (sides[1] == 3u) {
+          ClipAxis(px, 1, cy ? mid.y - eps : mid.y + eps, cy == 0, pxy);
+        } else {
+          pxy = px;
+        }
+        if (pxy.empty()) continue;
+        for (unsigned cz = 0; cz < 2; ++cz) {
+          if (!(sides[2] >> cz & 1u)) continue;
+          Pieces* dst = out[cx | cy << 1 | cz << 2];
+          if (!dst) continue;
+          if (sides[2] == 3u) {
+            ClipAxis(pxy, 2, cz ? mid.z - eps : mid.z + eps, cz == 0, s.b);
+            if (!s.b.empty()) dst->Add(pc.tri, s.b.data(), s.b.size());
+          } else {
+            dst->Add(pc.tri, pxy.data(), pxy.size());
+          }
+        }
+      }
+    }
+  }
+}
+
+// floor() for |x| < 2^31 without a libm call (baseline x86-64 has no roundsd).
+int Floor(double x) {
+  const int i = static_cast<int>(x);
+  return i - (x < i ? 1 : 0);
+}
+
+// The tightest quantized slab along integer normal n (non-zero) holding n·u ∈ [dmin, dmax], widened
+// by the safety margin and rounded outward.
+Fit Quantize(double dmin, double dmax, int nx, int ny, int nz) {
+  Fit f;
+  const double l1 = std::abs(nx) + std::abs(ny) + std::abs(nz), half = 0.5 * l1;
+  const double inv_norm = 1 / std::sqrt(double(nx * nx + ny * ny + nz * nz));
+  // Geometry inside the cube never leaves [−L1/2, L1/2] along n: clamp before widening.
+  const double margin = kSlabMargin * l1;
+  const double lo = (std::max(dmin, -half) - margin) * (1 / kStep);
+  const double hi = (std::min(dmax, half) + margin) * (1 / kStep);
+  // Need 2·pos − thick ≤ lo and 2·pos + thick ≥ hi; the best pos straddles (lo + hi)/4.
+  const int p0 = Floor((lo + hi) * 0.25);
+  for (int pos = p0; pos <= p0 + 1; ++pos) {
+    const int p = std::clamp(pos, -64, 63);
+    const int t = -Floor(-std::max(2.0 * p - lo, hi - 2.0 * p));
+    if (t < 0 || t > 127) continue;
+    Contour c{nx, ny, nz, p, t};
+    const double cost = (std::min(c.High(), half) - std::max(c.Low(), -half)) * inv_norm;
+    if (cost < f.cost) f = {cost, c};
+  }
+  return f;
+}
+
+// The tightest conservative quantized slab along integer normal n for points `u` (node units).
+// Gives up (infinite cost) as soon as the raw width shows it cannot beat `bound`.
+Fit EvalNormal(const std::vector<Vec3d>& u, int nx, int ny, int nz,
+               double bound = std::numeric_limits<double>::infinity()) {
+  Fit f;
+  const int l1i = std::abs(nx) + std::abs(ny) + std::abs(nz);
+  if (l1i == 0) return f;
+  const double dx = nx, dy = ny, dz = nz;
+  const double half = 0.5 * l1i;
+  const double norm = std::sqrt(dx * dx + dy * dy + dz * dz);
+  const double width_bound = bound * norm;
+  double dmin = std::numeric_limits<double>::infinity(), dmax = -dmin;
+  for (const Vec3d& p : u) {
+    const double d = dx * p.x + dy * p.y + dz * p.z;
+    dmin = std::min(dmin, d);
+    dmax = std::max(dmax, d);
+    if (std::min(dmax, half) - std::max(dmin, -half) >= width_bound) return f;
+  }
+  return Quantize(dmin, dmax, nx, ny, nz);
+}
+
+// The 26 integer neighbour offsets of a normal (each component −1, 0 or +1), padded to 28 lanes.
+struct Offsets {
+  alignas(32) std::array<float, 28> x{}, y{}, z{};
+  Offsets() {
+    int k = 0;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (!dx && !dy && !dz) continue;
+          x[static_cast<std::size_t>(k)] = float(dx);
+          y[static_cast<std::size_t>(k)] = float(dy);
+          z[static_cast<std::size_t>(k)] = float(dz);
+          ++k;
+        }
+      }
+    }
+  }
+};
+const Offsets kOffsets;
+
+// Steepest descent over the 26 integer neighbours of n. Each step measures all 26 slabs in one
+// float pass over the points (vectorizes; 4× faster than 26 passes), then re-fits the winner
+// exactly in double, so rounding in the search can cost tightness but never conservativeness.
+Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best) {
+  uf.resize(u.size() * 3);
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    uf[3 * i] = float(u[i].x);
+    uf[3 * i + 1] = float(u[i].y);
+    uf[3 * i + 2] = float(u[i].z);
+  }
+  for (int iter = 0; iter < kMaxSearchSteps; ++iter) {
+    alignas(32) std::array<float, 28> mn, mx;
+    mn.fill(std::numeric_limits<float>::infinity());
+    mx.fill(-std::numeric_limits<float>::infinity());
+    const float fx = float(best.c.nx), fy = float(best.c.ny), fz = float(best.c.nz);
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const float px = uf[3 * i], py = uf[3 * i + 1], pz = uf[3 * i + 2];
+      const float d0 = fx * px + fy * py + fz * pz;
+      for (std::size_t k = 0; k < 28; ++k) {
+        const float d = d0 + kOffsets.x[k] * px + kOffsets.y[k] * py + kOffsets.z[k] * pz;
+        mn[k] = std::min(mn[k], d);
+        mx[k] = std::max(mx[k], d);
+      }
+    }
+    // Candidates by their float estimate; the best few are re-fitted exactly.
+    std::array<std::pair<double, int>, 26> est;
+    int n_est = 0;
+    for (std::size_t k = 0; k < 26; ++k) {
+      const int nx = best.c.nx + int(kOffsets.x[k]), ny = best.c.ny + int(kOffsets.y[k]),
+                nz = best.c.nz + int(kOffsets.z[k]);
+      if (std::min({nx, ny, nz}) < -32 || std::max({nx, ny, nz}) > 31) continue;
+      if (!nx && !ny && !nz) continue;
+      // The clipped raw width is a lower bound of the quantized thickness: prune on it first.
+      const double half = 0.5 * (std::abs(nx) + std::abs(ny) + std::abs(nz));
+      const double width = std::min(double(mx[k]), half) - std::max(double(mn[k]), -half);
+      if (width * width >= best.cost * best.cost * double(nx * nx + ny * ny + nz * nz)) continue;
+      const double cost = Quantize(mn[k], mx[k], nx, ny, nz).cost;
+      if (cost < best.cost + 1e-6) est[std::size_t(n_est++)] = {cost, int(k)};
+    }
+    std::sort(est.begin(), est.begin() + n_est);
+    bool moved = false;
+    for (int e = 0; e < std::min(n_est, 3) && !moved; ++e) {
+      const auto k = static_cast<std::size_t>(est[std::size_t(e)].second);
+      const Fit f = EvalNormal(u, best.c.nx + int(kOffsets.x[k]), best.c.ny + int(kOffsets.y[k]),
+                               best.c.nz + int(kOffsets.z[k]), best.cost);
+      if (f.cost < best.cost) best = f, moved = true;
+    }
+    if (!moved) break;
+  }
+  return best;
+}
+
+// Scales a real direction so its largest component is ±31 and rounds it.
+std::array<int, 3> QuantizeNormal(const Vec3d& n) {
+  const double m = std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
+  std::array<int, 3> q{};
+  for (int a = 0; a < 3; ++a)
+    q[static_cast<std::size_t>(a)] = static_cast<int>(std::lround(n[a] / m * 31));
+  return q;
+}
+
+struct Context {
+  const Mesh* mesh;
+  std::vector<Vec3d> vox;  // mesh positions in voxel space
+  std::uint32_t depth;
+  std::span<const std::vector<std::uint64_t>> keys;
+  ContourOptions options;
+  double eps;  // overlap of clipping half-spaces, voxel units
+  std::vector<std::vector<std::uint32_t>>* out;
+};
+
+std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& center, double size,
+                      Scratch& s) {
+  s.u.clear();
+  Vec3d normal{}, fallback{};
+  double abs_area = 0;
+  const double inv = 1.0 / size;
+  const auto to_u = [&](const Vec3d& v) { return (v - center) * inv; };
+  for (const Piece& pc : pieces.pieces) {
+    Vec3d area{};
+    if (ctx.options.clip_to_node) {
+      const Vec3d* v = pieces.verts.data() + pc.begin;
+      for (std::uint32_t i = 0; i < pc.count; ++i) s.u.push_back(to_u(v[i]));
+      for (std::uint32_t i = 1; i + 1 < pc.count; ++i)
+        area = area + Cross(v[i] - v[0], v[i + 1] - v[0]);
+    } else {
+      const Triangle& t = ctx.mesh->triangles[pc.tri];
+      const Vec3d &a = ctx.vox[t[0]], &b = ctx.vox[t[1]], &c = ctx.vox[t[2]];
+      s.u.push_back(to_u(a));
+      s.u.push_back(to_u(b));
+      s.u.push_back(to_u(c));
+      area = Cross(b - a, c - a);
+    }
+    normal = normal + area;
+    abs_area += Length(area);
+    if (Length(area) > Length(fallback)) fallback = area;
+  }
+  if (s.u.empty()) return 0;
+  // Starting normals: the area-weighted normal; where the surface folds back inside the node
+  // (creases, closed bits: the area sum cancels) or the node is big enough for the search to
+  // get stuck in a local minimum, also the largest piece's normal and 13 canonical directions.
+  // Big nodes search on an evenly strided subset of at most kSearchPoints points (the extremes
+  // of 100k points barely move the optimum); the chosen normal is then fitted to all points.
+  const std::vector<Vec3d>* search_pts = &s.u;
+  if (s.u.size() > kSearchPoints) {
+    s.sub.clear();
+    const std::size_t stride = (s.u.size() + kSearchPoints - 1) / kSearchPoints;
+    for (std::size_t i = 0; i < s.u.size(); i += stride) s.sub.push_back(s.u[i]);
+    search_pts = &s.sub;
+  }
+  const std::vector<Vec3d>& pts = *search_pts;
+  std::vector<Fit>& starts = s.starts;
+  starts.clear();
+  if (Length(normal) > 1e-3 * abs_area && Length(normal) > 0) {
+    const auto q = QuantizeNormal(normal);
+    starts.push_back(EvalNormal(pts, q[0], q[1], q[2]));
+  }
+  const bool big = pieces.pieces.size() >= kMultiStartPieces;
+  if (big || Length(normal) <= 0.25 * abs_area) {
+    static constexpr std::array<std::array<int, 3>, 13> kDirs{{{31, 0, 0},
+                                                               {0, 31, 0},
+                                                               {0, 0, 31},
+                                                               {31, 31, 0},
+                                                               {31, -31, 0},
+                                                               {31, 0, 31},
+                                                               {31, 0, -31},
+                                                               {0, 31, 31},
+                                                               {0, 31, -31},
+                                                               {31, 31, 31},
+                                                               {31, 31, -31},
+                                                               {31, -31, 31},
+                                                               {-31, 31, 31}}};
+    for (const auto& d : kDirs) starts.push_back(EvalNormal(pts, d[0], d[1], d[2]));
+    if (Length(fallback) > 0) {
+      const auto q = QuantizeNormal(fallback);
+      starts.push_back(EvalNormal(pts, q[0], q[1], q[2]));
+    }
+  }
+  std::stable_sort(starts.begin(), starts.end(),
+                   [](const Fit& x, const Fit& y) { return x.cost < y.cost; });
+  Fit best;
+  const std::size_t searches = std::min<std::size_t>(starts.size(), big ? 4 : 1);
+  for (std::size_t i = 0; i < searches; ++i) {
+    if (!std::isfinite(starts[i].cost)) break;
+    const Fit f = LocalSearch(pts, s.uf, starts[i]);
+    if (f.cost < best.cost) best = f;
+  }
+  if (!std::isfinite(best.cost)) return 0;
+  if (search_pts != &s.u) best = EvalNormal(s.u, best.c.nx, best.c.ny, best.c.nz);
+  if (!std::isfinite(best.cost)) return 0;
+  const ContourSpan span = ClippedSpan(best.c);
+  if (!((span.high - span.low) / span.l1 <= ctx.options.max_relative_thickness)) return 0;
+  return EncodeContour(best.c);
+}
+
+struct Workspace {
+  explicit Workspace(std::uint32_t depth) : children(depth + 1) {}
+  std::vector<std::array<Pieces, 8>> children;  // per level: buffers for a node's children
+  Scratch scratch;
+};
+
+void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const Pieces& pieces,
+               Workspace& ws) {
+  const std::uint64_t key = ctx.keys[level][index];
+  const double size = std::ldexp(1.0, static_cast<int>(ctx.depth - level));
+  const MortonCoord mc = MortonDecode(key);
+  const Vec3d lo{mc.x * size, mc.y * size, mc.z * size};
+  const Vec3d center = lo + Vec3d{size, size, size} * 0.5;
+  (*ctx.out)[level][index] = FitNode(ctx, pieces, center, size, ws.scratch);
+  if (level == ctx.depth) return;
+
+  const auto& next = ctx.keys[level + 1];
+  auto it = std::lower_bound(next.begin(), next.end(), key << 3);
+  std::array<std::size_t, 8> child_index{};
+  std::array<Pieces*, 8> dst{};
+  std::array<unsigned, 8> present{};
+  std::size_t n = 0;
+  auto& bufs = ws.children[level];
+  for (; it != next.end() && (*it >> 3) == key; ++it) {
+    const unsigned c = MortonChildIndex(*it);
+    child_index[c] = static_cast<std::size_t>(it - next.begin());
+    bufs[c].clear();
+    dst[c] = &bufs[c];
+    present[n++] = c;
+  }
+  if (n == 0) return;
+  SplitPieces(pieces, center, ctx.eps, dst, ws.scratch);
+
+  const auto visit = [&](std::size_t i, Workspace& w) {
+    const unsigned c = present[i];
+    if (!bufs[c].pieces.empty()) VisitNode(ctx, level + 1, child_index[c], bufs[c], w);
+  };
+  if (pieces.pieces.size() >= kParallelPieces) {
+    // Each child writes only its own subtree's fixed indices: the result is thread-independent.
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      Workspace w(ctx.depth);
+      visit(i, w);
+    });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) visit(i, ws);
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> FitContours(
+    const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
+    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options) {
+  std::vector<std::vector<std::uint32_t>> out(level_keys.size());
+  for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
+  if (level_keys.size() != std::size_t{depth} + 1 || level_keys[0].empty()) return out;
+
+  Context ctx;
+  ctx.mesh = &mesh;
+  ctx.depth = depth;
+  ctx.keys = level_keys;
+  ctx.options = options;
+  ctx.out = &out;
+  const double extent = std::ldexp(1.0, static_cast<int>(depth));
+  // Rounding in clipping is ~2^depth·2^-52 voxels per cut; the overlap is far above that yet
+  // negligible against the slab quantization (≥ 1/256 of a node).
+  ctx.eps = std::max(1e-7, extent * 0x1p-36);
+  ctx.vox.resize(mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    ctx.vox[i] = grid.WorldToVoxel(mesh.positions[i]);
+  }
+
+  // The root's pieces: every triangle clipped to the (slightly enlarged) root cube.
+  Pieces root;
+  Scratch s;
+  const double rlo = -ctx.eps, rhi = extent + ctx.eps;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    s.a = {ctx.vox[tri[0]], ctx.vox[tri[1]], ctx.vox[tri[2]]};
+    for (int a = 0; a < 3 && !s.a.empty(); ++a) {
+      ClipAxis(s.a, a, rlo, false, s.b);
+      ClipAxis(s.b, a, rhi, true, s.a);
+    }
+    if (!s.a.empty()) root.Add(static_cast<std::uint32_t>(t), s.a.data(), s.a.size());
+  }
+  if (root.pieces.empty()) return out;
+  Workspace ws(depth);
+  VisitNode(ctx, 0, 0, root, ws);
+  return out;
+}
+
+}  // namespace svokit
