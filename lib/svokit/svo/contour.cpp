@@ -278,14 +278,14 @@ const Offsets kOffsets;
 // Steepest descent over the 26 integer neighbours of n. Each step measures all 26 slabs in one
 // float pass over the points (vectorizes; 4× faster than 26 passes), then re-fits the winner
 // exactly in double, so rounding in the search can cost tightness but never conservativeness.
-Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best) {
+Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, int max_steps) {
   uf.resize(u.size() * 3);
   for (std::size_t i = 0; i < u.size(); ++i) {
     uf[3 * i] = float(u[i].x);
     uf[3 * i + 1] = float(u[i].y);
     uf[3 * i + 2] = float(u[i].z);
   }
-  for (int iter = 0; iter < kMaxSearchSteps; ++iter) {
+  for (int iter = 0; iter < max_steps; ++iter) {
     alignas(32) std::array<float, 28> mn, mx;
     mn.fill(std::numeric_limits<float>::infinity());
     mx.fill(-std::numeric_limits<float>::infinity());
@@ -344,6 +344,8 @@ struct Context {
   ContourOptions options;
   double eps;  // overlap of clipping half-spaces, voxel units
   std::vector<std::vector<std::uint32_t>>* out;
+  // Per level below the voxels: index in the next level of node i's first child (i + 1: end).
+  std::vector<std::vector<std::size_t>> first_child;
 };
 
 std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& center, double size,
@@ -419,7 +421,8 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
   const std::size_t searches = std::min<std::size_t>(starts.size(), big ? 4 : 1);
   for (std::size_t i = 0; i < searches; ++i) {
     if (!std::isfinite(starts[i].cost)) break;
-    const Fit f = LocalSearch(pts, s.uf, starts[i]);
+    const Fit f = LocalSearch(pts, s.uf, starts[i],
+                              big ? kMaxSearchSteps : ctx.options.small_node_search_steps);
     if (f.cost < best.cost) best = f;
   }
   if (!std::isfinite(best.cost)) return 0;
@@ -447,7 +450,7 @@ void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const
   if (level == ctx.depth) return;
 
   const auto& next = ctx.keys[level + 1];
-  auto it = std::lower_bound(next.begin(), next.end(), key << 3);
+  auto it = next.begin() + static_cast<std::ptrdiff_t>(ctx.first_child[level][index]);
   std::array<std::size_t, 8> child_index{};
   std::array<Pieces*, 8> dst{};
   std::array<unsigned, 8> present{};
@@ -497,6 +500,18 @@ std::vector<std::vector<std::uint32_t>> FitContours(
   // Rounding in clipping is ~2^depth·2^-52 voxels per cut; the overlap is far above that yet
   // negligible against the slab quantization (≥ 1/256 of a node).
   ctx.eps = std::max(1e-7, extent * 0x1p-36);
+  ctx.first_child.resize(depth);
+  for (std::uint32_t l = 0; l < depth; ++l) {  // children of a node are one run of the next level
+    const auto& next = level_keys[l + 1];
+    auto& first = ctx.first_child[l];
+    first.resize(level_keys[l].size() + 1);
+    std::size_t f = 0;
+    for (std::size_t i = 0; i < level_keys[l].size(); ++i) {
+      while (f < next.size() && (next[f] >> 3) < level_keys[l][i]) ++f;
+      first[i] = f;
+    }
+    first.back() = next.size();
+  }
   ctx.vox.resize(mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     ctx.vox[i] = grid.WorldToVoxel(mesh.positions[i]);

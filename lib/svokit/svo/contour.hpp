@@ -29,6 +29,10 @@ struct ContourOptions {
   /// must remove at least a tenth of the cube's depth along n; a thicker slab culls too little of
   /// a ray's path through the node to pay for its 4 bytes. Values ≥ 1 keep every fitted contour.
   double max_relative_thickness = 0.9;
+  /// Hill-climbing steps over the integer normal for nodes with few pieces (most of them: the
+  /// finest levels); big nodes always climb to convergence. Tightness against time, measured in
+  /// scripts/bench svo.
+  int small_node_search_steps = 0;
 };
 
 /// Contours of every node of every level: `level_keys[L]` are the sorted Morton keys of level L's
