@@ -1,0 +1,66 @@
+// svo-export: .svo → OpenVDB (.vdb), binvox, MagicaVoxel (.vox), PLY points or xyz text, at the
+// voxel level or a coarser one.
+
+#include <filesystem>
+#include <optional>
+
+#include "apps/app.hpp"
+#include "formats/svo/svo_file.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/svo/export.hpp"
+
+int main(int argc, char** argv) {
+  using namespace svokit;
+  const std::string tool = "svo-export";
+  CLI::App cli{
+      "Exports a sparse voxel octree's voxels (or the nodes of a coarser level) as OpenVDB grids "
+      "(.vdb), binvox, MagicaVoxel (.vox), PLY points or xyz text, by the output's extension.",
+      tool};
+  std::filesystem::path input, output;
+  std::optional<std::uint32_t> level;
+  app::CommonOptions common;
+  cli.add_option("input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
+  cli.add_option("-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
+  cli.add_option("--level", level,
+                 "Export the nodes of this octree level (0 = root) as voxels of its node size; "
+                 "default: the voxels");
+  app::AddCommonOptions(cli, common);
+
+  return app::Run(tool, cli, argc, argv, [&] {
+    if (Status s = app::CheckOutputPath(output, ExportExtensions()); !s.ok()) {
+      return app::Fail(tool, s);
+    }
+    ThreadLimit threads(common.threads);
+    Progress progress = common.MakeProgress();
+
+    StatusOr<Svo> svo = [&]() -> StatusOr<Svo> {
+      Progress::Stage stage(progress, "read", 1);
+      // Levels below the exported one are never read (the file is breadth-first).
+      StatusOr<Svo> read = ReadSvo(input, level);
+      if (!read.ok()) stage.Cancel();
+      return read;
+    }();
+    if (!svo.ok()) return app::Fail(tool, svo.status());
+    if (level && *level > svo->depth) {
+      return app::Fail(tool, Status::BadInput("{}: --level {} exceeds the octree's depth {}",
+                                              input.string(), *level, svo->depth));
+    }
+
+    ExportOptions options;
+    options.level = level;
+    Status written;
+    {
+      Progress::Stage stage(progress, "export", 1);
+      written = ExportSvo(*svo, output, options);
+      if (!written.ok()) stage.Cancel();
+    }
+    if (!written.ok()) return app::Fail(tool, written);
+
+    const std::uint32_t exported = level.value_or(svo->depth);
+    fmt::print("octree      {} (depth {})\n", input.string(), svo->depth);
+    fmt::print("level       {} ({} nodes of {:.9g})\n", exported, svo->levels[exported].node_count,
+               svo->NodeSize(exported));
+    fmt::print("output      {}\n", output.string());
+    return 0;
+  });
+}
