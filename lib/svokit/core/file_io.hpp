@@ -36,6 +36,9 @@ class AtomicFileWriter {
   /// Flushes, closes and renames onto the final path.
   Status Commit();
   std::uint64_t bytes_written() const { return bytes_written_; }
+  /// The temporary's path, for libraries that write files by name (OpenVDB): they fill it,
+  /// Commit() renames it into place.
+  const std::string& temp_path() const { return temp_path_; }
 
  private:
   void Discard();

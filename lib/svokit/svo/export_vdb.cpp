@@ -1,17 +1,12 @@
 // The only translation unit that sees OpenVDB's headers: they are heavy to compile, and the rest
 // of svokit stays free of them.
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
 #include <mutex>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include "svokit/core/file_io.hpp"
 #include "svokit/svo/export.hpp"
 
 namespace svokit {
@@ -23,45 +18,6 @@ void InitializeOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
 }
-
-// A hidden temporary file beside `path` (same file system, so the rename is atomic), removed on
-// destruction unless it was renamed into place.
-class TempBeside {
- public:
-  explicit TempBeside(const std::filesystem::path& path) : path_(path) {}
-  ~TempBeside() {
-    if (!temp_.empty()) ::unlink(temp_.c_str());
-  }
-  TempBeside(const TempBeside&) = delete;
-  TempBeside& operator=(const TempBeside&) = delete;
-
-  Status Create() {
-    const std::filesystem::path dir = path_.parent_path().empty() ? "." : path_.parent_path();
-    std::string templ = fmt::format("{}/.{}.tmp.XXXXXX", dir.string(), path_.filename().string());
-    const int fd = ::mkstemp(templ.data());
-    if (fd < 0) {
-      return Status::BadInput("{}: cannot create output ({})", path_.string(),
-                              std::strerror(errno));
-    }
-    ::fchmod(fd, 0644);
-    ::close(fd);
-    temp_ = templ;
-    return Status::Ok();
-  }
-  const std::string& temp() const { return temp_; }
-  Status Commit() {
-    if (std::rename(temp_.c_str(), path_.c_str()) != 0) {
-      return Status::Internal("{}: cannot rename into place ({})", path_.string(),
-                              std::strerror(errno));
-    }
-    temp_.clear();
-    return Status::Ok();
-  }
-
- private:
-  std::filesystem::path path_;
-  std::string temp_;
-};
 
 }  // namespace
 
@@ -106,10 +62,10 @@ Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path)
   if (voxels.has_normals()) grids.push_back(normal);
   for (const openvdb::GridBase::Ptr& grid : grids) grid->setTransform(transform);
 
-  TempBeside temp(path);
-  SVOKIT_RETURN_IF_ERROR(temp.Create());
+  AtomicFileWriter temp(path);
+  SVOKIT_RETURN_IF_ERROR(temp.Open());
   try {
-    openvdb::io::File file(temp.temp());
+    openvdb::io::File file(temp.temp_path());
     openvdb::MetaMap meta;
     meta.insertMeta("creator", openvdb::StringMetadata(std::string("svokit ") + SVOKIT_VERSION));
     file.write(grids, meta);
