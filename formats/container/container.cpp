@@ -113,7 +113,8 @@ struct Reader::Mapping {
   }
 };
 
-StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId& format) {
+StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId& format,
+                              SectionFilter load, const void* context) {
   const std::string name = path.string();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return Status::BadInput("{}: cannot open ({})", name, std::strerror(errno));
@@ -135,13 +136,14 @@ StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId&
   ::close(fd);
   std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(mapping->data),
                                       mapping->size);
-  StatusOr<Reader> reader = FromBytes(bytes, name, format);
+  StatusOr<Reader> reader = FromBytes(bytes, name, format, load, context);
   if (reader.ok()) reader->mapping_ = std::move(mapping);
   return reader;
 }
 
 StatusOr<Reader> Reader::FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   const FormatId& format) {
+                                   const FormatId& format, SectionFilter load,
+                                   const void* context) {
   if (bytes.size() < kHeaderSize ||
       std::memcmp(bytes.data(), format.magic.data(), format.magic.size()) != 0) {
     return Status::BadInput("{}: not a {} file (bad magic)", name, format.name);
@@ -190,6 +192,7 @@ StatusOr<Reader> Reader::FromBytes(std::span<const std::uint8_t> bytes, const st
       return Status::BadInput("{}: section '{}' (offset {}, {} bytes) lies outside the file", name,
                               TagString(tag), offset, size);
     }
+    if (load != nullptr && !load(tag, context)) continue;
     const auto payload = bytes.subspan(offset, size);
     if (Crc32c(payload.data(), payload.size()) != section_crc) {
       return Status::BadInput("{}: section '{}' checksum mismatch (file is corrupt)", name,

@@ -66,10 +66,15 @@ class Writer {
 /// header checksum, section bounds and every section checksum before returning.
 class Reader {
  public:
-  static StatusOr<Reader> Open(const std::filesystem::path& path, const FormatId& format);
+  /// Sections for which `load` returns false are neither verified nor available (a streaming
+  /// reader touches only the pages it needs); by default every section is.
+  using SectionFilter = bool (*)(Tag tag, const void* context);
+  static StatusOr<Reader> Open(const std::filesystem::path& path, const FormatId& format,
+                               SectionFilter load = nullptr, const void* context = nullptr);
   /// Verifies in-memory bytes (they must outlive the Reader); `name` is used in messages.
   static StatusOr<Reader> FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
-                                    const FormatId& format);
+                                    const FormatId& format, SectionFilter load = nullptr,
+                                    const void* context = nullptr);
 
   std::uint32_t version() const { return version_; }
   std::uint32_t flags() const { return flags_; }

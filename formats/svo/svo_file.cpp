@@ -24,6 +24,14 @@ Tag LevelTag(const char (&kind)[3], std::uint32_t level) {
           static_cast<char>('0' + level % 10)};
 }
 
+// Loads the sections of levels ≤ *context and every section that is not per level.
+bool UpToLevel(Tag tag, const void* context) {
+  const bool per_level = tag[2] >= '0' && tag[2] <= '9' && tag[3] >= '0' && tag[3] <= '9';
+  if (!per_level) return true;
+  const auto level = static_cast<std::uint32_t>((tag[2] - '0') * 10 + (tag[3] - '0'));
+  return level <= *static_cast<const std::uint32_t*>(context);
+}
+
 template <class T>
 std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
   return {reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)};
@@ -206,11 +214,14 @@ Status WriteSvo(const Svo& svo, const std::filesystem::path& path) {
 
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level) {
-  return DecodeSections(container::Reader::FromBytes(bytes, name, kSvoFormat), max_level);
+  const std::uint32_t last = max_level.value_or(kMaxDepth);
+  return DecodeSections(container::Reader::FromBytes(bytes, name, kSvoFormat, &UpToLevel, &last),
+                        max_level);
 }
 
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint32_t> max_level) {
-  return DecodeSections(container::Reader::Open(path, kSvoFormat), max_level);
+  const std::uint32_t last = max_level.value_or(kMaxDepth);
+  return DecodeSections(container::Reader::Open(path, kSvoFormat, &UpToLevel, &last), max_level);
 }
 
 }  // namespace svokit
