@@ -1,0 +1,306 @@
+// svo-build and mesh2svo as a user runs them: the two routes give the same file, the files do
+// not depend on the thread count, and bad input is one line on stderr, exit 2, no output left.
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <sstream>
+
+#include "formats/svo/svo_file.hpp"
+#include "formats/vfrag/vfrag.hpp"
+#include "tests/cli/run_tool.hpp"
+
+namespace svokit::test {
+namespace {
+
+std::string Torus() {
+  return (DataDir() / "uv-torus.obj").string();
+}
+
+// Runs a tool that must succeed.
+void RunOk(const std::string& tool, const std::vector<std::string>& args) {
+  const ToolResult r = RunTool(tool, args);
+  ASSERT_EQ(r.exit_code, 0) << tool << ": " << r.err;
+}
+
+TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
+  TempDir dir;
+  const std::string vfrag = (dir / "t.vfrag").string();
+  RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "48", "-q"});
+  const std::string chained = (dir / "chain.svo").string(), direct = (dir / "direct.svo").string();
+  ToolResult build = RunTool("svo-build", {vfrag, "-o", chained, "--mesh", Torus(), "-q"});
+  ASSERT_EQ(build.exit_code, 0) << build.err;
+  EXPECT_TRUE(build.err.empty()) << build.err;
+  EXPECT_NE(build.out.find("chain.svo"), std::string::npos) << build.out;
+  ToolResult m2s = RunTool("mesh2svo", {Torus(), "-o", direct, "-r", "48", "-q"});
+  ASSERT_EQ(m2s.exit_code, 0) << m2s.err;
+  EXPECT_NE(m2s.out.find("2304 triangles"), std::string::npos) << m2s.out;
+  const std::string a = ReadText(chained), b = ReadText(direct);
+  ASSERT_FALSE(a.empty());
+  auto sa = ReadSvo(chained), sb = ReadSvo(direct);
+  ASSERT_TRUE(sa.ok()) << sa.status().message();
+  ASSERT_TRUE(sb.ok()) << sb.status().message();
+  EXPECT_EQ(sa->metadata, sb->metadata) << "both routes must record the same metadata";
+  EXPECT_TRUE(*sa == *sb) << "the octrees differ";
+  EXPECT_TRUE(a == b) << "files differ: " << a.size() << " vs " << b.size() << " bytes";
+
+  // What the file holds: the voxels of the .vfrag, bricks 3 with colour and normal, contours,
+  // and metadata naming the source and the options.
+  auto voxels = ReadVfrag(vfrag);
+  ASSERT_TRUE(voxels.ok());
+  EXPECT_EQ(sa->LevelKeys(sa->depth), voxels->keys);
+  EXPECT_EQ(sa->grid, voxels->grid);
+  EXPECT_EQ(sa->depth, 6u);
+  EXPECT_EQ(sa->brick_side, 3u);
+  EXPECT_TRUE(sa->has_color && sa->has_normal && sa->has_contours);
+  EXPECT_NE(sa->metadata.find("uv-torus.obj"), std::string::npos) << sa->metadata;
+  EXPECT_NE(sa->metadata.find("--resolution 48"), std::string::npos) << sa->metadata;
+  EXPECT_NE(sa->metadata.find("--bricks 3"), std::string::npos) << sa->metadata;
+}
+
+TEST(SvoBuildCli, ChainEqualsMesh2svoWithOtherOptions) {
+  TempDir dir;
+  const std::string vfrag = (dir / "t.vfrag").string();
+  RunOk("svo-voxelize",
+        {Torus(), "-o", vfrag, "-r", "40", "--mode", "thin", "--attributes", "color", "-q"});
+  RunOk("svo-build",
+        {vfrag, "-o", (dir / "a.svo").string(), "--bricks", "2", "--no-contours", "-q"});
+  RunOk("mesh2svo", {Torus(), "-o", (dir / "b.svo").string(), "-r", "40", "--mode", "thin",
+                     "--attributes", "color", "--bricks", "2", "--no-contours", "-q"});
+  auto sa = ReadSvo(dir / "a.svo");
+  ASSERT_TRUE(sa.ok()) << sa.status().message();
+  EXPECT_EQ(sa->brick_side, 2u);
+  EXPECT_TRUE(sa->has_color);
+  EXPECT_FALSE(sa->has_normal);
+  EXPECT_EQ(sa->mode, VoxelMode::kThin);
+  auto sb = ReadSvo(dir / "b.svo");
+  ASSERT_TRUE(sb.ok()) << sb.status().message();
+  EXPECT_EQ(sa->metadata, sb->metadata);
+  EXPECT_TRUE(ReadText(dir / "a.svo") == ReadText(dir / "b.svo"));
+}
+
+TEST(SvoBuildCli, NoContoursNeedsNoMesh) {
+  TempDir dir;
+  const std::string vfrag = (dir / "t.vfrag").string();
+  RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "32", "-q"});
+  ToolResult r = RunTool("svo-build", {vfrag, "-o", (dir / "n.svo").string(), "--no-contours"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto svo = ReadSvo(dir / "n.svo");
+  ASSERT_TRUE(svo.ok()) << svo.status().message();
+  EXPECT_FALSE(svo->has_contours);
+  for (const SvoLevel& lv : svo->levels) EXPECT_TRUE(lv.contours.empty());
+  EXPECT_EQ(svo->brick_side, 3u);
+  EXPECT_NE(svo->metadata.find("--no-contours"), std::string::npos) << svo->metadata;
+  // Without bricks either: nodes only.
+  RunOk("svo-build",
+        {vfrag, "-o", (dir / "bare.svo").string(), "--bricks", "none", "--no-contours", "-q"});
+  auto bare = ReadSvo(dir / "bare.svo");
+  ASSERT_TRUE(bare.ok());
+  EXPECT_EQ(bare->brick_side, 0u);
+  EXPECT_EQ(bare->LevelKeys(bare->depth), svo->LevelKeys(svo->depth));
+  EXPECT_LT(std::filesystem::file_size(dir / "bare.svo"),
+            std::filesystem::file_size(dir / "n.svo"));
+}
+
+TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
+  TempDir dir;
+  for (const char* threads : {"1", "2"}) {
+    RunOk("mesh2svo", {Torus(), "-o", (dir / fmt::format("m{}.svo", threads)).string(), "-r", "64",
+                       "-j", threads, "-q"});
+  }
+  const std::string one = ReadText(dir / "m1.svo");
+  ASSERT_GT(one.size(), 1000u);
+  EXPECT_TRUE(one == ReadText(dir / "m2.svo")) << "mesh2svo -j 1 and -j 2 differ";
+
+  const std::string vfrag = (dir / "t.vfrag").string();
+  RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "64", "-q"});
+  for (const char* threads : {"1", "2"}) {
+    RunOk("svo-build", {vfrag, "-o", (dir / fmt::format("b{}.svo", threads)).string(), "--mesh",
+                        Torus(), "-j", threads, "-q"});
+  }
+  EXPECT_TRUE(ReadText(dir / "b1.svo") == ReadText(dir / "b2.svo"))
+      << "svo-build -j 1 and -j 2 differ";
+  EXPECT_TRUE(ReadText(dir / "b1.svo") == one) << "svo-build differs from mesh2svo at 64";
+}
+
+TEST(SvoBuildCli, Mesh2svoPrintsOneLinePerStageAndASummary) {
+  TempDir dir;
+  const std::string out = (dir / "t.svo").string();
+  const ToolResult r = RunTool("mesh2svo", {Torus(), "-o", out, "-r", "32"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Not a terminal: one line per finished stage on stderr.
+  const auto lines = r.ErrLines();
+  for (const char* stage : {"import", "voxelize", "octree", "bricks", "contours", "write"}) {
+    EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                            [&](const std::string& l) {
+                              return l.starts_with(stage) && l.find("done") != std::string::npos;
+                            }),
+              1)
+        << stage << " in\n"
+        << r.err;
+  }
+  auto svo = ReadSvo(out);
+  ASSERT_TRUE(svo.ok()) << svo.status().message();
+  // The summary: triangles, voxels, nodes per level (matching the file), time per stage, bytes.
+  EXPECT_NE(r.out.find("2304 triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(fmt::format("voxels      {}", svo->voxel_count())), std::string::npos)
+      << r.out;
+  for (std::uint32_t l = 0; l <= svo->depth; ++l) {
+    bool found = false;
+    std::size_t start = 0;
+    while (start < r.out.size() && !found) {
+      const std::size_t end = r.out.find('\n', start);
+      std::istringstream row(r.out.substr(start, end - start));
+      std::string level, size, nodes;
+      if (row >> level >> size >> nodes) {
+        found = level == std::to_string(l) && nodes == std::to_string(svo->levels[l].node_count);
+      }
+      start = end == std::string::npos ? r.out.size() : end + 1;
+    }
+    EXPECT_TRUE(found) << "level " << l << " with " << svo->levels[l].node_count << " nodes in\n"
+                       << r.out;
+  }
+  EXPECT_NE(r.out.find("time"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("total"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(fmt::format("({} bytes)", std::filesystem::file_size(out))),
+            std::string::npos)
+      << r.out;
+}
+
+struct BadCase {
+  std::string what;
+  std::vector<std::string> args;  // "{in}" → the input directory, "{out}" → the output directory
+  std::string expect;             // a part of the error line
+};
+
+// Each case: exit 2, stderr exactly one line "<tool>: ..." holding `expect`, the output
+// directory left empty. Run once quiet and once with progress (the error is then the last line
+// and the only one starting with the tool's name).
+void ExpectBadInput(const std::string& tool, const TempDir& in, const BadCase& c) {
+  for (bool quiet : {true, false}) {
+    TempDir out;
+    std::vector<std::string> args;
+    for (std::string a : c.args) {
+      if (a.starts_with("{in}")) a = in.path().string() + a.substr(4);
+      if (a.starts_with("{out}")) a = out.path().string() + a.substr(5);
+      args.push_back(a);
+    }
+    if (quiet) args.push_back("-q");
+    const ToolResult r = RunTool(tool, args);
+    EXPECT_EQ(r.exit_code, 2) << c.what << ": " << r.err;
+    const auto lines = r.ErrLines();
+    ASSERT_FALSE(lines.empty()) << c.what;
+    if (quiet) {
+      EXPECT_EQ(lines.size(), 1u) << c.what << ":\n" << r.err;
+    }
+    EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                            [&](const std::string& l) { return l.starts_with(tool + ": "); }),
+              1)
+        << c.what << ":\n"
+        << r.err;
+    EXPECT_TRUE(lines.back().starts_with(tool + ": ")) << c.what << ":\n" << r.err;
+    EXPECT_NE(lines.back().find(c.expect), std::string::npos)
+        << c.what << ": expected '" << c.expect << "' in\n"
+        << r.err;
+    EXPECT_TRUE(out.Files().empty()) << c.what << ": output left behind";
+  }
+}
+
+TEST(SvoBuildCli, BadInputIsOneLineExitTwoAndNoOutput) {
+  TempDir in;
+  const std::string vfrag = (in / "t.vfrag").string();
+  RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "24", "-q"});
+  const std::string good = ReadText(vfrag);
+  std::string corrupt = good;
+  corrupt[corrupt.size() / 2] = static_cast<char>(corrupt[corrupt.size() / 2] ^ 0x10);
+  in.Write("corrupt.vfrag", corrupt);
+  in.Write("trunc.vfrag", good.substr(0, good.size() - 100));
+  in.Write("empty.vfrag", std::string());
+  // A triangle far from the torus: a valid mesh, but not the one that was voxelized.
+  in.Write("far.obj", "v 100 100 100\nv 101 100 100\nv 100 101 100\nf 1 2 3\n");
+  in.Write("broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
+  const std::vector<BadCase> cases = {
+      {"missing input",
+       {"{in}/missing.vfrag", "-o", "{out}/o.svo", "--no-contours"},
+       "missing.vfrag"},
+      {"corrupt input",
+       {"{in}/corrupt.vfrag", "-o", "{out}/o.svo", "--no-contours"},
+       "corrupt.vfrag"},
+      {"truncated input",
+       {"{in}/trunc.vfrag", "-o", "{out}/o.svo", "--no-contours"},
+       "trunc.vfrag"},
+      {"empty input", {"{in}/empty.vfrag", "-o", "{out}/o.svo", "--no-contours"}, "empty.vfrag"},
+      {"not a vfrag", {Torus(), "-o", "{out}/o.svo", "--no-contours"}, "uv-torus.obj"},
+      {"contours without mesh", {"{in}/t.vfrag", "-o", "{out}/o.svo"}, "--mesh"},
+      {"contours without mesh names the input", {"{in}/t.vfrag", "-o", "{out}/o.svo"}, "t.vfrag"},
+      {"mesh outside the grid",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--mesh", "{in}/far.obj"},
+       "far.obj"},
+      {"mesh outside the grid says so",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--mesh", "{in}/far.obj"},
+       "outside"},
+      {"missing mesh",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--mesh", "{in}/nomesh.obj"},
+       "nomesh.obj"},
+      {"broken mesh",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--mesh", "{in}/broken.obj"},
+       "broken.obj"},
+      {"bad --bricks",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--no-contours", "--bricks", "4"},
+       "--bricks"},
+      {"bad --bricks word",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--no-contours", "--bricks", "three"},
+       "--bricks"},
+      {"wrong output extension",
+       {"{in}/t.vfrag", "-o", "{out}/o.vdb", "--no-contours"},
+       "o.vdb: output must be a .svo file"},
+      {"no output extension",
+       {"{in}/t.vfrag", "-o", "{out}/o", "--no-contours"},
+       "output must be a .svo file"},
+      {"missing output directory",
+       {"{in}/t.vfrag", "-o", "{out}/nodir/o.svo", "--no-contours"},
+       "nodir/o.svo: output directory does not exist"},
+      {"no output", {"{in}/t.vfrag", "--no-contours"}, "--output"},
+      {"bad thread count",
+       {"{in}/t.vfrag", "-o", "{out}/o.svo", "--no-contours", "-j", "-3"},
+       "--threads"},
+  };
+  for (const BadCase& c : cases) ExpectBadInput("svo-build", in, c);
+}
+
+TEST(SvoBuildCli, Mesh2svoBadInputIsOneLineExitTwoAndNoOutput) {
+  TempDir in;
+  in.Write("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+  in.Write("empty.obj", "# nothing\n");
+  const std::vector<BadCase> cases = {
+      {"missing mesh", {"{in}/missing.obj", "-o", "{out}/o.svo", "-r", "16"}, "missing.obj"},
+      {"NaN vertex", {"{in}/nan.obj", "-o", "{out}/o.svo", "-r", "16"}, "nan.obj"},
+      {"no triangles", {"{in}/empty.obj", "-o", "{out}/o.svo", "-r", "16"}, "empty.obj"},
+      {"no resolution", {Torus(), "-o", "{out}/o.svo"}, "--resolution N or --voxel-size S"},
+      {"zero resolution", {Torus(), "-o", "{out}/o.svo", "-r", "0"}, "resolution"},
+      {"bad --bricks", {Torus(), "-o", "{out}/o.svo", "-r", "16", "--bricks", "5"}, "--bricks"},
+      {"wrong output extension",
+       {Torus(), "-o", "{out}/o.vfrag", "-r", "16"},
+       "o.vfrag: output must be a .svo file"},
+      {"missing output directory",
+       {Torus(), "-o", "{out}/nodir/o.svo", "-r", "16"},
+       "output directory does not exist"},
+      {"bad mode", {Torus(), "-o", "{out}/o.svo", "-r", "16", "--mode", "fat"}, "--mode"},
+  };
+  for (const BadCase& c : cases) ExpectBadInput("mesh2svo", in, c);
+}
+
+TEST(SvoBuildCli, HelpAndVersion) {
+  for (const char* tool : {"svo-build", "mesh2svo"}) {
+    ToolResult help = RunTool(tool, {"--help"});
+    EXPECT_EQ(help.exit_code, 0) << tool;
+    EXPECT_NE(help.out.find("--bricks"), std::string::npos) << tool;
+    EXPECT_NE(help.out.find("--no-contours"), std::string::npos) << tool;
+    ToolResult version = RunTool(tool, {"--version"});
+    EXPECT_EQ(version.exit_code, 0) << tool;
+    EXPECT_NE(version.out.find("svokit"), std::string::npos) << tool;
+  }
+}
+
+}  // namespace
+}  // namespace svokit::test
