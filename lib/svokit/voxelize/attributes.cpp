@@ -18,12 +18,7 @@ constexpr int kMaxPolygon = 16;
 // them: buffers have room for that past kMaxPolygon.
 constexpr int kClipCapacity = kMaxPolygon + 2;
 
-// A polygon vertex is carried as its barycentrics with respect to the original triangle, corners
-// 1 and 2 (b0 = 1 − b1 − b2): everything linear on the triangle (position, UV, colour, normal)
-// follows exactly, and a vertex is 16 bytes.
-struct ClipVertex {
-  double b1, b2;
-};
+using attributes_detail::ClipVertex;
 
 // The triangle in voxel-local coordinates (the box is [0, 1]³): p(b) = a + b1·e1 + b2·e2. All
 // three are fixed-point differences, exact in doubles, so the original corners map back exactly.
@@ -88,16 +83,18 @@ int ClipAxis(const Frame& f, ClipVertex*& poly, ClipVertex*& spare, int n) {
   return n;
 }
 
-// Clips the triangle to the unit box; the polygon ends up in `poly`. The two other axes first,
-// the dominant axis of the normal (kW) last: once the polygon is cut to the voxel's column, its
-// extent along kW is at most about two voxels and often needs no clipping at all.
+// Clips the triangle to the voxel's column, the unit square in (kU, kV) (the polygon ends up in
+// `poly`); ClipAxis<kW> then finishes the box. The column part reads no kW coordinate, so it is
+// shared by every voxel of a column. The two other axes go first, the dominant axis of the normal
+// (kW) last: once the polygon is cut to the column, its extent along kW is at most about two
+// voxels and often needs no clipping at all.
 //
 // Fast path, the common case for triangles much larger than a voxel: when the voxel's column
 // (its square in the (kU, kV) projection) lies inside the triangle's projection, the polygon is
 // the plane's section of the column, i.e. the square lifted onto the plane, and only the two kW
 // planes remain.
-template <int kU, int kV, int kW>
-int ClipToBox(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
+template <int kU, int kV>
+int ClipToColumn(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
   const double det = f.e1[kU] * f.e2[kV] - f.e2[kU] * f.e1[kV];  // ±N[kW], largest of N
   if (det != 0) {
     const double inv = 1.0 / det;
@@ -114,7 +111,7 @@ int ClipToBox(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
     if (inside) {
       // Counter-clockwise in barycentric space, like the triangle itself (positive fan areas).
       for (int k = 0; k < 4; ++k) poly[k] = corner[det > 0 ? k : 3 - k];
-      return ClipAxis<kW>(f, poly, spare, 4);
+      return 4;
     }
   }
   poly[0] = {0, 0};
@@ -122,7 +119,6 @@ int ClipToBox(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
   poly[2] = {0, 1};
   int n = ClipAxis<kU>(f, poly, spare, 3);
   if (n > 0) n = ClipAxis<kV>(f, poly, spare, n);
-  if (n > 0) n = ClipAxis<kW>(f, poly, spare, n);
   return n;
 }
 
@@ -182,37 +178,83 @@ AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoin
   }
 }
 
-AttributeSample AttributeSampler::Sample(std::size_t triangle, std::int64_t x, std::int64_t y,
-                                         std::int64_t z) const {
+AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const {
+  Prepared p;
+  p.triangle = triangle;
   const Triangle& tri = mesh_.triangles[triangle];
-  const std::int64_t origin[3] = {x * kFixedPointOne, y * kFixedPointOne, z * kFixedPointOne};
-  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
-
-  // The triangle in voxel-local coordinates: fixed-point differences, exact in doubles.
-  const FixedPoint3& v0 = vertices_[tri[0]];
+  p.v0 = vertices_[tri[0]];
   const FixedPoint3& v1 = vertices_[tri[1]];
   const FixedPoint3& v2 = vertices_[tri[2]];
+  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
+  // Fixed-point differences, exact in doubles.
+  for (int a = 0; a < 3; ++a) {
+    p.e1[a] = static_cast<double>(v1[a] - p.v0[a]) * kScale;
+    p.e2[a] = static_cast<double>(v2[a] - p.v0[a]) * kScale;
+  }
+  p.normal = Cross(Vec3d{p.e1[0], p.e1[1], p.e1[2]}, Vec3d{p.e2[0], p.e2[1], p.e2[2]});
+  p.normal_length = Length(p.normal);
+  const double nx = std::abs(p.normal.x), ny = std::abs(p.normal.y), nz = std::abs(p.normal.z);
+  p.axis = nx > ny && nx > nz ? 0 : (ny > nz ? 1 : 2);
+  return p;
+}
+
+AttributeSample AttributeSampler::Sample(std::size_t triangle, std::int64_t x, std::int64_t y,
+                                         std::int64_t z) const {
+  AttributeSample out;
+  SampleRun(Prepare(triangle), x, y, z, 0, 1, &out);
+  return out;
+}
+
+void AttributeSampler::SampleRun(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z,
+                                 int axis, int n, AttributeSample* out) const {
+  switch (p.axis) {
+    case 0:
+      return SampleRunAlong<1, 2, 0>(p, x, y, z, axis, n, out);
+    case 1:
+      return SampleRunAlong<2, 0, 1>(p, x, y, z, axis, n, out);
+    default:
+      return SampleRunAlong<0, 1, 2>(p, x, y, z, axis, n, out);
+  }
+}
+
+template <int kU, int kV, int kW>
+void AttributeSampler::SampleRunAlong(const Prepared& p, std::int64_t x, std::int64_t y,
+                                      std::int64_t z, int axis, int n, AttributeSample* out) const {
+  std::int64_t origin[3] = {x, y, z};
+  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
+  // The triangle in voxel-local coordinates: fixed-point differences, exact in doubles.
   Frame f;
   for (int a = 0; a < 3; ++a) {
-    f.a[a] = static_cast<double>(v0[a] - origin[a]) * kScale;
-    f.e1[a] = static_cast<double>(v1[a] - v0[a]) * kScale;
-    f.e2[a] = static_cast<double>(v2[a] - v0[a]) * kScale;
+    f.e1[a] = p.e1[a];
+    f.e2[a] = p.e2[a];
   }
-  const Vec3d normal = Cross(Vec3d{f.e1[0], f.e1[1], f.e1[2]}, Vec3d{f.e2[0], f.e2[1], f.e2[2]});
-
+  auto place = [&](int a) {
+    f.a[a] = static_cast<double>(p.v0[a] - origin[a] * kFixedPointOne) * kScale;
+  };
   ClipVertex buffers[2][kClipCapacity];
-  ClipVertex* poly = buffers[0];
-  ClipVertex* spare = buffers[1];
-  const double nx = std::abs(normal.x), ny = std::abs(normal.y), nz = std::abs(normal.z);
-  int n;
-  if (nx > ny && nx > nz) {
-    n = ClipToBox<1, 2, 0>(f, poly, spare);
-  } else if (ny > nz) {
-    n = ClipToBox<2, 0, 1>(f, poly, spare);
-  } else {
-    n = ClipToBox<0, 1, 2>(f, poly, spare);
+  ClipVertex column[kClipCapacity];
+  int column_n = -1;  // the column's polygon, when shared by the run's voxels
+  for (int i = 0; i < n; ++i, ++origin[axis]) {
+    for (int a = 0; a < 3; ++a) place(a);
+    ClipVertex* poly = buffers[0];
+    ClipVertex* spare = buffers[1];
+    int m;
+    if (axis != kW) {
+      m = ClipToColumn<kU, kV>(f, poly, spare);
+    } else {
+      if (column_n < 0) {
+        column_n = ClipToColumn<kU, kV>(f, poly, spare);
+        std::copy(poly, poly + column_n, column);
+      }
+      m = column_n;
+      std::copy(column, column + m, poly);
+    }
+    if (m > 0) m = ClipAxis<kW>(f, poly, spare, m);
+    out[i] = Finish(p, poly, m);
   }
+}
 
+AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* poly, int n) const {
   // Area and area centroid from the fan around poly[0], in barycentric space: the map to the
   // triangle's plane is affine with area factor |N| (N = e1 × e2), so fan triangle i has area
   // |N|·alpha_i/2 with alpha_i its barycentric cross product (positive: clipping keeps the
@@ -233,7 +275,9 @@ AttributeSample AttributeSampler::Sample(std::size_t triangle, std::int64_t x, s
     cb1 += w * (u1 + w1);
     cb2 += w * (u2 + w2);
   }
-  const double normal_length = Length(normal);
+  const double normal_length = p.normal_length;
+  const Vec3d& normal = p.normal;
+  const std::size_t triangle = p.triangle;
   const bool has_area = total > 0 && centroid_total > 0 && normal_length > 0;
   double b1, b2;  // the barycentrics the linear attributes are evaluated at
   if (has_area) {

@@ -18,6 +18,15 @@
 
 namespace svokit {
 
+namespace attributes_detail {
+// A clipped polygon's vertex, carried as its barycentrics with respect to the original triangle,
+// corners 1 and 2 (b0 = 1 − b1 − b2): everything linear on the triangle (position, UV, colour,
+// normal) follows exactly, and a vertex is 16 bytes.
+struct ClipVertex {
+  double b1, b2;
+};
+}  // namespace attributes_detail
+
 /// What one triangle contributes to one voxel.
 struct AttributeSample {
   /// Area of the triangle clipped to the voxel's closed box [x,x+1]×[y,y+1]×[z,z+1], in voxel²
@@ -50,10 +59,31 @@ class AttributeSampler {
   AttributeSample Sample(std::size_t triangle, std::int64_t x, std::int64_t y,
                          std::int64_t z) const;
 
+  /// The per-triangle part of Sample(), computed once for all the voxels of a triangle.
+  struct Prepared {
+    std::size_t triangle = 0;
+    FixedPoint3 v0;
+    double e1[3] = {}, e2[3] = {};  // v1 − v0 and v2 − v0 in voxels (exact)
+    Vec3d normal;                   // e1 × e2
+    double normal_length = 0;
+    int axis = 2;  // dominant axis of the normal, clipped last
+  };
+  Prepared Prepare(std::size_t triangle) const;
+  /// Sample() for the `n` voxels from (x, y, z) on along `axis`, into out[0..n), identical voxel
+  /// by voxel; a run along the triangle's dominant axis clips to its column once.
+  void SampleRun(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis, int n,
+                 AttributeSample* out) const;
+
   /// Textures that could not be decoded, one message each (their materials use the base colour).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  template <int kU, int kV, int kW>
+  void SampleRunAlong(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis,
+                      int n, AttributeSample* out) const;
+  // Area, colour and normal of the triangle clipped to a voxel: the polygon poly[0..n).
+  AttributeSample Finish(const Prepared& p, const attributes_detail::ClipVertex* poly, int n) const;
+
   struct MaterialInfo {
     Rgba base_color;
     const TextureSampler* texture = nullptr;  // null: untextured, or the texture failed

@@ -16,9 +16,11 @@ Int128 Max0(Int128 x) {
   return x > 0 ? x : 0;
 }
 
-// Floor and ceiling of a / b for b > 0. A double quotient is exact to a few units at these
-// magnitudes; integer products then fix it up, avoiding a 128-bit division in the column loop.
-Int128 FloorDiv(Int128 a, Int128 b) {
+}  // namespace
+
+// A double quotient is exact to a few units at these magnitudes; integer products then fix it
+// up, avoiding a 128-bit division.
+Int128 voxelize_detail::FloorDiv(Int128 a, Int128 b) {
   const double estimate = std::floor(static_cast<double>(a) / static_cast<double>(b));
   if (!(std::abs(estimate) < 9.0e18)) {
     Int128 q = a / b;
@@ -31,12 +33,6 @@ Int128 FloorDiv(Int128 a, Int128 b) {
   return q;
 }
 
-std::int64_t FloorDiv64(std::int64_t a, std::int64_t b) {
-  return static_cast<std::int64_t>(FloorDiv(a, b));
-}
-
-}  // namespace
-
 TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
                                      const FixedPoint3& c, VoxelMode mode, const IBox3& grid)
     : mode_(mode) {
@@ -45,8 +41,8 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
   for (int ax = 0; ax < 3; ++ax) {
     const std::int64_t mn = std::min({a[ax], b[ax], c[ax]});
     const std::int64_t mx = std::max({a[ax], b[ax], c[ax]});
-    lo_[ax] = std::max(-FloorDiv64(-mn, kFixedPointOne) - 1, grid.lo[ax]);
-    hi_[ax] = std::min(FloorDiv64(mx, kFixedPointOne) + 1, grid.hi[ax]);
+    lo_[ax] = std::max(-voxelize_detail::FloorDiv(-mn, kFixedPointOne) - 1, grid.lo[ax]);
+    hi_[ax] = std::min(voxelize_detail::FloorDiv(mx, kFixedPointOne) + 1, grid.hi[ax]);
     if (lo_[ax] >= hi_[ax]) empty_ = true;
   }
 
@@ -70,9 +66,13 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
     for (Int128& x : n_) x = -x;
   }
   d_ = n_[0] * a.x + n_[1] * a.y + n_[2] * a.z;
-  if (n_[w_] != 0) {
+  has_plane_ = n_[w_] != 0;
+  if (has_plane_) {
     // Solve the plane test for the box's w index: plane_lo = ceil(..) = floor(.. + den − 1).
+    // Every term but the constant is a multiple of S, and floor(x / (S·k)) = floor(floor(x / S)
+    // / k): the constant is floored by S once here, which keeps the walk's numbers small.
     const Int128 nw = n_[w_];
+    Depth<Int128>& depth = wide_.depth;
     if (mode_ == VoxelMode::kConservative) {
       // min over the box of N·x ≤ d ≤ max over the box.
       Int128 below = 0, above = 0;
@@ -80,24 +80,20 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
         below += std::min<Int128>(0, n_[ax]) * kS;
         above += Max0(n_[ax]) * kS;
       }
-      depth_den_ = nw * kS;
-      depth_a_lo_ = d_ - above + depth_den_ - 1;
-      depth_a_hi_ = d_ - below;
-      depth_b_ = n_[u_] * kS;
-      depth_c_ = n_[v_] * kS;
+      depth.den = nw;
+      depth.a_lo = voxelize_detail::FloorDiv(d_ - above + nw * kS - 1, kS);
+      depth.a_hi = voxelize_detail::FloorDiv(d_ - below, kS);
+      depth.b = n_[u_];
+      depth.c = n_[v_];
     } else {
       // |N·centre − d| ≤ ½·N_w (the plane crosses the voxel's centre line along w), doubled:
       // −N_w·S ≤ 2N·P + S·ΣN − 2d ≤ N_w·S with P the box corner.
       const Int128 k0 = kS * (n_[0] + n_[1] + n_[2]) - 2 * d_;
-      depth_den_ = 2 * nw * kS;
-      depth_a_lo_ = -nw * kS - k0 + depth_den_ - 1;
-      depth_a_hi_ = nw * kS - k0;
-      depth_b_ = 2 * n_[u_] * kS;
-      depth_c_ = 2 * n_[v_] * kS;
-    }
-    for (auto [step, delta] : {std::pair{&depth_step_u_, -depth_b_}, {&depth_step_v_, -depth_c_}}) {
-      step->dq = FloorDiv(delta, depth_den_);
-      step->dr = delta - step->dq * depth_den_;
+      depth.den = 2 * nw;
+      depth.a_lo = voxelize_detail::FloorDiv(-nw * kS - k0 + 2 * nw * kS - 1, kS);
+      depth.a_hi = voxelize_detail::FloorDiv(nw * kS - k0, kS);
+      depth.b = 2 * n_[u_];
+      depth.c = 2 * n_[v_];
     }
   }
 
@@ -112,7 +108,7 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
     for (int i = 0; i < 3; ++i) {
       const Int128 np = -e[i][q] * sign, nq = e[i][p] * sign;
       const Int128 vp = vert[i][p], vq = vert[i][q];
-      Edge& edge = edges_[slot][i];
+      EdgeT<Int128>& edge = wide_.edges[slot][i];
       if (mode_ == VoxelMode::kConservative) {
         // Inward normal at the box's most interior corner (Haines & Wallace critical point).
         edge.a = np * kS;
@@ -131,54 +127,51 @@ TriangleVoxelizer::TriangleVoxelizer(const FixedPoint3& a, const FixedPoint3& b,
 
 void TriangleVoxelizer::Localize() {
   if (empty_) return;
-  // Move the edge functions' origin to the candidate box's low corner, then see whether every
-  // value the walk can reach (one step past the box included) fits in 63 bits.
+  // Move the origin to the candidate box's low corner, then see whether every value the walk can
+  // reach (one step past the box included) fits in 63 bits.
   origin_ = lo_;
   constexpr Int128 kLimit = Int128{1} << 62;
   fits_int64_ = true;
+  std::array<Int128, 3> extent;
+  for (int ax = 0; ax < 3; ++ax) extent[ax] = hi_[ax] - lo_[ax] + 1;
   const int axes[3][2] = {{u_, v_}, {v_, w_}, {w_, u_}};
   for (int slot = 0; slot < 3; ++slot) {
     const int p = axes[slot][0], q = axes[slot][1];
-    const Int128 ext_p = hi_[p] - lo_[p] + 1, ext_q = hi_[q] - lo_[q] + 1;
     for (int i = 0; i < 3; ++i) {
-      Edge& e = edges_[slot][i];
+      EdgeT<Int128>& e = wide_.edges[slot][i];
       e.c += e.a * origin_[p] + e.b * origin_[q];
-      if (Abs(e.a) * ext_p + Abs(e.b) * ext_q + Abs(e.c) >= kLimit) fits_int64_ = false;
-      edges64_[slot][i] = {static_cast<std::int64_t>(e.a), static_cast<std::int64_t>(e.b),
-                           static_cast<std::int64_t>(e.c)};
+      if (Abs(e.a) * extent[p] + Abs(e.b) * extent[q] + Abs(e.c) >= kLimit) fits_int64_ = false;
+      narrow_.edges[slot][i] = {static_cast<std::int64_t>(e.a), static_cast<std::int64_t>(e.b),
+                                static_cast<std::int64_t>(e.c)};
     }
   }
+  if (!has_plane_) return;
+  Depth<Int128>& d = wide_.depth;
+  for (Int128* a : {&d.a_lo, &d.a_hi}) {
+    *a -= d.b * origin_[u_] + d.c * origin_[v_] + d.den * origin_[w_];
+    if (Abs(*a) + Abs(d.b) * extent[u_] + Abs(d.c) * extent[v_] >= kLimit) fits_int64_ = false;
+  }
+  if (d.den >= kLimit) fits_int64_ = false;
+  for (auto [step, delta] : {std::pair{&d.step_u, -d.b}, {&d.step_v, -d.c}}) {
+    step->dq = voxelize_detail::FloorDiv(delta, d.den);
+    step->dr = delta - step->dq * d.den;
+  }
+  auto narrow = [](Int128 x) { return static_cast<std::int64_t>(x); };
+  narrow_.depth = {narrow(d.den),
+                   narrow(d.a_lo),
+                   narrow(d.a_hi),
+                   narrow(d.b),
+                   narrow(d.c),
+                   {narrow(d.step_u.dq), narrow(d.step_u.dr)},
+                   {narrow(d.step_v.dq), narrow(d.step_v.dr)}};
 }
 
 bool TriangleVoxelizer::ColumnInside(std::int64_t pu, std::int64_t pv) const {
   const std::int64_t lu = pu - origin_[u_], lv = pv - origin_[v_];
-  for (const Edge& e : edges_[0]) {
+  for (const EdgeT<Int128>& e : wide_.edges[0]) {
     if (e.a * lu + e.b * lv + e.c < 0) return false;
   }
   return true;
-}
-
-bool TriangleVoxelizer::SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const {
-  return StartSideRun(edges_, pu, pv, pw).Inside();
-}
-
-TriangleVoxelizer::DepthCursor TriangleVoxelizer::StartDepth(std::int64_t pu,
-                                                             std::int64_t pv) const {
-  DepthCursor c;
-  c.has_plane = n_[w_] != 0;
-  if (!c.has_plane) return c;
-  for (FloorCursor* f : {&c.lo, &c.hi}) {
-    const Int128 num = (f == &c.lo ? depth_a_lo_ : depth_a_hi_) - depth_b_ * pu - depth_c_ * pv;
-    f->q = FloorDiv(num, depth_den_);
-    f->r = num - f->q * depth_den_;
-  }
-  return c;
-}
-
-bool TriangleVoxelizer::DepthRange(std::int64_t pu, std::int64_t pv, std::int64_t& w0,
-                                   std::int64_t& w1) const {
-  const DepthCursor c = StartDepth(pu, pv);
-  return ClipDepth(c, w0, w1);
 }
 
 bool TriangleVoxelizer::Overlaps(std::int64_t x, std::int64_t y, std::int64_t z) const {
@@ -188,9 +181,10 @@ bool TriangleVoxelizer::Overlaps(std::int64_t x, std::int64_t y, std::int64_t z)
     if (p[ax] < lo_[ax] || p[ax] >= hi_[ax]) return false;
   }
   if (!ColumnInside(p[u_], p[v_])) return false;
+  const std::int64_t lu = p[u_] - origin_[u_], lv = p[v_] - origin_[v_], lw = p[w_] - origin_[w_];
   std::int64_t w0, w1;
-  DepthRange(p[u_], p[v_], w0, w1);
-  return p[w_] >= w0 && p[w_] <= w1 && SideTests(p[u_], p[v_], p[w_]);
+  ClipDepth(StartDepth(wide_.depth, lu, lv), w0, w1);
+  return lw >= w0 && lw <= w1 && StartSideRun(wide_.edges, lu, lv, lw).Inside();
 }
 
 }  // namespace svokit

@@ -36,8 +36,13 @@ class TriangleVoxelizer {
   /// Projected area in voxel² along the dominant axis (the hybrid method's classifier).
   double projected_area() const { return projected_area_; }
 
-  /// Calls emit(x, y, z) for every voxel of the triangle in columns [u0,u1) × [v0,v1) (clipped
-  /// to the footprint), columns in row-major order, voxels of a column in increasing order.
+  /// Calls emit(x, y, z, n) for every run of voxels of the triangle in columns [u0,u1) × [v0,v1)
+  /// (clipped to the footprint): n ≥ 1 voxels from (x, y, z) on, stepping along the dominant
+  /// axis. Columns in row-major order, runs of a column in increasing order.
+  template <class EmitRun>
+  void Runs(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
+            const EmitRun& emit) const;
+  /// The same voxels one by one: emit(x, y, z).
   template <class Emit>
   void Columns(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
                const Emit& emit) const;
@@ -53,7 +58,6 @@ class TriangleVoxelizer {
   struct EdgeT {
     Int a, b, c;
   };
-  using Edge = EdgeT<Int128>;
   // [slot][edge]: slot 0 projects onto (u, v), slot 1 onto (v, w), slot 2 onto (w, u).
   template <class Int>
   using EdgeSet = std::array<std::array<EdgeT<Int>, 3>, 3>;
@@ -70,71 +74,81 @@ class TriangleVoxelizer {
       for (int k = 0; k < 6; ++k) value[k] += step[k];
     }
   };
-  template <class Int>
-  SideRun<Int> StartSideRun(const EdgeSet<Int>& edges, std::int64_t pu, std::int64_t pv,
-                            std::int64_t pw) const;
-  template <class Int, class Emit>
-  void ColumnsWith(const EdgeSet<Int>& edges, std::int64_t u0, std::int64_t u1, std::int64_t v0,
-                   std::int64_t v1, const Emit& emit) const;
   // floor(num / den) as quotient and remainder (0 ≤ r < den), for num stepping by constants.
+  template <class Int>
   struct FloorCursor {
-    Int128 q = 0, r = 0;
+    Int q = 0, r = 0;
   };
   // A constant step of the numerator, split the same way: step = dq·den + dr, 0 ≤ dr < den.
+  template <class Int>
   struct FloorStep {
-    Int128 dq = 0, dr = 0;
+    Int dq = 0, dr = 0;
   };
-  // The plane's run along w at one column: plane_lo = lo.q, plane_hi = hi.q. Without a plane
-  // (degenerate triangle) every w of the candidate range passes.
+  // The plane's run along w at a column (local indices): plane_lo = lo.q, plane_hi = hi.q.
+  template <class Int>
   struct DepthCursor {
-    FloorCursor lo, hi;
-    bool has_plane = false;
+    FloorCursor<Int> lo, hi;
   };
-  DepthCursor StartDepth(std::int64_t pu, std::int64_t pv) const;
-  void Step(DepthCursor& c, const FloorStep& s) const {
-    if (!c.has_plane) return;
-    for (FloorCursor* f : {&c.lo, &c.hi}) {
-      f->q += s.dq;
-      f->r += s.dr;
-      if (f->r >= depth_den_) f->r -= depth_den_, ++f->q;
-    }
+  // Depth-range constants in local coordinates: plane_lo/hi = floor((a_lo/hi − b·lu − c·lv) / den).
+  template <class Int>
+  struct Depth {
+    Int den = 1, a_lo = 0, a_hi = 0, b = 0, c = 0;
+    FloorStep<Int> step_u, step_v;  // one column along u, one row along v
+  };
+  // Everything the column walk evaluates, in one integer width.
+  template <class Int>
+  struct Setup {
+    EdgeSet<Int> edges{};
+    Depth<Int> depth;
+  };
+
+  template <class Int>
+  SideRun<Int> StartSideRun(const EdgeSet<Int>& edges, std::int64_t lu, std::int64_t lv,
+                            std::int64_t lw) const;
+  template <class Int, class EmitRun>
+  void RunsWith(const Setup<Int>& setup, std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                std::int64_t v1, const EmitRun& emit) const;
+  template <class Int>
+  DepthCursor<Int> StartDepth(const Depth<Int>& depth, std::int64_t lu, std::int64_t lv) const;
+  // Without a plane the cursor stays at zero (den = 1, zero steps).
+  template <class Int>
+  static void Step(Int den, DepthCursor<Int>& c, const FloorStep<Int>& s) {
+    c.lo.q += s.dq, c.lo.r += s.dr;
+    c.hi.q += s.dq, c.hi.r += s.dr;
+    if (c.lo.r >= den) c.lo.r -= den, ++c.lo.q;
+    if (c.hi.r >= den) c.hi.r -= den, ++c.hi.q;
   }
-  // The column's voxel run [w0, w1] (empty if w0 > w1) within the candidate range; true when the
-  // plane alone meets exactly one voxel of the column (conservative mode), which makes the side
-  // tests unnecessary: every triangle point in the column then lies in that voxel.
-  bool ClipDepth(const DepthCursor& c, std::int64_t& w0, std::int64_t& w1) const {
-    Int128 lo = lo_[w_], hi = hi_[w_] - 1;
-    bool single = false;
-    if (c.has_plane) {
-      single = mode_ == VoxelMode::kConservative && c.lo.q == c.hi.q;
-      lo = c.lo.q > lo ? c.lo.q : lo;
-      hi = c.hi.q < hi ? c.hi.q : hi;
-    }
-    w0 = static_cast<std::int64_t>(lo);
-    w1 = static_cast<std::int64_t>(hi < lo ? lo - 1 : hi);
+  // The column's local voxel run [w0, w1] (empty if w0 > w1) within the candidate range; true
+  // when the plane alone meets exactly one voxel of the column (conservative mode), which makes
+  // the side tests unnecessary: every triangle point in the column then lies in that voxel.
+  // Without a plane (degenerate triangle) every w of the candidate range passes.
+  template <class Int>
+  bool ClipDepth(const DepthCursor<Int>& c, std::int64_t& w0, std::int64_t& w1) const {
+    w0 = lo_[w_] - origin_[w_];
+    w1 = hi_[w_] - 1 - origin_[w_];
+    if (!has_plane_) return false;
+    const bool single = mode_ == VoxelMode::kConservative && c.lo.q == c.hi.q;
+    if (c.lo.q > w0) w0 = static_cast<std::int64_t>(c.lo.q);
+    if (c.hi.q < w1) w1 = static_cast<std::int64_t>(c.hi.q);
     return single;
   }
   void Localize();
   bool ColumnInside(std::int64_t pu, std::int64_t pv) const;
-  bool DepthRange(std::int64_t pu, std::int64_t pv, std::int64_t& w0, std::int64_t& w1) const;
-  bool SideTests(std::int64_t pu, std::int64_t pv, std::int64_t pw) const;
 
   VoxelMode mode_;
   int w_, u_, v_;
   bool empty_ = false;
+  bool has_plane_ = false;  // false for a degenerate triangle
   double projected_area_ = 0;
   std::array<std::int64_t, 3> lo_{}, hi_{};  // candidate voxel index range per axis (AABB test)
   // Plane N·x = d in fixed-point units, oriented so N[w] ≥ 0.
   std::array<Int128, 3> n_{};
   Int128 d_ = 0;
-  // Per-triangle constants of the depth range: plane_lo/hi = floor((A_lo/hi − B·pu − C·pv) / den).
-  Int128 depth_den_ = 1, depth_a_lo_ = 0, depth_a_hi_ = 0, depth_b_ = 0, depth_c_ = 0;
-  FloorStep depth_step_u_, depth_step_v_;  // one column along u, one row along v
-  // Projected edges: [0] the (u,v) plane, [1] (v,w), [2] (w,u); three edges each.
-  EdgeSet<Int128> edges_{};
-  // The same edges in 64 bits, used when every value over the candidate box fits (footprints up
-  // to some thousand voxels): the column walk then runs on native integers.
-  EdgeSet<std::int64_t> edges64_{};
+  // The walk's constants in 128 bits, relative to origin_ (the candidate box's low corner); and
+  // the same in 64 bits, used when every value over the candidate box fits (footprints up to
+  // some thousand voxels): the column walk then runs on native integers.
+  Setup<Int128> wide_;
+  Setup<std::int64_t> narrow_;
   bool fits_int64_ = false;
   std::array<std::int64_t, 3> origin_{};
 };

@@ -14,6 +14,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "svokit/core/morton.hpp"
+
 namespace svokit {
 
 class VoxelBitSet {
@@ -21,21 +23,47 @@ class VoxelBitSet {
   static constexpr int kBrickBits = 12;  // 16³ voxels per brick
   using Brick = std::array<std::uint64_t, (1u << kBrickBits) / 64>;
 
-  void Insert(std::uint64_t key) {
-    const std::uint64_t brick = key >> kBrickBits;
-    // A small direct-mapped cache in front of the hash map: a triangle's voxels fall into a few
-    // neighbouring bricks.
-    CacheEntry& slot = cache_[(brick ^ (brick >> 3) ^ (brick >> 6)) & (kCacheSize - 1)];
-    if (slot.bits == nullptr || slot.key != brick) {
-      auto [it, fresh] = index_.try_emplace(brick, bricks_.size());
-      if (fresh) {
-        keys_.push_back(brick);
-        bricks_.emplace_back();
-      }
-      slot = {brick, &bricks_[it->second]};
+  /// Morton code of (x, y, z) mod 16 inside its brick.
+  static std::uint32_t LocalCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+    static constexpr std::uint16_t kSpread[16] = {0x000, 0x001, 0x008, 0x009, 0x040, 0x041,
+                                                  0x048, 0x049, 0x200, 0x201, 0x208, 0x209,
+                                                  0x240, 0x241, 0x248, 0x249};
+    return kSpread[x & 15] | kSpread[y & 15] << 1 | kSpread[z & 15] << 2;
+  }
+  /// The local code one voxel further along `axis` (inside the brick): that axis's bits are
+  /// incremented, the carry passing through the other axes' bits by filling them.
+  static std::uint32_t NextLocal(std::uint32_t local, int axis) {
+    const std::uint32_t mask = 0x249u << axis;
+    return (((local | ~mask) + 1) & mask) | (local & ~mask);
+  }
+
+  /// Calls f(bx, by, bz, local, count) for each brick (bx, by, bz) that the `n` voxels from
+  /// (x, y, z) on along `axis` pass through, in order: `local` is the Morton code of the first of
+  /// its `count` voxels inside the brick.
+  template <class F>
+  static void ForEachBrickOfRun(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis,
+                                std::uint32_t n, const F& f) {
+    std::uint32_t c[3] = {x, y, z};
+    while (n > 0) {
+      const std::uint32_t count = std::min(n, 16 - (c[axis] & 15));
+      f(c[0] >> 4, c[1] >> 4, c[2] >> 4, LocalCode(c[0], c[1], c[2]), count);
+      c[axis] += count;
+      n -= count;
     }
-    const std::uint32_t local = static_cast<std::uint32_t>(key) & ((1u << kBrickBits) - 1);
-    (*slot.bits)[local >> 6] |= std::uint64_t{1} << (local & 63);
+  }
+
+  /// Inserts the `n` voxels from (x, y, z) on along `axis` (a column run): one brick lookup per
+  /// brick the run passes through, not per voxel.
+  void InsertRun(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis, std::uint32_t n) {
+    ForEachBrickOfRun(x, y, z, axis, n,
+                      [&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint32_t local,
+                          std::uint32_t count) {
+                        Brick& bits = Bits(bx, by, bz);
+                        for (std::uint32_t k = 0; k < count; ++k) {
+                          bits[local >> 6] |= std::uint64_t{1} << (local & 63);
+                          local = NextLocal(local, axis);
+                        }
+                      });
   }
 
   std::size_t brick_count() const { return keys_.size(); }
@@ -69,14 +97,36 @@ class VoxelBitSet {
   static std::vector<std::uint64_t> UnionKeys(const Sets& sets, Ranks* ranks = nullptr);
 
  private:
+  // The bits of brick (bx, by, bz), created empty on first use.
+  Brick& Bits(std::uint32_t bx, std::uint32_t by, std::uint32_t bz) {
+    // A direct-mapped cache in front of the hash map, keyed by packed brick coordinates (the
+    // Morton key is computed on a miss only): each 8³ block of bricks maps to distinct slots,
+    // and a triangle's runs fall into a few neighbouring bricks.
+    const std::uint64_t packed = bx | std::uint64_t{by} << 21 | std::uint64_t{bz} << 42;
+    CacheEntry& slot = cache_[(bx & 7) | (by & 7) << 3 | (bz & 7) << 6];
+    if (slot.bits == nullptr || slot.packed != packed) [[unlikely]] {
+      slot = {packed, &Lookup(MortonEncode(bx, by, bz))};
+    }
+    return *slot.bits;
+  }
+  // Out of line: keeps the cache-hit path small enough to inline into the column walk.
+  [[gnu::noinline]] Brick& Lookup(std::uint64_t brick) {
+    auto [it, fresh] = index_.try_emplace(brick, bricks_.size());
+    if (fresh) {
+      keys_.push_back(brick);
+      bricks_.emplace_back();
+    }
+    return bricks_[it->second];
+  }
+
   std::unordered_map<std::uint64_t, std::size_t> index_;
   std::vector<std::uint64_t> keys_;
   std::deque<Brick> bricks_;  // stable addresses: cached pointers survive growth
   struct CacheEntry {
-    std::uint64_t key = 0;
+    std::uint64_t packed = 0;
     Brick* bits = nullptr;
   };
-  static constexpr std::size_t kCacheSize = 64;
+  static constexpr std::size_t kCacheSize = 512;
   std::array<CacheEntry, kCacheSize> cache_{};
 };
 

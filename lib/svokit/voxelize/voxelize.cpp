@@ -26,9 +26,9 @@ constexpr std::int64_t kTileColumns = 32;
 constexpr std::size_t kTrianglesPerTask = 512;
 constexpr std::size_t kTilesPerTask = 16;
 
-std::uint64_t VoxelKey(std::int64_t x, std::int64_t y, std::int64_t z) {
-  return MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                      static_cast<std::uint32_t>(z));
+// Voxel coordinates inside the grid fit 21 bits (Morton keys).
+std::uint32_t Coord(std::int64_t c) {
+  return static_cast<std::uint32_t>(c);
 }
 
 struct Tile {
@@ -74,12 +74,16 @@ struct BrickTriangle {
   bool operator==(const BrickTriangle&) const = default;
 };
 
-// Records the bricks one triangle's voxels fall in (consecutive voxels mostly share a brick).
+// Records the bricks one triangle's voxel runs fall in (consecutive runs mostly share a brick).
 class BrickRecorder {
  public:
-  void Voxel(std::uint64_t key) {
-    const std::uint64_t brick = key >> VoxelBitSet::kBrickBits;
-    if (bricks_.empty() || bricks_.back() != brick) bricks_.push_back(brick);
+  void Run(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis, std::uint32_t n) {
+    VoxelBitSet::ForEachBrickOfRun(
+        x, y, z, axis, n,
+        [&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint32_t, std::uint32_t) {
+          const std::uint64_t brick = MortonEncode(bx, by, bz);
+          if (bricks_.empty() || bricks_.back() != brick) bricks_.push_back(brick);
+        });
   }
   void EndTriangle(std::uint32_t triangle, std::vector<BrickTriangle>& out) {
     std::sort(bricks_.begin(), bricks_.end());
@@ -197,25 +201,47 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   auto walk = [&](std::size_t t, const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1,
                   std::int64_t v0, std::int64_t v1) {
     VoxelBitSet& keys = parts.local();
+    const int axis = tv.dominant_axis();
     if (!attributes) {
-      tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-        keys.Insert(VoxelKey(x, y, z));
+      tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
+        keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
       });
       return;
     }
     BrickRecorder& recorder = recorders.local();
-    tv.Columns(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-      const std::uint64_t key = VoxelKey(x, y, z);
-      keys.Insert(key);
-      recorder.Voxel(key);
+    tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
+      keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
+      recorder.Run(Coord(x), Coord(y), Coord(z), axis, Coord(k));
     });
     recorder.EndTriangle(static_cast<std::uint32_t>(t), bins.local());
   };
 
-  // Triangle path: every triangle not in `large`, a batch of triangles per task.
+  // Triangle path: every triangle not in `large`, a batch of triangles per task, in Morton order
+  // of their first corner's brick: a batch then shares bricks, so brick lookups hit the bit
+  // set's cache and brick memory stays hot (the union does not depend on the order).
   {
-    ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+    struct Ordered {
+      std::uint64_t brick;
+      std::uint32_t triangle;
+    };
+    std::vector<Ordered> order(n);
+    const IBox3 box = grid.IndexBox();
+    ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
+        const FixedPoint3& p = vertices[mesh.triangles[t][0]];
+        std::uint32_t c[3];
+        for (int a = 0; a < 3; ++a) {
+          c[a] = Coord(std::clamp(p[a] >> kFixedPointBits, box.lo[a], box.hi[a] - 1) >> 4);
+        }
+        order[t] = {MortonEncode(c[0], c[1], c[2]), static_cast<std::uint32_t>(t)};
+      }
+    });
+    tbb::parallel_sort(order.begin(), order.end(), [](const Ordered& a, const Ordered& b) {
+      return a.brick != b.brick ? a.brick < b.brick : a.triangle < b.triangle;
+    });
+    ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::size_t t = order[i].triangle;
         if (is_large[t]) continue;
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
         walk(t, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
@@ -286,15 +312,25 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         for (std::size_t i = starts[g]; i < starts[g + 1]; ++i) {
           const std::uint32_t t = pairs[i].triangle;
           const TriangleVoxelizer tv = voxelizer.Triangle(t);
+          const AttributeSampler::Prepared prepared = sampler.Prepare(t);
           const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
-          tv.Columns(lo[u], lo[u] + 16, lo[v], lo[v] + 16,
-                     [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                       const std::int64_t c[3] = {x, y, z};
-                       if (c[w] < lo[w] || c[w] >= lo[w] + 16) return;
-                       // The low 12 key bits are the voxel's Morton code inside its brick.
-                       const auto local = static_cast<std::uint32_t>(VoxelKey(x, y, z) & 4095u);
-                       acc.Add(local, sampler.Sample(t, x, y, z));
-                     });
+          tv.Runs(lo[u], lo[u] + 16, lo[v], lo[v] + 16,
+                  [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
+                    // The part of the run inside the brick.
+                    std::int64_t c[3] = {x, y, z};
+                    const std::int64_t first = std::max(c[w], lo[w]);
+                    const std::int64_t last = std::min(c[w] + k, lo[w] + 16);
+                    if (first >= last) return;
+                    c[w] = first;
+                    const int count = static_cast<int>(last - first);
+                    AttributeSample samples[16];
+                    sampler.SampleRun(prepared, c[0], c[1], c[2], w, count, samples);
+                    std::uint32_t local =
+                        VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
+                    for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+                      acc.Add(local, samples[s]);
+                    }
+                  });
         }
         const std::uint32_t slot = ranks.brick_slot.at(brick);
         acc.Finish(ranks.bits[slot], ranks.first[slot], set);
