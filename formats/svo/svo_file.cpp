@@ -5,6 +5,7 @@
 #include "formats/container/bytes.hpp"
 #include "formats/container/grid_section.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/svo/build.hpp"
 
 namespace svokit {
 namespace {
@@ -79,10 +80,11 @@ Status ReadLevelArray(const container::Reader& file, Tag tag, std::uint64_t coun
   return r.GetArray(out, count);
 }
 
-// Masks, first-child and first-contour indices of level l against the counts of level l + 1.
-Status CheckLinks(const Svo& svo, std::uint32_t l, const std::string& name) {
+// Masks, first-child and first-contour indices of level l against the counts HEAD gives level
+// l + 1 (checked whether or not level l + 1 is loaded: a streaming client indexes it next).
+Status CheckLinks(const Svo& svo, std::uint32_t l, const std::string& name,
+                  std::uint64_t next_nodes, std::uint64_t next_contours) {
   const SvoLevel& lv = svo.levels[l];
-  const SvoLevel* finer = l + 1 < svo.levels.size() ? &svo.levels[l + 1] : nullptr;
   std::uint64_t children = 0, contours = 0;
   for (std::size_t i = 0; i < lv.nodes.size(); ++i) {
     const SvoNode& n = lv.nodes[i];
@@ -102,10 +104,10 @@ Status CheckLinks(const Svo& svo, std::uint32_t l, const std::string& name) {
     contours += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(n.contour_mask)));
     if (children > std::uint64_t{0xffffffff}) return bad("too many children");
   }
-  if (finer != nullptr && (children != finer->node_count || contours != finer->contours.size())) {
+  if (children != next_nodes || contours != next_contours) {
     return Status::BadInput(
         "{}: level {} masks name {} children and {} contours, level {} holds {} and {}", name, l,
-        children, contours, l + 1, finer->node_count, finer->contours.size());
+        children, contours, l + 1, next_nodes, next_contours);
   }
   return Status::Ok();
 }
@@ -127,10 +129,9 @@ StatusOr<Svo> DecodeSections(const StatusOr<container::Reader>& opened,
   SVOKIT_RETURN_IF_ERROR(head.Get(svo.brick_side));
   SVOKIT_RETURN_IF_ERROR(head.Get(flags));
   SVOKIT_RETURN_IF_ERROR(head.Get(level_count));
-  if (svo.depth == 0 || svo.depth > kMaxDepth ||
-      (std::uint64_t{1} << svo.depth) < svo.grid.max_dim()) {
-    return Status::BadInput("{}: depth {} does not fit the {}-voxel grid", name, svo.depth,
-                            svo.grid.max_dim());
+  if (svo.depth == 0 || svo.depth > kMaxDepth || svo.depth != OctreeDepth(svo.grid)) {
+    return Status::BadInput("{}: depth {} is not the {}-voxel grid's octree depth {}", name,
+                            svo.depth, svo.grid.max_dim(), OctreeDepth(svo.grid));
   }
   if (level_count != svo.depth + 1) {
     return Status::BadInput("{}: {} levels for depth {}", name, level_count, svo.depth);
@@ -147,10 +148,12 @@ StatusOr<Svo> DecodeSections(const StatusOr<container::Reader>& opened,
   svo.has_contours = flags & kHasContours;
   const std::uint32_t last = std::min(svo.depth, max_level.value_or(svo.depth));
   svo.levels.resize(last + 1);
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> counts(svo.depth + 1);  // nodes, contours
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
     std::uint64_t nodes = 0, contours = 0;
     SVOKIT_RETURN_IF_ERROR(head.Get(nodes));
     SVOKIT_RETURN_IF_ERROR(head.Get(contours));
+    counts[l] = {nodes, contours};
     const std::uint64_t limit = std::uint64_t{1} << (3 * l);
     if (nodes == 0 || nodes > limit || (l == 0 && contours > 1) || contours > nodes ||
         (!svo.has_contours && contours != 0)) {
@@ -175,15 +178,8 @@ StatusOr<Svo> DecodeSections(const StatusOr<container::Reader>& opened,
     }
   }
   if (svo.levels[0].node_count != 1) return Status::BadInput("{}: level 0 is not one root", name);
-  for (std::uint32_t l = 0; l < last; ++l) SVOKIT_RETURN_IF_ERROR(CheckLinks(svo, l, name));
-  if (last < svo.depth) {  // the unread level's counts still bound the last one's masks
-    std::uint64_t children = 0;
-    for (const SvoNode& n : svo.levels[last].nodes) {
-      children += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(n.child_mask)));
-    }
-    if (svo.levels[last].nodes.empty() || children == 0) {
-      return Status::BadInput("{}: level {} has no children", name, last);
-    }
+  for (std::uint32_t l = 0; l <= last && l < svo.depth; ++l) {
+    SVOKIT_RETURN_IF_ERROR(CheckLinks(svo, l, name, counts[l + 1].first, counts[l + 1].second));
   }
   // Every node inside the grid at its level's resolution.
   const std::vector<std::uint64_t> keys = svo.LevelKeys(last);

@@ -371,17 +371,17 @@ TEST(SvoFile, RejectsIndicesOutOfSequence) {
 TEST(SvoFile, RejectsADepthThatDoesNotFitTheGrid) {
   Svo svo = HandSvo();
   svo.depth = 1;  // 2 < 4 voxels
-  ExpectRejected(svo, "depth 1 does not fit the 4-voxel grid");
+  ExpectRejected(svo, "depth 1 is not the 4-voxel grid's octree depth 2");
   svo = HandSvo();
-  svo.depth = 3;  // three levels stored
-  ExpectRejected(svo, "3 levels for depth 3");
+  svo.depth = 3;  // deeper than the enclosing power of two
+  ExpectRejected(svo, "depth 3 is not the 4-voxel grid's octree depth 2");
   svo = HandSvo();
   svo.depth = 0;
   ExpectRejected(svo, "depth 0");
   // The grid grows beyond the tree.
   svo = HandSvo();
   svo.grid = GridTransform(svo.grid.origin(), svo.grid.voxel_size(), {5, 4, 3});
-  ExpectRejected(svo, "does not fit the 5-voxel grid");
+  ExpectRejected(svo, "depth 2 is not the 5-voxel grid's octree depth 3");
 }
 
 TEST(SvoFile, RejectsNodesOutsideTheGridAndImpossibleCounts) {

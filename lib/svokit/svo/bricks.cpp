@@ -43,9 +43,15 @@ class KeyIndex {
   std::size_t mask_ = 0;
 };
 
-// The 4³ block of level L+1 nodes around the 2³ children of one level-L node: block coordinate
-// b = 2·(neighbour offset) + child bit + 1, so the node's own children sit at 1..2 per axis.
-using Block = std::array<std::int64_t, 64>;
+// The children of a level-L node and of its 26 neighbours: a 6³ block of level L+1 nodes, block
+// coordinate b = 2·(neighbour offset) + child bit + 2, so the node's own children sit at 2..3 per
+// axis. (Side-2 tents reach the corners of the cells at 0 and 5; side-3 ones stay within 1..4.)
+constexpr int kBlock = 6;
+using Block = std::array<std::int64_t, kBlock * kBlock * kBlock>;
+
+constexpr std::size_t BlockIndex(int x, int y, int z) {
+  return static_cast<std::size_t>(x + kBlock * (y + kBlock * z));
+}
 
 Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index, std::uint64_t node,
                      std::uint64_t key) {
@@ -68,11 +74,9 @@ Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index,
         const SvoNode& n = nodes[static_cast<std::size_t>(q)];
         for (unsigned ch = 0; ch < 8; ++ch) {
           if (!(n.child_mask & (1u << ch))) continue;
-          const int bx = 2 * ox + static_cast<int>(ch & 1) + 1;
-          const int by = 2 * oy + static_cast<int>((ch >> 1) & 1) + 1;
-          const int bz = 2 * oz + static_cast<int>((ch >> 2) & 1) + 1;
-          if (bx < 0 || by < 0 || bz < 0 || bx > 3 || by > 3 || bz > 3) continue;
-          block[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))] = n.Child(ch);
+          block[BlockIndex(2 * ox + static_cast<int>(ch & 1) + 2,
+                           2 * oy + static_cast<int>((ch >> 1) & 1) + 2,
+                           2 * oz + static_cast<int>((ch >> 2) & 1) + 2)] = n.Child(ch);
         }
       }
     }
@@ -97,9 +101,12 @@ struct EncodedSample {
   std::uint16_t normal;
 };
 
+// A sample whose opacity rounds to 0 is empty: no colour, no normal.
 EncodedSample Encode(const Svo& svo, const PremultipliedSample& p) {
+  const std::uint8_t opacity = EncodeUnorm8(p.opacity);
+  if (opacity == 0) return {0, 0, 0};
   const BrickSample s = Unpremultiply(p);
-  return {EncodeUnorm8(s.opacity), svo.has_color ? EncodeColor(s.color) : 0u,
+  return {opacity, svo.has_color ? EncodeColor(s.color) : 0u,
           svo.has_normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
 }
 
@@ -116,8 +123,8 @@ void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint
   const int side = static_cast<int>(svo.brick_side);
   const int points = 2 * side - 1;     // per axis, over the 2 children
   const int step = side == 3 ? 1 : 2;  // point spacing in half voxels
-  std::array<PremultipliedSample, 64> cells;
-  for (std::size_t c = 0; c < 64; ++c) {
+  std::array<PremultipliedSample, kBlock * kBlock * kBlock> cells;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
     if (block[c] < 0) continue;
     BrickSample b;
     b.opacity = 1;
@@ -133,15 +140,15 @@ void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint
         // same operands in the same order for every node that computes this point).
         int lo[3], hi[3];
         const int t[3] = {x * step, y * step, z * step};  // half voxels from the children's min
-        for (int a = 0; a < 3; ++a) {  // block cell j spans half voxels [2j − 2, 2j]
-          lo[a] = (t[a] + 1) / 2;
-          hi[a] = t[a] / 2 + 1;
+        for (int a = 0; a < 3; ++a) {  // block cell j spans half voxels [2j − 4, 2j − 2]
+          lo[a] = (t[a] + 1) / 2 + 1;
+          hi[a] = t[a] / 2 + 2;
         }
         PremultipliedSample sum;
         for (int cz = lo[2]; cz <= hi[2]; ++cz) {
           for (int cy = lo[1]; cy <= hi[1]; ++cy) {
             for (int cx = lo[0]; cx <= hi[0]; ++cx) {
-              const std::size_t c = static_cast<std::size_t>(cx + 4 * (cy + 4 * cz));
+              const std::size_t c = BlockIndex(cx, cy, cz);
               if (block[c] >= 0) Accumulate(sum, cells[c], 1.f);
             }
           }
@@ -188,21 +195,21 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
   };
   const std::uint32_t samples = svo.brick_samples();
   const SvoLevel& finer = svo.levels[level + 1];
-  for (int bz = 0; bz < 4; ++bz) {
-    for (int by = 0; by < 4; ++by) {
-      for (int bx = 0; bx < 4; ++bx) {
-        const std::int64_t f = block[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))];
+  for (int bz = 0; bz < kBlock; ++bz) {
+    for (int by = 0; by < kBlock; ++by) {
+      for (int bx = 0; bx < kBlock; ++bx) {
+        const std::int64_t f = block[BlockIndex(bx, by, bz)];
         if (f < 0) continue;
         // Samples shared with a neighbour brick are equal, so overwriting is harmless.
         const std::size_t first = static_cast<std::size_t>(f) * samples;
         for (int nz = 0; nz < side; ++nz) {
-          const int z = bz * cell + nz - lo;
+          const int z = (bz - 1) * cell + nz - lo;
           if (z < 0 || z >= n) continue;
           for (int ny = 0; ny < side; ++ny) {
-            const int y = by * cell + ny - lo;
+            const int y = (by - 1) * cell + ny - lo;
             if (y < 0 || y >= n) continue;
             for (int nx = 0; nx < side; ++nx) {
-              const int x = bx * cell + nx - lo;
+              const int x = (bx - 1) * cell + nx - lo;
               const std::size_t i = first + static_cast<std::size_t>(nx + side * (ny + side * nz));
               if (x < 0 || x >= n || finer.opacity[i] == 0) continue;
               BrickSample s;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -77,16 +78,32 @@ const std::array<float, 256>& SrgbDecodeTable() {
   return table;
 }
 
-// Nearest 8-bit sRGB code: the codes' midpoints, converted to linear once, are searched instead of
-// calling pow per channel (the bricks encode millions of samples).
+// Nearest 8-bit sRGB code without pow: the codes' midpoints in linear light, and per 1/4096 of
+// the linear range the code at its start; a bin spans < 1 code (slope ≤ 255·12.92/4096), so one
+// comparison finishes it.
 std::uint32_t EncodeSrgb8(float linear) {
-  static const std::array<float, 255> midpoints = [] {
-    std::array<float, 255> m{};
-    for (int i = 0; i < 255; ++i) m[i] = SrgbToLinear((static_cast<float>(i) + 0.5f) / 255.f);
+  constexpr int kBins = 4096;
+  struct Tables {
+    std::array<float, 256> midpoints{};  // [255] = +inf
+    std::array<std::uint8_t, kBins + 1> start{};
+  };
+  static const Tables t = [] {
+    Tables m;
+    for (int i = 0; i < 255; ++i) {
+      m.midpoints[i] = SrgbToLinear((static_cast<float>(i) + 0.5f) / 255.f);
+    }
+    m.midpoints[255] = std::numeric_limits<float>::infinity();
+    for (int b = 0; b <= kBins; ++b) {
+      const float v = static_cast<float>(b) / kBins;
+      m.start[b] = static_cast<std::uint8_t>(
+          std::upper_bound(m.midpoints.begin(), m.midpoints.end() - 1, v) - m.midpoints.begin());
+    }
     return m;
   }();
-  return static_cast<std::uint32_t>(std::upper_bound(midpoints.begin(), midpoints.end(), linear) -
-                                    midpoints.begin());
+  const float v = std::clamp(linear, 0.f, 1.f);
+  std::uint32_t code = t.start[static_cast<std::size_t>(v * kBins)];
+  while (v >= t.midpoints[code]) ++code;
+  return code;
 }
 
 std::uint32_t EncodeSnorm8(float v) {  // [−1, 1] → [1, 255]; 0 stays free for "no normal"

@@ -62,7 +62,7 @@ struct SvoLevel {
 };
 
 struct Svo {
-  GridTransform grid;  ///< the voxel grid (leaf voxel size, origin); dims ≤ 2^depth
+  GridTransform grid;  ///< the voxel grid (leaf voxel size, origin)
   VoxelMode mode = VoxelMode::kConservative;
   std::uint32_t depth = 0;  ///< level `depth` holds the voxels; 2^depth ≥ grid.max_dim()
   std::uint32_t brick_side =
