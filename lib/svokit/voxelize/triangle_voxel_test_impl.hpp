@@ -79,6 +79,14 @@ void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::
   const std::int64_t lu0 = u0 - origin_[u_], lu1 = u1 - origin_[u_];
   std::int64_t xyz[3];
   DepthCursor<Int> row = StartDepth(setup.depth, lu0, v0 - origin_[v_]);
+  // Conservative mode, with a plane: a column whose whole square lies inside the projected
+  // triangle meets the triangle exactly where it meets the plane, so its plane run needs no side
+  // tests. An edge function's minimum over the square is its value (at the most interior corner)
+  // minus |a| + |b|.
+  const bool shortcut = has_plane_ && mode_ == VoxelMode::kConservative;
+  Int inner[3];
+  for (int i = 0; i < 3; ++i)
+    inner[i] = (foot[i].a < 0 ? -foot[i].a : foot[i].a) + (foot[i].b < 0 ? -foot[i].b : foot[i].b);
   const Int den = setup.depth.den;
   const FloorStep<Int> step_u = setup.depth.step_u;
   for (std::int64_t pv = v0; pv < v1; ++pv, Step(den, row, setup.depth.step_v)) {
@@ -102,11 +110,11 @@ void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::
       const bool single = ClipDepth(depth, w0, w1);
       if (w0 > w1) continue;
       xyz[u_] = lu + origin_[u_];
-      if (single) {
-        // A one-voxel plane run needs no side tests: the triangle's points in this column all lie
-        // in that voxel (exact for conservative mode only).
+      if (single || (shortcut && ((e0 - inner[0]) | (e1 - inner[1]) | (e2 - inner[2])) >= 0)) {
+        // A one-voxel plane run needs no side tests either: the triangle's points in this
+        // column all lie in that voxel (exact for conservative mode only).
         xyz[w_] = w0 + origin_[w_];
-        emit(xyz[0], xyz[1], xyz[2], std::int64_t{1});  // w0 == w1 here
+        emit(xyz[0], xyz[1], xyz[2], w1 - w0 + 1);
         continue;
       }
       // Maximal runs of voxels passing the six side tests.
