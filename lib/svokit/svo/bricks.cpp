@@ -189,7 +189,9 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
   // [cell − 1, cell − 1 + n): only those lattice points are decoded.
   const int lo = cell - 1, n = 2 * side + 1;
   static thread_local std::vector<PremultipliedSample> lattice;
+  static thread_local std::vector<std::uint8_t> filled;
   lattice.assign(static_cast<std::size_t>(n * n * n), PremultipliedSample{});
+  filled.assign(lattice.size(), 0);
   const auto at = [n](int x, int y, int z) {
     return static_cast<std::size_t>(x + n * (y + n * z));
   };
@@ -200,7 +202,7 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
       for (int bx = 0; bx < kBlock; ++bx) {
         const std::int64_t f = block[BlockIndex(bx, by, bz)];
         if (f < 0) continue;
-        // Samples shared with a neighbour brick are equal, so overwriting is harmless.
+        // Samples shared with a neighbour brick are equal: each point is decoded once.
         const std::size_t first = static_cast<std::size_t>(f) * samples;
         for (int nz = 0; nz < side; ++nz) {
           const int z = (bz - 1) * cell + nz - lo;
@@ -211,7 +213,8 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
             for (int nx = 0; nx < side; ++nx) {
               const int x = (bx - 1) * cell + nx - lo;
               const std::size_t i = first + static_cast<std::size_t>(nx + side * (ny + side * nz));
-              if (x < 0 || x >= n || finer.opacity[i] == 0) continue;
+              if (x < 0 || x >= n || finer.opacity[i] == 0 || filled[at(x, y, z)]) continue;
+              filled[at(x, y, z)] = 1;
               BrickSample s;
               s.opacity = DecodeUnorm8(finer.opacity[i]);
               if (svo.has_color) s.color = DecodeColor(finer.color[i]);

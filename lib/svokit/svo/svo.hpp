@@ -15,6 +15,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/vec.hpp"
+#include "svokit/svo/sample_codec.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -96,16 +97,6 @@ struct SvoLevelBytes {
 SvoLevelBytes LevelBytes(const Svo& svo, std::uint32_t level);
 /// The per-level table the tools print: level, node size, nodes, contours, bytes per kind.
 std::string LevelTable(const Svo& svo);
-
-// Brick sample quantization, shared by the builder, the reader's checks and the exporters.
-std::uint8_t EncodeUnorm8(float v);
-inline float DecodeUnorm8(std::uint8_t v) {
-  return static_cast<float>(v) * (1.f / 255.f);
-}
-std::uint32_t EncodeColor(const Rgba& linear);  ///< sRGB RGB, linear A, 8 bits each
-Rgba DecodeColor(std::uint32_t rgba8);
-std::uint16_t EncodeNormal(const Vec3f& n);  ///< octahedral snorm8 ([1, 255]); 0 for a zero normal
-Vec3f DecodeNormal(std::uint16_t oct);
 
 /// ESVO contour word: thickness 7 bits [31:25], position 7 bits signed [24:18], normal 3 × 6 bits
 /// signed [17:0] (x high). With node centre c and size s, u = (x − c)/s ∈ [−½, ½]³; the slab is

@@ -1,0 +1,116 @@
+#pragma once
+// Brick sample quantization, shared by the builder, the reader's checks and the exporters: 8-bit
+// linear opacity, RGBA8 colour (sRGB RGB, linear A), octahedral normals with 8 bits per axis.
+// Inline, with tables built once at start-up: the bricks encode and decode millions of samples.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "svokit/core/vec.hpp"
+
+namespace svokit {
+
+inline std::uint8_t EncodeUnorm8(float v) {
+  return static_cast<std::uint8_t>(std::clamp(v, 0.f, 1.f) * 255.f + 0.5f);
+}
+inline float DecodeUnorm8(std::uint8_t v) {
+  return static_cast<float>(v) * (1.f / 255.f);
+}
+
+namespace codec_detail {
+
+// [−1, 1] → [1, 255]: code 0 stays free for "no normal".
+inline std::uint32_t EncodeSnorm8(float v) {
+  return static_cast<std::uint32_t>(std::clamp(v, -1.f, 1.f) * 127.f +
+                                    128.5f);  // > 0: truncation rounds
+}
+inline float DecodeSnorm8(std::uint32_t b) {
+  return static_cast<float>(static_cast<int>(b) - 128) / 127.f;
+}
+
+// Octahedral mapping (Meyer et al. 2010): |x|+|y|+|z| = 1, the lower half folded over.
+inline Vec3f OctahedralDecode(std::uint16_t oct) {
+  if (oct == 0) return {0, 0, 0};
+  float x = DecodeSnorm8(oct & 0xffu), y = DecodeSnorm8(oct >> 8u);
+  const float z = 1.f - std::abs(x) - std::abs(y);
+  if (z < 0) {
+    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
+    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
+    x = fx;
+    y = fy;
+  }
+  const float len = std::sqrt(x * x + y * y + z * z);
+  return {x / len, y / len, z / len};
+}
+
+struct Tables {
+  static constexpr int kBins = 4096;
+  std::array<float, 256> srgb_decode{};
+  // Nearest sRGB code without pow: the codes' midpoints in linear light ([255] = +inf), and per
+  // 1/4096 of the range the code at its start; a bin spans < 1 code (slope ≤ 255·12.92/4096).
+  std::array<float, 256> srgb_midpoints{};
+  std::array<std::uint8_t, kBins + 1> srgb_start{};
+  std::array<Vec3f, 65536> normals{};
+
+  Tables() {
+    for (int i = 0; i < 256; ++i) srgb_decode[i] = SrgbToLinear(static_cast<float>(i) / 255.f);
+    for (int i = 0; i < 255; ++i) {
+      srgb_midpoints[i] = SrgbToLinear((static_cast<float>(i) + 0.5f) / 255.f);
+    }
+    srgb_midpoints[255] = std::numeric_limits<float>::infinity();
+    for (int b = 0; b <= kBins; ++b) {
+      const float v = static_cast<float>(b) / kBins;
+      srgb_start[b] = static_cast<std::uint8_t>(
+          std::upper_bound(srgb_midpoints.begin(), srgb_midpoints.end() - 1, v) -
+          srgb_midpoints.begin());
+    }
+    for (std::uint32_t i = 0; i < normals.size(); ++i) {
+      normals[i] = OctahedralDecode(static_cast<std::uint16_t>(i));
+    }
+  }
+};
+inline const Tables kTables;
+
+inline std::uint32_t EncodeSrgb8(float linear) {
+  const float v = std::clamp(linear, 0.f, 1.f);
+  std::uint32_t code = kTables.srgb_start[static_cast<std::size_t>(v * Tables::kBins)];
+  while (v >= kTables.srgb_midpoints[code]) ++code;
+  return code;
+}
+
+}  // namespace codec_detail
+
+/// sRGB RGB, linear A, 8 bits each; R in the low byte.
+inline std::uint32_t EncodeColor(const Rgba& c) {
+  using codec_detail::EncodeSrgb8;
+  return EncodeSrgb8(c.r) | EncodeSrgb8(c.g) << 8 | EncodeSrgb8(c.b) << 16 |
+         std::uint32_t{EncodeUnorm8(c.a)} << 24;
+}
+inline Rgba DecodeColor(std::uint32_t v) {
+  const auto& t = codec_detail::kTables.srgb_decode;
+  return {t[v & 0xff], t[(v >> 8) & 0xff], t[(v >> 16) & 0xff],
+          DecodeUnorm8(static_cast<std::uint8_t>(v >> 24))};
+}
+
+/// Octahedral, 8 bits per axis (x low byte); a zero normal encodes as 0.
+inline std::uint16_t EncodeNormal(const Vec3f& n) {
+  using codec_detail::EncodeSnorm8;
+  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+  if (!(l1 > 1e-20f)) return 0;
+  float x = n.x / l1, y = n.y / l1;
+  if (n.z < 0) {
+    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
+    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
+    x = fx;
+    y = fy;
+  }
+  return static_cast<std::uint16_t>(EncodeSnorm8(x) | EncodeSnorm8(y) << 8);
+}
+inline Vec3f DecodeNormal(std::uint16_t oct) {
+  return codec_detail::kTables.normals[oct];
+}
+
+}  // namespace svokit
