@@ -27,6 +27,7 @@
 #include "svokit/mesh/import.hpp"
 #include "svokit/mesh/mesh_report.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/voxel_bitset.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 #include "tests/voxelize/exact_reference.hpp"
@@ -1005,6 +1006,25 @@ TEST(SlowThinSeparation, Armadillo512) {
 
 TEST(SlowThinSeparation, UvTorus512) {
   CheckSeparation(Torus(), 512);
+}
+
+// Column runs (the voxelizer's only way into a bit set) across brick boundaries, along each axis:
+// the union must hold exactly the runs' voxels, whatever set each run went into.
+TEST(VoxelBitSetRuns, RunsAcrossBricksMatchPerVoxelKeys) {
+  std::mt19937_64 rng(20240613);
+  std::vector<VoxelBitSet> sets(3);
+  std::vector<std::uint64_t> want;
+  for (int i = 0; i < 3000; ++i) {
+    std::uint32_t c[3];
+    for (std::uint32_t& x : c) x = static_cast<std::uint32_t>(rng() % 100);
+    const int axis = static_cast<int>(rng() % 3);
+    const std::uint32_t n = 1 + static_cast<std::uint32_t>(rng() % 40);
+    sets[rng() % sets.size()].InsertRun(c[0], c[1], c[2], axis, n);
+    for (std::uint32_t k = 0; k < n; ++k, ++c[axis]) want.push_back(MortonEncode(c[0], c[1], c[2]));
+  }
+  std::sort(want.begin(), want.end());
+  want.erase(std::unique(want.begin(), want.end()), want.end());
+  EXPECT_EQ(VoxelBitSet::UnionKeys(sets), want);
 }
 
 }  // namespace
