@@ -153,25 +153,32 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks
   starts.push_back(refs.size());
 
   // OR each group, count its voxels, then write every brick's keys at its prefix-sum offset.
-  std::vector<Brick> merged(bricks);
-  std::vector<std::uint64_t> offset(bricks + 1, 0);
-  tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    Brick& m = merged[b];
-    m = *refs[starts[b]].bits;
+  // The merged bricks are kept only for `ranks`; otherwise the second pass ORs again, which is
+  // cheaper than allocating and zeroing a copy of every brick.
+  auto merge = [&](std::size_t b) {
+    Brick m = *refs[starts[b]].bits;
     for (std::size_t r = starts[b] + 1; r < starts[b + 1]; ++r) {
       for (std::size_t w = 0; w < m.size(); ++w) m[w] |= (*refs[r].bits)[w];
     }
+    return m;
+  };
+  std::vector<Brick> merged(ranks ? bricks : 0);
+  std::vector<std::uint64_t> offset(bricks + 1, 0);
+  tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
+    const Brick m = merge(b);
     std::uint64_t count = 0;
     for (std::uint64_t word : m) count += static_cast<std::uint64_t>(std::popcount(word));
     offset[b + 1] = count;
+    if (ranks) merged[b] = m;
   });
   for (std::size_t b = 0; b < bricks; ++b) offset[b + 1] += offset[b];
   std::vector<std::uint64_t> keys(offset[bricks]);
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
+    const Brick m = ranks ? merged[b] : merge(b);
     std::uint64_t* out = keys.data() + offset[b];
     const std::uint64_t base = refs[starts[b]].key << kBrickBits;
-    for (std::size_t w = 0; w < merged[b].size(); ++w) {
-      for (std::uint64_t word = merged[b][w]; word != 0; word &= word - 1) {
+    for (std::size_t w = 0; w < m.size(); ++w) {
+      for (std::uint64_t word = m[w]; word != 0; word &= word - 1) {
         *out++ = base | (w * 64 + static_cast<std::uint64_t>(std::countr_zero(word)));
       }
     }
