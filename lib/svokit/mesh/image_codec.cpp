@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <mutex>
 
+#include "svokit/core/file_io.hpp"
+
 namespace svokit {
 
 namespace {
@@ -15,6 +17,7 @@ constexpr const char* kPluginName = "libsvokit_oiio.so";
 
 struct Plugin {
   SvokitDecodeFn decode = nullptr;
+  SvokitEncodeFn encode = nullptr;  // null in a plugin built before image writing existed
   std::string error;
 };
 
@@ -43,6 +46,7 @@ const Plugin& LoadPlugin() {
       void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
       if (!handle) continue;
       plugin.decode = reinterpret_cast<SvokitDecodeFn>(::dlsym(handle, "svokit_oiio_decode"));
+      plugin.encode = reinterpret_cast<SvokitEncodeFn>(::dlsym(handle, "svokit_oiio_encode"));
       if (plugin.decode) return;
     }
     plugin.error = std::string("the image decoding plugin ") + kPluginName +
@@ -85,6 +89,37 @@ StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
                             header.channels);
   SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, pixels.data(), pixels.size()));
   return pixels;
+}
+
+Status WriteImage(const std::filesystem::path& path, int width, int height, int channels,
+                  std::span<const std::uint8_t> pixels) {
+  if (width <= 0 || height <= 0 || channels < 1 || channels > 4) {
+    return Status::BadInput("{}: cannot write a {}x{} image with {} channels", path.string(), width,
+                            height, channels);
+  }
+  if (pixels.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
+                           static_cast<std::size_t>(channels)) {
+    return Status::Internal("{}: {} pixel bytes for a {}x{}x{} image", path.string(), pixels.size(),
+                            width, height, channels);
+  }
+  const std::string format = LowerExtension(path);
+  if (format.empty()) {
+    return Status::BadInput("{}: no extension to choose an image format by", path.string());
+  }
+  const Plugin& plugin = LoadPlugin();
+  if (!plugin.decode) return Status::Internal("{}: {}", path.string(), plugin.error);
+  if (!plugin.encode) {
+    return Status::Internal("{}: the image plugin {} cannot write images (rebuild it)",
+                            path.string(), kPluginName);
+  }
+  AtomicFileWriter file(path);
+  SVOKIT_RETURN_IF_ERROR(file.Open());
+  char error[512] = {};
+  if (plugin.encode(file.temp_path().c_str(), format.c_str(), width, height, channels,
+                    pixels.data(), error, sizeof error) != 0) {
+    return Status::BadInput("{}: cannot write the image ({})", path.string(), error);
+  }
+  return file.Commit();
 }
 
 }  // namespace svokit

@@ -1,6 +1,7 @@
-// libsvokit_oiio: the plugin module that decodes images with OpenImageIO (see image_codec.hpp).
-// One entry point: with `pixels` null it reads the header only; otherwise it decodes all pixels
-// into the caller's buffer of `pixel_count` floats.
+// libsvokit_oiio: the plugin module that decodes and encodes images with OpenImageIO (see
+// image_codec.hpp). svokit_oiio_decode: with `pixels` null it reads the header only; otherwise it
+// decodes all pixels into the caller's buffer of `pixel_count` floats. svokit_oiio_encode: writes
+// 8-bit pixels to a named file in a named format.
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -82,6 +83,29 @@ extern "C" __attribute__((visibility("default"))) int svokit_oiio_decode(
     if (needed != pixel_count) return Fail("pixel buffer size mismatch", error, error_size);
     if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels)) {
       return Fail(input->geterror(), error, error_size);
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    return Fail(e.what(), error, error_size);
+  }
+}
+
+extern "C" __attribute__((visibility("default"))) int svokit_oiio_encode(
+    const char* path, const char* format, int width, int height, int channels,
+    const std::uint8_t* pixels, char* error, std::size_t error_size) {
+  try {
+    auto output = OIIO::ImageOutput::create(format);
+    if (!output) {
+      const std::string message = OIIO::geterror();
+      return Fail(message.empty() ? std::string("no writer for format '") + format + "'" : message,
+                  error, error_size);
+    }
+    OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
+    // Our alpha is straight: without this the PNG writer would un-premultiply the colours.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    if (!output->open(path, spec) || !output->write_image(OIIO::TypeDesc::UINT8, pixels) ||
+        !output->close()) {
+      return Fail(output->geterror(), error, error_size);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -1,0 +1,461 @@
+#include "svokit/render/ray_cast.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "svokit/mesh/image_codec.hpp"
+
+namespace svokit {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxImageSide = 16384;
+constexpr double kMargin = 0.02;  // of the image per side, around the fitted bounds
+
+constexpr std::array<std::string_view, 7> kViewNames = {"front", "back",   "left", "right",
+                                                        "top",   "bottom", "iso"};
+constexpr std::array<std::string_view, 3> kShadeNames = {"color", "normal", "depth"};
+
+Vec3d Normalized(const Vec3d& v) {
+  return v / Length(v);
+}
+
+struct Basis {
+  Vec3d forward, up;
+};
+
+Basis ViewBasis(View view) {
+  switch (view) {
+    case View::kFront:
+      return {{0, 0, -1}, {0, 1, 0}};
+    case View::kBack:
+      return {{0, 0, 1}, {0, 1, 0}};
+    case View::kLeft:
+      return {{1, 0, 0}, {0, 1, 0}};
+    case View::kRight:
+      return {{-1, 0, 0}, {0, 1, 0}};
+    case View::kTop:
+      return {{0, -1, 0}, {0, 0, -1}};
+    case View::kBottom:
+      return {{0, 1, 0}, {0, 0, 1}};
+    case View::kIso:
+      break;
+  }
+  const Vec3d f = Normalized(Vec3d{-1, -1, -1});
+  const Vec3d y{0, 1, 0};
+  return {f, Normalized(y - f * Dot(y, f))};
+}
+
+std::array<Vec3d, 8> Corners(const Box3d& b) {
+  std::array<Vec3d, 8> c;
+  for (unsigned i = 0; i < 8; ++i) {
+    c[i] = {i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
+  }
+  return c;
+}
+
+// A node's span along the ray and the world normal of the surface the span was entered through
+// (a cube face or a slab plane), facing the ray.
+struct Span {
+  double t0 = 0, t1 = 0;
+  Vec3d entry_normal;
+};
+
+// The brick interpolated trilinearly at local position f ∈ [0, 1]³ of the node, opacity-weighted
+// (samples store straight colour and unit normals, so they are premultiplied before mixing).
+struct BrickValue {
+  bool any = false;
+  Rgba color{1, 1, 1, 1};
+  Vec3d normal;  // zero when the bricks hold none
+};
+
+BrickValue SampleBrick(const Svo& svo, std::uint32_t level, std::uint64_t index, const Vec3d& f) {
+  BrickValue v;
+  const std::uint32_t side = svo.brick_side;
+  if (side < 2) return v;
+  std::array<std::uint32_t, 3> i0{};
+  std::array<double, 3> w{};
+  for (int a = 0; a < 3; ++a) {
+    const double g = std::clamp(f[a], 0.0, 1.0) * (side - 1);
+    i0[a] = std::min(static_cast<std::uint32_t>(g), side - 2);
+    w[a] = g - i0[a];
+  }
+  double sum = 0, r = 0, g = 0, b = 0, alpha = 0;
+  Vec3d n;
+  for (unsigned c = 0; c < 8; ++c) {
+    const std::uint32_t x = i0[0] + (c & 1), y = i0[1] + (c >> 1 & 1), z = i0[2] + (c >> 2 & 1);
+    const double weight =
+        (c & 1 ? w[0] : 1 - w[0]) * (c & 2 ? w[1] : 1 - w[1]) * (c & 4 ? w[2] : 1 - w[2]);
+    const BrickSample s = svo.Sample(level, index, x + side * (y + side * z));
+    const double wa = weight * s.opacity;
+    sum += wa;
+    r += wa * s.color.r;
+    g += wa * s.color.g;
+    b += wa * s.color.b;
+    alpha += wa * s.color.a;
+    n = n + Vec3d{s.normal.x, s.normal.y, s.normal.z} * wa;
+  }
+  if (!(sum > 0)) return v;
+  v.any = true;
+  if (svo.has_color) {
+    v.color = {static_cast<float>(r / sum), static_cast<float>(g / sum),
+               static_cast<float>(b / sum), static_cast<float>(alpha / sum)};
+  }
+  const double len = Length(n);
+  if (svo.has_normal && len > 1e-12) v.normal = n / len;
+  return v;
+}
+
+// The traversal runs in the octree's unit cube, mirrored so every direction component is positive
+// (child c of the mirrored cube is child c ^ mirror of the real one); t stays the world distance.
+class Caster {
+ public:
+  Caster(const Svo& svo, const Vec3d& origin, const Vec3d& direction, std::uint32_t leaf_level,
+         bool use_contours)
+      : svo_(svo),
+        leaf_level_(leaf_level),
+        contours_(use_contours),
+        world_origin_(origin),
+        world_dir_(direction) {
+    const double root = svo.grid.voxel_size() * std::ldexp(1.0, static_cast<int>(svo.depth));
+    const Vec3d o = (origin - svo.grid.origin()) / root, d = direction / root;
+    const double largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    for (int a = 0; a < 3; ++a) {
+      o_[a] = o[a];
+      d_[a] = d[a];
+      if (d_[a] < 0) {
+        o_[a] = 1 - o_[a];
+        d_[a] = -d_[a];
+        mirror_ |= 1u << a;
+      }
+      // Axis-parallel rays: a tiny positive component keeps every slab test finite and ordered.
+      d_[a] = std::max(d_[a], largest * 1e-14);
+      inv_[a] = 1 / d_[a];
+    }
+  }
+
+  RayHit Cast() {
+    Span span;
+    span.t0 = -kInf;
+    span.t1 = kInf;
+    int entry_axis = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double t0 = -o_[a] * inv_[a], t1 = (1 - o_[a]) * inv_[a];
+      if (t0 > span.t0) {
+        span.t0 = t0;
+        entry_axis = a;
+      }
+      span.t1 = std::min(span.t1, t1);
+    }
+    span.entry_normal = FaceNormal(entry_axis);
+    span.t0 = std::max(span.t0, 0.0);
+    if (span.t0 <= span.t1) {
+      const SvoLevel& root = svo_.levels[0];
+      Visit(0, 0, root.contours.empty() ? 0 : root.contours[0], {0, 0, 0}, 1.0, span);
+    }
+    hit_.visits = visits_;
+    return hit_;
+  }
+
+ private:
+  // The world normal of the mirrored cube face the ray enters through along `axis`.
+  Vec3d FaceNormal(int axis) const {
+    Vec3d n;
+    n[axis] = (mirror_ >> axis & 1) ? 1.0 : -1.0;
+    return n;
+  }
+
+  // Narrows `span` to the node's slab; false when nothing of the span is left.
+  bool ClipToContour(std::uint32_t word, const Vec3d& lo, double size, Span& span) const {
+    const Contour c = DecodeContour(word);
+    const Vec3d n{static_cast<double>(c.nx), static_cast<double>(c.ny), static_cast<double>(c.nz)};
+    Vec3d nm = n;  // the normal in mirrored space
+    for (int a = 0; a < 3; ++a) {
+      if (mirror_ >> a & 1) nm[a] = -nm[a];
+    }
+    const Vec3d center = lo + Vec3d{size, size, size} * 0.5;
+    const double at = Dot(nm, o_ - center) / size, slope = Dot(nm, d_) / size;
+    if (slope == 0) return at >= c.Low() && at <= c.High() && span.t0 <= span.t1;
+    double ta = (c.Low() - at) / slope, tb = (c.High() - at) / slope;
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > span.t0) {
+      span.t0 = ta;
+      const Vec3d unit = Normalized(n);
+      span.entry_normal = Dot(unit, world_dir_) > 0 ? unit * -1.0 : unit;
+    }
+    span.t1 = std::min(span.t1, tb);
+    return span.t0 <= span.t1;
+  }
+
+  // `contour`: the node's contour word, 0 for none (0 never encodes one: its normal is zero).
+  bool Visit(std::uint32_t level, std::uint64_t index, std::uint32_t contour, const Vec3d& lo,
+             double size, Span span) {
+    ++visits_;
+    if (contours_ && contour != 0 && !ClipToContour(contour, lo, size, span)) return false;
+    if (level == leaf_level_) {
+      Hit(level, index, contour, lo, size, span);
+      return true;
+    }
+    const SvoNode& node = svo_.levels[level].nodes[index];
+    const double half = size * 0.5;
+    Vec3d tm, t1;
+    std::array<double, 3> t0{};
+    for (int a = 0; a < 3; ++a) {
+      t0[a] = (lo[a] - o_[a]) * inv_[a];
+      tm[a] = (lo[a] + half - o_[a]) * inv_[a];
+      t1[a] = (lo[a] + size - o_[a]) * inv_[a];
+    }
+    // The child holding the span's entry point, then siblings in the order the ray crosses the
+    // three mid-planes: each step sets one more bit, so at most four children are visited.
+    unsigned c = 0;
+    for (int a = 0; a < 3; ++a) {
+      if (tm[a] <= span.t0) c |= 1u << a;
+    }
+    while (true) {
+      double cmin = -kInf, cmax = kInf;
+      int entry_axis = 0;
+      for (int a = 0; a < 3; ++a) {
+        const bool upper = c >> a & 1;
+        const double enter = upper ? tm[a] : t0[a], leave = upper ? t1[a] : tm[a];
+        if (enter > cmin) {
+          cmin = enter;
+          entry_axis = a;
+        }
+        cmax = std::min(cmax, leave);
+      }
+      const unsigned real = c ^ mirror_;
+      if (node.child_mask >> real & 1) {
+        Span child = span;
+        if (cmin > child.t0) {
+          child.t0 = cmin;
+          child.entry_normal = FaceNormal(entry_axis);
+        }
+        child.t1 = std::min(child.t1, cmax);
+        if (child.t0 <= child.t1) {
+          std::uint32_t word = 0;
+          if (node.contour_mask >> real & 1) {
+            word = svo_.levels[level + 1].contours[node.ChildContour(real)];
+          }
+          const Vec3d child_lo{lo.x + ((c & 1) ? half : 0), lo.y + ((c & 2) ? half : 0),
+                               lo.z + ((c & 4) ? half : 0)};
+          if (Visit(level + 1, node.Child(real), word, child_lo, half, child)) return true;
+        }
+      }
+      // Leave through the nearest mid-plane not yet crossed, unless the ray leaves the node (or
+      // its narrowed span) first.
+      int next = -1;
+      double best = kInf;
+      for (int a = 0; a < 3; ++a) {
+        if (!(c >> a & 1) && tm[a] < best) {
+          best = tm[a];
+          next = a;
+        }
+      }
+      if (next < 0 || best > span.t1) break;
+      bool left_parent = false;
+      for (int a = 0; a < 3; ++a) {
+        if ((c >> a & 1) && t1[a] < best) left_parent = true;
+      }
+      if (left_parent) break;
+      c |= 1u << next;
+    }
+    return false;
+  }
+
+  void Hit(std::uint32_t level, std::uint64_t index, std::uint32_t contour, const Vec3d& lo,
+           double size, const Span& span) {
+    hit_.hit = true;
+    hit_.t = span.t0;
+    hit_.level = level;
+    hit_.node = index;
+    hit_.position = world_origin_ + world_dir_ * span.t0;
+    // Local position in the (real, unmirrored) node from the mirrored one.
+    Vec3d f;
+    for (int a = 0; a < 3; ++a) {
+      const double local = (o_[a] + d_[a] * span.t0 - lo[a]) / size;
+      f[a] = (mirror_ >> a & 1) ? 1 - local : local;
+    }
+    const BrickValue brick = SampleBrick(svo_, level, index, f);
+    hit_.color = brick.color;
+    // The leaf's own contour normal, else the filtered brick normal, else the face or slab the
+    // span was entered through.
+    Vec3d n = span.entry_normal;
+    if (contours_ && contour != 0) {
+      const Contour c = DecodeContour(contour);
+      n = Normalized(
+          Vec3d{static_cast<double>(c.nx), static_cast<double>(c.ny), static_cast<double>(c.nz)});
+    } else if (Length(brick.normal) > 0) {
+      n = brick.normal;
+    }
+    hit_.normal = Dot(n, world_dir_) > 0 ? n * -1.0 : n;
+  }
+
+  const Svo& svo_;
+  std::uint32_t leaf_level_;
+  bool contours_;
+  Vec3d world_origin_, world_dir_;
+  Vec3d o_, d_, inv_;
+  unsigned mirror_ = 0;
+  std::uint32_t visits_ = 0;
+  RayHit hit_;
+};
+
+std::uint8_t Byte(double v) {
+  return static_cast<std::uint8_t>(std::clamp(v, 0.0, 1.0) * 255.0 + 0.5);
+}
+
+}  // namespace
+
+StatusOr<View> ParseView(std::string_view name) {
+  for (std::size_t i = 0; i < kViewNames.size(); ++i) {
+    if (kViewNames[i] == name) return static_cast<View>(i);
+  }
+  return Status::BadInput("--view '{}' is not front, back, left, right, top, bottom or iso", name);
+}
+
+StatusOr<Shade> ParseShade(std::string_view name) {
+  for (std::size_t i = 0; i < kShadeNames.size(); ++i) {
+    if (kShadeNames[i] == name) return static_cast<Shade>(i);
+  }
+  return Status::BadInput("--shade '{}' is not color, normal or depth", name);
+}
+
+StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {
+  const auto bad = [&] {
+    return Status::BadInput("--size '{}': expected WxH with each side 1 to {}", text,
+                            kMaxImageSide);
+  };
+  const std::size_t x = text.find('x');
+  if (x == std::string_view::npos) return bad();
+  std::array<int, 2> size{};
+  const std::array<std::string_view, 2> parts = {text.substr(0, x), text.substr(x + 1)};
+  for (int i = 0; i < 2; ++i) {
+    const char* end = parts[i].data() + parts[i].size();
+    const auto [ptr, ec] = std::from_chars(parts[i].data(), end, size[i]);
+    if (ec != std::errc() || ptr != end || size[i] < 1 || size[i] > kMaxImageSide) return bad();
+  }
+  return size;
+}
+
+std::string_view ViewName(View view) {
+  return kViewNames[static_cast<std::size_t>(view)];
+}
+std::string_view ShadeName(Shade shade) {
+  return kShadeNames[static_cast<std::size_t>(shade)];
+}
+
+std::array<double, 2> OrthoCamera::Project(const Vec3d& p) const {
+  const Vec3d rel = p - top_left;
+  return {Dot(rel, right) / pixel_size, -Dot(rel, up) / pixel_size};
+}
+
+OrthoCamera FitCamera(const Svo& svo, View view, int width, int height) {
+  const Basis basis = ViewBasis(view);
+  OrthoCamera cam;
+  cam.forward = basis.forward;
+  cam.up = basis.up;
+  cam.right = Cross(basis.forward, basis.up);
+  cam.width = width;
+  cam.height = height;
+  double rmin = kInf, rmax = -kInf, umin = kInf, umax = -kInf, fmin = kInf;
+  const Box3d bounds = svo.grid.GridBounds();
+  for (const Vec3d& c : Corners(bounds)) {
+    rmin = std::min(rmin, Dot(c, cam.right));
+    rmax = std::max(rmax, Dot(c, cam.right));
+    umin = std::min(umin, Dot(c, cam.up));
+    umax = std::max(umax, Dot(c, cam.up));
+    fmin = std::min(fmin, Dot(c, cam.forward));
+  }
+  cam.pixel_size = std::max((rmax - rmin) / (width * (1 - 2 * kMargin)),
+                            (umax - umin) / (height * (1 - 2 * kMargin)));
+  const double rc = (rmin + rmax) / 2, uc = (umin + umax) / 2;
+  // The image plane sits a little in front of the grid, so every ray starts outside it.
+  const double f0 = fmin - 0.01 * Length(bounds.extent()) - cam.pixel_size;
+  cam.top_left = cam.right * (rc - width / 2.0 * cam.pixel_size) +
+                 cam.up * (uc + height / 2.0 * cam.pixel_size) + cam.forward * f0;
+  return cam;
+}
+
+RayHit CastRay(const Svo& svo, const Vec3d& origin, const Vec3d& direction,
+               std::uint32_t leaf_level, bool use_contours) {
+  return Caster(svo, origin, direction, leaf_level, use_contours).Cast();
+}
+
+StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
+  if (options.width < 1 || options.height < 1 || options.width > kMaxImageSide ||
+      options.height > kMaxImageSide) {
+    return Status::BadInput("--size {}x{}: each side must be 1 to {}", options.width,
+                            options.height, kMaxImageSide);
+  }
+  if (svo.levels.empty() || svo.levels[0].node_count != 1) {
+    return Status::Internal("render of an octree without a root");
+  }
+  const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
+  const std::uint32_t level = options.level.value_or(loaded);
+  if (level > loaded) {
+    return Status::BadInput("--level {} is beyond the octree's levels 0..{}", level, loaded);
+  }
+  RenderResult result;
+  result.level = level;
+  result.camera = FitCamera(svo, options.view, options.width, options.height);
+  result.image = RgbaImage(options.width, options.height);
+  const OrthoCamera& cam = result.camera;
+  double near = kInf, far = -kInf;
+  for (const Vec3d& c : Corners(svo.grid.GridBounds())) {
+    const double t = Dot(c - cam.top_left, cam.forward);
+    near = std::min(near, t);
+    far = std::max(far, t);
+  }
+  std::vector<std::uint64_t> row_hits(static_cast<std::size_t>(options.height)),
+      row_visits(static_cast<std::size_t>(options.height));
+  tbb::parallel_for(0, options.height, [&](int y) {
+    for (int x = 0; x < options.width; ++x) {
+      const Vec3d origin = cam.top_left + cam.right * ((x + 0.5) * cam.pixel_size) -
+                           cam.up * ((y + 0.5) * cam.pixel_size);
+      const RayHit hit = CastRay(svo, origin, cam.forward, level, options.contours);
+      row_visits[static_cast<std::size_t>(y)] += hit.visits;
+      if (!hit.hit) continue;
+      ++row_hits[static_cast<std::size_t>(y)];
+      std::uint8_t* px = result.image.at(x, y);
+      px[3] = 255;
+      switch (options.shade) {
+        case Shade::kColor: {
+          // A headlight: faces turned away from the viewer darken, so the shape reads.
+          const double light = 0.2 + 0.8 * std::max(0.0, -Dot(hit.normal, cam.forward));
+          px[0] = Byte(LinearToSrgb(static_cast<float>(hit.color.r * light)));
+          px[1] = Byte(LinearToSrgb(static_cast<float>(hit.color.g * light)));
+          px[2] = Byte(LinearToSrgb(static_cast<float>(hit.color.b * light)));
+          break;
+        }
+        case Shade::kNormal:
+          px[0] = Byte(hit.normal.x * 0.5 + 0.5);
+          px[1] = Byte(hit.normal.y * 0.5 + 0.5);
+          px[2] = Byte(hit.normal.z * 0.5 + 0.5);
+          break;
+        case Shade::kDepth: {
+          const double v = 1 - 0.85 * (hit.t - near) / std::max(far - near, 1e-300);
+          px[0] = px[1] = px[2] = Byte(v);
+          break;
+        }
+      }
+    }
+  });
+  for (std::size_t y = 0; y < row_hits.size(); ++y) {
+    result.hits += row_hits[y];
+    result.node_visits += row_visits[y];
+  }
+  return result;
+}
+
+Status WriteRgbaImage(const RgbaImage& image, const std::filesystem::path& path) {
+  return WriteImage(path, image.width, image.height, 4, image.pixels);
+}
+
+}  // namespace svokit

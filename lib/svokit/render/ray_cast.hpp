@@ -1,0 +1,90 @@
+#pragma once
+// A CPU ray caster over the sparse voxel octree, showing what an ESVO-style renderer would:
+// orthographic views fitted to the grid, ordered front-to-back child traversal with the ray
+// mirrored into the positive octant (seed 001 §1.4.4; Laine & Karras 2010), and contour slabs
+// narrowing each node's t-span (a node's slab ∩ its cube ∩ its ancestors' slabs). A leaf (a node
+// of the render level) whose narrowed span is non-empty is hit at the span's entry.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "svokit/core/status.hpp"
+#include "svokit/core/vec.hpp"
+#include "svokit/render/image.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+enum class View { kFront, kBack, kLeft, kRight, kTop, kBottom, kIso };
+enum class Shade {
+  kColor,   ///< brick colour (trilinear at the hit) under a headlight
+  kNormal,  ///< shading normal as RGB = (n + 1)/2
+  kDepth,   ///< grey, near bright, over the grid's depth range along the view
+};
+
+/// "front", "back", "left", "right", "top", "bottom", "iso"; anything else is bad input.
+StatusOr<View> ParseView(std::string_view name);
+StatusOr<Shade> ParseShade(std::string_view name);
+std::string_view ViewName(View view);
+/// "WxH" (e.g. "640x480"), each side 1..16384; anything else is bad input.
+StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text);
+std::string_view ShadeName(Shade shade);
+
+/// An orthographic camera: the ray of pixel (x, y) (x right, y down) starts at
+/// top_left + right·(x + ½)·pixel_size − up·(y + ½)·pixel_size and runs along `forward`.
+/// front looks along −z with +y up; back along +z; left along +x; right along −x (all +y up);
+/// top along −y with −z up; bottom along +y with +z up; iso along −(1, 1, 1) with +y up.
+struct OrthoCamera {
+  Vec3d top_left, right, up, forward;  ///< unit vectors, right = forward × up
+  double pixel_size = 1;               ///< world units per pixel
+  int width = 0, height = 0;
+
+  /// Continuous pixel coordinates of a world point (pixel (x, y) spans [x, x + 1) × [y, y + 1)).
+  std::array<double, 2> Project(const Vec3d& p) const;
+};
+
+/// A camera whose image (width × height, square pixels) holds the grid's world bounds with a
+/// margin of 2 % per side, centred.
+OrthoCamera FitCamera(const Svo& svo, View view, int width, int height);
+
+struct RenderOptions {
+  View view = View::kFront;
+  int width = 512, height = 512;
+  /// Nodes of this level are the leaves; default (and at most) the finest loaded level.
+  std::optional<std::uint32_t> level;
+  Shade shade = Shade::kColor;
+  /// Intersect contour slabs; off, leaves are their full cubes (what contours save is visible).
+  bool contours = true;
+};
+
+/// One ray's outcome.
+struct RayHit {
+  bool hit = false;
+  double t = 0;             ///< world distance from the ray origin (ray direction is unit)
+  std::uint32_t level = 0;  ///< the leaf's level and index
+  std::uint64_t node = 0;
+  Vec3d position;            ///< world hit point
+  Vec3d normal;              ///< shading normal, unit, facing the ray
+  Rgba color;                ///< linear; white when the octree has no colour
+  std::uint32_t visits = 0;  ///< nodes whose span was tested
+};
+
+/// Casts one ray (unit `direction`) against the octree, `leaf_level` ≤ the finest loaded level.
+RayHit CastRay(const Svo& svo, const Vec3d& origin, const Vec3d& direction,
+               std::uint32_t leaf_level, bool use_contours);
+
+struct RenderResult {
+  RgbaImage image;  ///< hit pixels opaque, misses alpha 0
+  OrthoCamera camera;
+  std::uint32_t level = 0;  ///< the level rendered as leaves
+  std::uint64_t hits = 0, node_visits = 0;
+};
+
+/// Renders `svo` (rows in parallel; the image does not depend on the thread count). Bad input:
+/// a size outside 1..16384 per axis, a level beyond the loaded ones.
+StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options);
+
+}  // namespace svokit

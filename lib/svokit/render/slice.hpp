@@ -1,0 +1,42 @@
+#pragma once
+// One axis-aligned slice of the octree's grid as a picture: a cell per node of the chosen level
+// (the voxels by default) whose index along the axis is K; occupied cells show the node's colour
+// (its brick's centre sample, or the opacity-weighted mean of the corners of a 2³ brick; a fixed
+// orange without colour), empty cells are transparent.
+//
+// Orientation, as the views of ray_cast.hpp see the grid: z=K as from the front (x right, y up),
+// x=K as from the left (z right, y up), y=K as from the top (x right, z down).
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "svokit/core/status.hpp"
+#include "svokit/render/image.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+struct SliceSpec {
+  int axis = 2;  ///< 0 x, 1 y, 2 z
+  std::uint32_t index = 0;
+};
+
+/// "x=12", "Y=0", "z=127": an axis and a non-negative cell index; anything else is bad input.
+StatusOr<SliceSpec> ParseSlice(std::string_view text);
+
+struct SliceOptions {
+  /// Cells are nodes of this level (default and at most: the finest loaded level).
+  std::optional<std::uint32_t> level;
+  /// Pixels per cell; 0 picks the largest that keeps the longer side ≤ 512 (at least 1).
+  int scale = 0;
+};
+
+/// The cell colour used for occupied nodes of an octree without colour (sRGB).
+inline constexpr std::uint8_t kSliceOccupied[3] = {230, 150, 40};
+
+/// Bad input: an index outside the grid at that level, a level beyond the loaded ones.
+StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
+                                const SliceOptions& options = {});
+
+}  // namespace svokit
