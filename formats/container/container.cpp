@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "formats/container/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
@@ -105,16 +107,23 @@ Status Writer::WriteFile(const std::filesystem::path& path) const {
   return file.Commit();
 }
 
-struct Reader::Mapping {
+namespace {
+
+struct Mapping {
   void* data = nullptr;
   std::size_t size = 0;
+  Mapping() = default;
+  Mapping(const Mapping&) = delete;
+  Mapping& operator=(const Mapping&) = delete;
   ~Mapping() {
     if (data) ::munmap(data, size);
   }
 };
 
-StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId& format,
-                              SectionFilter load, const void* context) {
+}  // namespace
+
+StatusOr<Frame> Frame::Open(const std::filesystem::path& path, const FormatId& format,
+                            SectionFilter load, const void* context) {
   const std::string name = path.string();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return Status::BadInput("{}: cannot open ({})", name, std::strerror(errno));
@@ -136,69 +145,112 @@ StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId&
   ::close(fd);
   std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(mapping->data),
                                       mapping->size);
-  StatusOr<Reader> reader = FromBytes(bytes, name, format, load, context);
-  if (reader.ok()) reader->mapping_ = std::move(mapping);
-  return reader;
+  StatusOr<Frame> frame = FromBytes(bytes, name, format, load, context);
+  if (frame.ok()) frame->mapping_ = std::move(mapping);
+  return frame;
 }
 
-StatusOr<Reader> Reader::FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   const FormatId& format, SectionFilter load,
-                                   const void* context) {
+StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                                 const FormatId& format, SectionFilter load, const void* context) {
   if (bytes.size() < kHeaderSize ||
       std::memcmp(bytes.data(), format.magic.data(), format.magic.size()) != 0) {
     return Status::BadInput("{}: not a {} file (bad magic)", name, format.name);
   }
   ByteReader header(bytes.subspan(8, kHeaderSize - 8), name);
-  Reader r;
-  r.name_ = name;
+  Frame f;
+  f.name_ = name;
   std::uint64_t file_size = 0;
   std::uint32_t count = 0, header_crc = 0;
-  SVOKIT_RETURN_IF_ERROR(header.Get(r.version_));
-  SVOKIT_RETURN_IF_ERROR(header.Get(r.flags_));
+  SVOKIT_RETURN_IF_ERROR(header.Get(f.version_));
+  SVOKIT_RETURN_IF_ERROR(header.Get(f.flags_));
   SVOKIT_RETURN_IF_ERROR(header.Get(file_size));
   SVOKIT_RETURN_IF_ERROR(header.Get(count));
   SVOKIT_RETURN_IF_ERROR(header.Get(header_crc));
-  if (r.version_ == 0 || r.version_ > format.version) {
+  if (f.version_ == 0 || f.version_ > format.version) {
     return Status::BadInput("{}: {} version {} is not supported (this build reads up to {})", name,
-                            format.name, r.version_, format.version);
+                            format.name, f.version_, format.version);
   }
+  const auto issue = [&](IssueKind kind, std::string message) {
+    f.issues_.push_back({kind, name + ": " + std::move(message)});
+  };
   if (file_size != bytes.size()) {
-    return Status::BadInput("{}: file is {} bytes but its header says {} (truncated or extended)",
-                            name, bytes.size(), file_size);
+    issue(IssueKind::kFileSize,
+          fmt::format("file is {} bytes but its header says {} (truncated or extended)",
+                      bytes.size(), file_size));
   }
   const std::size_t table_end = kHeaderSize + std::size_t{count} * kSectionEntrySize;
   if (count > bytes.size() / kSectionEntrySize || table_end > bytes.size()) {
-    return Status::BadInput("{}: section table ({} entries) runs past the end of the file", name,
-                            count);
+    issue(IssueKind::kSectionTable,
+          fmt::format("section table ({} entries) runs past the end of the file", count));
+    return f;
   }
   std::uint32_t crc = Crc32c(bytes.data(), 28);
   crc = Crc32c(bytes.data() + kHeaderSize, table_end - kHeaderSize, crc);
-  if (crc != header_crc) {
-    return Status::BadInput("{}: header checksum mismatch (file is corrupt)", name);
-  }
+  if (crc != header_crc)
+    issue(IssueKind::kHeaderChecksum, "header checksum mismatch (file is corrupt)");
   ByteReader table(bytes.subspan(kHeaderSize, table_end - kHeaderSize), name);
   for (std::uint32_t i = 0; i < count; ++i) {
-    Tag tag{};
+    Section s;
     std::uint32_t reserved0 = 0, reserved1 = 0, section_crc = 0;
-    std::uint64_t offset = 0, size = 0;
-    SVOKIT_RETURN_IF_ERROR(table.Get(tag));
+    SVOKIT_RETURN_IF_ERROR(table.Get(s.tag));
     SVOKIT_RETURN_IF_ERROR(table.Get(reserved0));
-    SVOKIT_RETURN_IF_ERROR(table.Get(offset));
-    SVOKIT_RETURN_IF_ERROR(table.Get(size));
+    SVOKIT_RETURN_IF_ERROR(table.Get(s.offset));
+    SVOKIT_RETURN_IF_ERROR(table.Get(s.size));
     SVOKIT_RETURN_IF_ERROR(table.Get(section_crc));
     SVOKIT_RETURN_IF_ERROR(table.Get(reserved1));
-    if (offset < table_end || offset % kAlignment != 0 || offset > bytes.size() ||
-        size > bytes.size() - offset) {
-      return Status::BadInput("{}: section '{}' (offset {}, {} bytes) lies outside the file", name,
-                              TagString(tag), offset, size);
+    s.in_file = s.offset >= table_end && s.offset % kAlignment == 0 && s.offset <= bytes.size() &&
+                s.size <= bytes.size() - s.offset;
+    if (!s.in_file) {
+      issue(IssueKind::kSectionBounds,
+            fmt::format("section '{}' (offset {}, {} bytes) lies outside the file",
+                        TagString(s.tag), s.offset, s.size));
+    } else {
+      s.bytes = bytes.subspan(s.offset, s.size);
+      s.loaded = load == nullptr || load(s.tag, context);
+      if (s.loaded) {
+        s.crc_ok = Crc32c(s.bytes.data(), s.bytes.size()) == section_crc;
+        if (!s.crc_ok) {
+          issue(IssueKind::kSectionChecksum,
+                fmt::format("section '{}' checksum mismatch (file is corrupt)", TagString(s.tag)));
+        }
+      }
     }
-    if (load != nullptr && !load(tag, context)) continue;
-    const auto payload = bytes.subspan(offset, size);
-    if (Crc32c(payload.data(), payload.size()) != section_crc) {
-      return Status::BadInput("{}: section '{}' checksum mismatch (file is corrupt)", name,
-                              TagString(tag));
-    }
-    r.entries_.push_back({tag, payload});
+    f.sections_.push_back(s);
+  }
+  return f;
+}
+
+const Frame::Section* Frame::Find(Tag tag) const {
+  for (const Section& s : sections_) {
+    if (s.tag == tag && s.in_file) return &s;
+  }
+  return nullptr;
+}
+
+StatusOr<Reader> Reader::Open(const std::filesystem::path& path, const FormatId& format,
+                              SectionFilter load, const void* context) {
+  StatusOr<Frame> frame = Frame::Open(path, format, load, context);
+  if (!frame.ok()) return frame.status();
+  return FromFrame(std::move(*frame));
+}
+
+StatusOr<Reader> Reader::FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                                   const FormatId& format, SectionFilter load,
+                                   const void* context) {
+  StatusOr<Frame> frame = Frame::FromBytes(bytes, name, format, load, context);
+  if (!frame.ok()) return frame.status();
+  return FromFrame(std::move(*frame));
+}
+
+StatusOr<Reader> Reader::FromFrame(Frame frame) {
+  if (!frame.issues_.empty()) return Status(StatusCode::kBadInput, frame.issues_.front().message);
+  Reader r;
+  r.mapping_ = std::move(frame.mapping_);
+  r.name_ = std::move(frame.name_);
+  r.version_ = frame.version_;
+  r.flags_ = frame.flags_;
+  for (const Frame::Section& s : frame.sections_) {
+    if (s.loaded) r.entries_.push_back({s.tag, s.bytes});
   }
   return r;
 }

@@ -62,19 +62,74 @@ class Writer {
   std::vector<Section> sections_;
 };
 
+/// Sections for which the filter returns false are neither verified nor available.
+using SectionFilter = bool (*)(Tag tag, const void* context);
+
+/// A container's frame (header and section table) parsed without refusing anything but a foreign
+/// file: every problem Reader would refuse is listed, in the order Reader checks them, so a
+/// validator can report them all. Reader is this parse plus "fail on the first issue".
+class Frame {
+ public:
+  enum class IssueKind {
+    kFileSize,
+    kSectionTable,
+    kHeaderChecksum,
+    kSectionBounds,
+    kSectionChecksum
+  };
+  struct Issue {
+    IssueKind kind;
+    std::string message;  ///< one line, starting with the file name
+  };
+  struct Section {
+    Tag tag{};
+    std::uint64_t offset = 0, size = 0;
+    bool in_file = false;  ///< inside the file and aligned; `bytes` is empty otherwise
+    bool loaded = false;   ///< the section filter asked for it (its checksum was verified)
+    bool crc_ok = false;   ///< loaded and its checksum matches
+    std::span<const std::uint8_t> bytes;
+  };
+  /// Fails (BadInput) only when the file cannot be read, lacks the format's magic or has a newer
+  /// version: then it is not a file of this format at all.
+  static StatusOr<Frame> Open(const std::filesystem::path& path, const FormatId& format,
+                              SectionFilter load = nullptr, const void* context = nullptr);
+  static StatusOr<Frame> FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                                   const FormatId& format, SectionFilter load = nullptr,
+                                   const void* context = nullptr);
+
+  const std::string& name() const { return name_; }
+  std::uint32_t version() const { return version_; }
+  std::uint32_t flags() const { return flags_; }
+  const std::vector<Issue>& issues() const { return issues_; }
+  const std::vector<Section>& sections() const { return sections_; }
+  /// The first section with this tag that lies inside the file, whatever its checksum says.
+  const Section* Find(Tag tag) const;
+
+ private:
+  friend class Reader;
+  std::shared_ptr<const void> mapping_;  // keeps mapped bytes alive
+  std::string name_;
+  std::uint32_t version_ = 0;
+  std::uint32_t flags_ = 0;
+  std::vector<Issue> issues_;
+  std::vector<Section> sections_;
+};
+
 /// A verified, memory-mapped container file. Open() checks the magic, version, file size,
 /// header checksum, section bounds and every section checksum before returning.
 class Reader {
  public:
   /// Sections for which `load` returns false are neither verified nor available (a streaming
   /// reader touches only the pages it needs); by default every section is.
-  using SectionFilter = bool (*)(Tag tag, const void* context);
+  using SectionFilter = container::SectionFilter;
   static StatusOr<Reader> Open(const std::filesystem::path& path, const FormatId& format,
                                SectionFilter load = nullptr, const void* context = nullptr);
   /// Verifies in-memory bytes (they must outlive the Reader); `name` is used in messages.
   static StatusOr<Reader> FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
                                     const FormatId& format, SectionFilter load = nullptr,
                                     const void* context = nullptr);
+  /// The loaded sections of a frame without issues; otherwise its first issue, as BadInput.
+  static StatusOr<Reader> FromFrame(Frame frame);
 
   std::uint32_t version() const { return version_; }
   std::uint32_t flags() const { return flags_; }
@@ -85,12 +140,11 @@ class Reader {
   StatusOr<std::span<const std::uint8_t>> Require(Tag tag) const;
 
  private:
-  struct Mapping;
   struct Entry {
     Tag tag;
     std::span<const std::uint8_t> bytes;
   };
-  std::shared_ptr<Mapping> mapping_;
+  std::shared_ptr<const void> mapping_;
   std::string name_;
   std::uint32_t version_ = 0;
   std::uint32_t flags_ = 0;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -25,5 +26,25 @@ StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& 
                         std::optional<std::uint32_t> max_level = std::nullopt);
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path,
                       std::optional<std::uint32_t> max_level = std::nullopt);
+
+/// One violated invariant: `kind` is a stable key (svo-validate's README section lists them),
+/// `message` one line naming the file, the same text the strict readers fail with.
+struct SvoIssue {
+  std::string kind;
+  std::string message;
+};
+/// A file decoded as far as its structure allows, with every issue the strict readers would stop
+/// at (they fail on the first of these same checks).
+struct LenientSvo {
+  Svo svo;  ///< complete only when `complete`; otherwise the levels decoded before the damage
+  std::vector<SvoIssue> issues;                       ///< in check order, at most 100 per kind
+  std::map<std::string, std::uint64_t> issue_counts;  ///< per kind, all of them
+  /// Every level decoded and linked consistently (checksum issues do not stop this).
+  bool complete = false;
+};
+/// Fails (BadInput) only for input that is not an .svo at all: unreadable, foreign magic, or a
+/// newer version.
+StatusOr<LenientSvo> DecodeSvoLenient(std::span<const std::uint8_t> bytes, const std::string& name);
+StatusOr<LenientSvo> ReadSvoLenient(const std::filesystem::path& path);
 
 }  // namespace svokit
