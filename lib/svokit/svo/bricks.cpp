@@ -102,12 +102,12 @@ struct EncodedSample {
 };
 
 // A sample whose opacity rounds to 0 is empty: no colour, no normal.
-EncodedSample Encode(const Svo& svo, const PremultipliedSample& p) {
+EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {
   const std::uint8_t opacity = EncodeUnorm8(p.opacity);
   if (opacity == 0) return {0, 0, 0};
   const BrickSample s = Unpremultiply(p);
-  return {opacity, svo.has_color ? EncodeColor(s.color) : 0u,
-          svo.has_normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
+  return {opacity, color ? EncodeColor(s.color) : 0u,
+          normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
 }
 
 void Store(const EncodedSample& e, std::size_t at, SvoLevel& out) {
@@ -116,10 +116,14 @@ void Store(const EncodedSample& e, std::size_t at, SvoLevel& out) {
   if (!out.normal.empty()) out.normal[at] = e.normal;
 }
 
-// Voxel-level bricks of the children of `node` (level depth − 1), from the voxels' own attributes.
-// The samples of all children lie on one lattice of (2·side − 1)³ points: each point is computed
-// and encoded once, then copied into every child brick that holds it.
-void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint64_t node) {
+// Voxel-level bricks of the children of `node` (level depth − 1) into `out`, from the voxels' own
+// attributes (null `voxels`: the opacity alone, from the occupancy). The samples of all children
+// lie on one lattice of (2·side − 1)³ points: each point is computed and encoded once, then
+// copied into every child brick that holds it.
+void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std::uint64_t node,
+                 SvoLevel& out) {
+  const bool color = voxels != nullptr && svo.has_color,
+             normal = voxels != nullptr && svo.has_normal;
   const int side = static_cast<int>(svo.brick_side);
   const int points = 2 * side - 1;     // per axis, over the 2 children
   const int step = side == 3 ? 1 : 2;  // point spacing in half voxels
@@ -128,8 +132,8 @@ void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint
     if (block[c] < 0) continue;
     BrickSample b;
     b.opacity = 1;
-    if (svo.has_color) b.color = voxels.colors[static_cast<std::size_t>(block[c])];
-    if (svo.has_normal) b.normal = voxels.normals[static_cast<std::size_t>(block[c])];
+    if (color) b.color = voxels->colors[static_cast<std::size_t>(block[c])];
+    if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
     cells[c] = Premultiply(b);
   }
   std::array<EncodedSample, 125> encoded;
@@ -156,11 +160,11 @@ void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint
         const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
         PremultipliedSample mean;
         Accumulate(mean, sum, 1.f / static_cast<float>(count));
-        encoded[static_cast<std::size_t>(x + points * (y + points * z))] = Encode(svo, mean);
+        encoded[static_cast<std::size_t>(x + points * (y + points * z))] =
+            Encode(color, normal, mean);
       }
     }
   }
-  SvoLevel& out = svo.levels[svo.depth];
   const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
   const int span = side - 1;  // points per voxel edge
   for (unsigned ch = 0; ch < 8; ++ch) {
@@ -180,9 +184,10 @@ void VoxelBricks(const VoxelSet& voxels, Svo& svo, const Block& block, std::uint
   }
 }
 
-// The brick of `node` at `level` from the level + 1 bricks in `block`: the finer bricks are
-// decoded onto one lattice over the block, then filtered by the separable tent.
-void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_t node) {
+// The brick of `node` at `level` from the stored level + 1 bricks in `block`, into `out`: the finer
+// bricks are decoded onto one lattice over the block, then filtered by the separable tent.
+void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::uint64_t node,
+                 SvoLevel& out) {
   const int side = static_cast<int>(svo.brick_side);
   const int cell = side - 1;  // finer node edge in finer sample spacings
   // Parent sample k sits at lattice index cell + 2k over the block; its tent reads indices
@@ -249,7 +254,6 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
       }
     }
   }
-  SvoLevel& out = svo.levels[level];
   for (int k = 0; k < side; ++k) {
     for (int y = 0; y < side; ++y) {
       for (int x = 0; x < side; ++x) {
@@ -258,8 +262,8 @@ void ParentBrick(Svo& svo, std::uint32_t level, const Block& block, std::uint64_
           Accumulate(o, fy[static_cast<std::size_t>(x + side * (y + side * (2 * k + d)))],
                      kTent[d]);
         }
-        Store(Encode(svo, o), node * samples + static_cast<std::size_t>(x + side * (y + side * k)),
-              out);
+        Store(Encode(svo.has_color, svo.has_normal, o),
+              node * samples + static_cast<std::size_t>(x + side * (y + side * k)), out);
       }
     }
   }
@@ -291,33 +295,63 @@ BrickSample Unpremultiply(const PremultipliedSample& p) {
   return s;
 }
 
+namespace {
+
+// Calls body(block, i) for every node i of `level`, in fixed-size chunks over TBB: each node writes
+// its own samples only, so the result does not depend on the thread count.
+template <class Body>
+void EachNode(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+              std::uint32_t level, const Body& body) {
+  const KeyIndex index(level_keys[level]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[level].size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        body(GatherChildren(svo, level, index, i, level_keys[level][i]), i);
+                      }
+                    });
+}
+
+void AllocateBricks(const Svo& svo, bool attributes, SvoLevel& lv) {
+  const std::size_t n = lv.node_count * svo.brick_samples();
+  lv.opacity.assign(n, 0);
+  lv.color.assign(attributes && svo.has_color ? n : 0, 0);
+  lv.normal.assign(attributes && svo.has_normal ? n : 0, 0);
+}
+
+}  // namespace
+
 void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uint64_t>>& level_keys,
                   Svo& svo) {
-  const std::uint32_t samples = svo.brick_samples();
-  for (SvoLevel& lv : svo.levels) {
-    const std::size_t n = lv.node_count * samples;
-    lv.opacity.assign(n, 0);
-    lv.color.assign(svo.has_color ? n : 0, 0);
-    lv.normal.assign(svo.has_normal ? n : 0, 0);
-  }
-  if (samples == 0) return;
-  // Fixed-size chunks, each node's samples written at its own index: thread-count independent.
+  for (SvoLevel& lv : svo.levels) AllocateBricks(svo, true, lv);
+  if (svo.brick_samples() == 0) return;
   for (std::uint32_t level = svo.depth; level-- > 0;) {
-    const KeyIndex index(level_keys[level]);
-    const auto each_node = [&](const auto& body) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[level].size(), 256),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                            body(GatherChildren(svo, level, index, i, level_keys[level][i]), i);
-                          }
-                        });
-    };
     // Every voxel brick must exist before a parent reads its neighbours'.
     if (level + 1 == svo.depth) {
-      each_node([&](const Block& block, std::size_t i) { VoxelBricks(voxels, svo, block, i); });
+      EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
+        VoxelBricks(&voxels, svo, block, i, svo.levels[svo.depth]);
+      });
     }
-    each_node([&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i); });
+    EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
+      ParentBrick(svo, level, block, i, svo.levels[level]);
+    });
   }
+}
+
+SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                       std::uint32_t level) {
+  SvoLevel out;
+  out.node_count = svo.levels[level].node_count;
+  const bool voxel_level = level == svo.depth;
+  AllocateBricks(svo, !voxel_level, out);
+  if (svo.brick_samples() == 0) return out;
+  if (voxel_level) {
+    EachNode(svo, level_keys, level - 1,
+             [&](const Block& block, std::size_t i) { VoxelBricks(nullptr, svo, block, i, out); });
+  } else {
+    EachNode(svo, level_keys, level,
+             [&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i, out); });
+  }
+  return out;
 }
 
 }  // namespace svokit

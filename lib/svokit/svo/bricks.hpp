@@ -22,6 +22,13 @@ namespace svokit {
 void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uint64_t>>& level_keys,
                   Svo& svo);
 
+/// What FilterBricks stores at `level`, recomputed from `svo` itself by the same code: the
+/// reference a checker compares the stored bricks with. Below the voxel level, the tent over the
+/// stored level + 1 bricks (colour and normal included); at the voxel level, the opacity alone
+/// (the voxels' own colours and normals are not in the file). `level_keys` as for FilterBricks.
+SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                       std::uint32_t level);
+
 /// A sample as the filter sees it: opacity, colour·opacity and normal·opacity, all linear.
 struct PremultipliedSample {
   float opacity = 0;
