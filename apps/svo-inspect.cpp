@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
                                               input.string(), *level, svo->depth));
     }
 
-    nlohmann::json pictures = {{"render", nullptr}, {"slice", nullptr}};
+    nlohmann::ordered_json pictures = {{"render", nullptr}, {"slice", nullptr}};
     std::string picture_lines;
     if (!render_path.empty()) {
       RenderOptions options;
@@ -150,7 +150,8 @@ int main(int argc, char** argv) {
     report.levels = levels;
     report.histograms = histograms;
     if (json) {
-      nlohmann::json out = nlohmann::json::parse(FormatStatsJson(*svo, stats, report));
+      nlohmann::ordered_json out =
+          nlohmann::ordered_json::parse(FormatStatsJson(*svo, stats, report));
       out["render"] = pictures["render"];
       out["slice"] = pictures["slice"];
       fmt::print("{}\n", out.dump(2));

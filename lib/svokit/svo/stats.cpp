@@ -118,18 +118,20 @@ BrickStats ComputeBrickStats(const Svo& svo, SvoHistograms& histograms) {
   return b;
 }
 
-nlohmann::json Vec(const Vec3d& v) {
+// Keys in the order the README documents them (ordered_json keeps insertion order).
+using Json = nlohmann::ordered_json;
+
+Json Vec(const Vec3d& v) {
   return {v.x, v.y, v.z};
 }
 
-nlohmann::json Range(const ValueRange& r) {
+Json Range(const ValueRange& r) {
   return {{"min", r.min}, {"max", r.max}, {"mean", r.mean}};
 }
 
 template <std::size_t N>
-nlohmann::json Ranges(const std::array<ValueRange, N>& r) {
-  nlohmann::json min = nlohmann::json::array(), max = nlohmann::json::array(),
-                 mean = nlohmann::json::array();
+Json Ranges(const std::array<ValueRange, N>& r) {
+  Json min = Json::array(), max = Json::array(), mean = Json::array();
   for (const ValueRange& v : r) {
     min.push_back(v.min);
     max.push_back(v.max);
@@ -282,7 +284,7 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
     line("contours", fmt::format("{} ({:.1f} % of nodes)", st.contours, 100.0 * st.contour_share));
     if (!thick.empty()) line("mean thickness", thick + " (node sizes)");
   }
-  const nlohmann::json meta = nlohmann::json::parse(svo.metadata, nullptr, false);
+  const Json meta = Json::parse(svo.metadata, nullptr, false);
   if (meta.is_object()) {
     for (const auto& [key, value] : meta.items()) {
       line(key, value.is_string() ? value.get<std::string>() : value.dump());
@@ -339,7 +341,7 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
 
 std::string FormatStatsJson(const Svo& svo, const SvoStats& st,
                             const InspectReportOptions& options) {
-  using nlohmann::json;
+  using json = Json;
   const auto& dims = svo.grid.dims();
   const Box3d bounds = svo.grid.GridBounds(), root = RootBounds(svo);
   json j;
