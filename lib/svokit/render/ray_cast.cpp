@@ -413,6 +413,9 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
     near = std::min(near, t);
     far = std::max(far, t);
   }
+  // A key light from the viewer's upper left: faces turned away darken, and the three faces of a
+  // cube seen from iso differ (a pure headlight would shade them alike).
+  const Vec3d light_dir = Normalized(cam.forward * -1.0 + cam.up * 0.6 - cam.right * 0.4);
   std::vector<std::uint64_t> row_hits(static_cast<std::size_t>(options.height)),
       row_visits(static_cast<std::size_t>(options.height));
   tbb::parallel_for(0, options.height, [&](int y) {
@@ -427,8 +430,7 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
       px[3] = 255;
       switch (options.shade) {
         case Shade::kColor: {
-          // A headlight: faces turned away from the viewer darken, so the shape reads.
-          const double light = 0.2 + 0.8 * std::max(0.0, -Dot(hit.normal, cam.forward));
+          const double light = 0.2 + 0.8 * std::max(0.0, Dot(hit.normal, light_dir));
           px[0] = Byte(LinearToSrgb(static_cast<float>(hit.color.r * light)));
           px[1] = Byte(LinearToSrgb(static_cast<float>(hit.color.g * light)));
           px[2] = Byte(LinearToSrgb(static_cast<float>(hit.color.b * light)));

@@ -20,7 +20,7 @@ namespace svokit {
 
 enum class View { kFront, kBack, kLeft, kRight, kTop, kBottom, kIso };
 enum class Shade {
-  kColor,   ///< brick colour (trilinear at the hit) under a headlight
+  kColor,   ///< brick colour (trilinear at the hit), lit from the viewer's upper left
   kNormal,  ///< shading normal as RGB = (n + 1)/2
   kDepth,   ///< grey, near bright, over the grid's depth range along the view
 };
