@@ -32,6 +32,9 @@ class TriangleVoxelizer {
   std::int64_t u_hi() const { return hi_[u_]; }
   std::int64_t v_lo() const { return lo_[v_]; }
   std::int64_t v_hi() const { return hi_[v_]; }
+  /// The candidate voxel range along `axis` (x = 0, y = 1, z = 2): [lo, hi).
+  std::int64_t lo(int axis) const { return lo_[axis]; }
+  std::int64_t hi(int axis) const { return hi_[axis]; }
   bool empty() const { return empty_; }
   /// Projected area in voxel² along the dominant axis (the hybrid method's classifier).
   double projected_area() const { return projected_area_; }

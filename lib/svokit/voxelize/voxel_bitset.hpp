@@ -70,25 +70,11 @@ class VoxelBitSet {
   std::uint64_t brick_key(std::size_t i) const { return keys_[i]; }
   const Brick& brick(std::size_t i) const { return bricks_[i]; }
 
-  /// The union of `sets` as sorted unique Morton keys (thread-count independent).
-  /// Where each voxel of a union sits in its sorted key array: bricks with the index of their
-  /// first voxel, so Rank() is a hash lookup plus popcounts.
+  /// Where each brick of a union sits in its sorted key array: its voxels are keys
+  /// [first[slot], first[slot + 1]).
   struct Ranks {
     std::unordered_map<std::uint64_t, std::uint32_t> brick_slot;
-    std::vector<std::uint64_t> first;  // per slot: index of the brick's first voxel
-    std::vector<Brick> bits;           // per slot: the brick's voxels
-    /// Index of `key` in the union's key array; the key must be in the union.
-    std::uint64_t Rank(std::uint64_t key) const {
-      const std::uint32_t slot = brick_slot.at(key >> kBrickBits);
-      const std::uint32_t local = static_cast<std::uint32_t>(key) & ((1u << kBrickBits) - 1);
-      const Brick& b = bits[slot];
-      std::uint64_t rank = first[slot];
-      for (std::uint32_t w = 0; w < (local >> 6); ++w) {
-        rank += static_cast<std::uint64_t>(std::popcount(b[w]));
-      }
-      const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
-      return rank + static_cast<std::uint64_t>(std::popcount(b[local >> 6] & below));
-    }
+    std::vector<std::uint64_t> first;  // per slot, and one past the last
   };
 
   /// The union of `sets` as sorted unique Morton keys (thread-count independent); fills `ranks`
@@ -152,9 +138,8 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks
   const std::size_t bricks = starts.size();
   starts.push_back(refs.size());
 
-  // OR each group, count its voxels, then write every brick's keys at its prefix-sum offset.
-  // The merged bricks are kept only for `ranks`; otherwise the second pass ORs again, which is
-  // cheaper than allocating and zeroing a copy of every brick.
+  // OR each group and count its voxels, then OR again to write every brick's keys at its
+  // prefix-sum offset (cheaper than keeping a merged copy of every brick).
   auto merge = [&](std::size_t b) {
     Brick m = *refs[starts[b]].bits;
     for (std::size_t r = starts[b] + 1; r < starts[b + 1]; ++r) {
@@ -162,19 +147,17 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks
     }
     return m;
   };
-  std::vector<Brick> merged(ranks ? bricks : 0);
   std::vector<std::uint64_t> offset(bricks + 1, 0);
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
     const Brick m = merge(b);
     std::uint64_t count = 0;
     for (std::uint64_t word : m) count += static_cast<std::uint64_t>(std::popcount(word));
     offset[b + 1] = count;
-    if (ranks) merged[b] = m;
   });
   for (std::size_t b = 0; b < bricks; ++b) offset[b + 1] += offset[b];
   std::vector<std::uint64_t> keys(offset[bricks]);
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    const Brick m = ranks ? merged[b] : merge(b);
+    const Brick m = merge(b);
     std::uint64_t* out = keys.data() + offset[b];
     const std::uint64_t base = refs[starts[b]].key << kBrickBits;
     for (std::size_t w = 0; w < m.size(); ++w) {
@@ -184,12 +167,11 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks
     }
   });
   if (ranks) {
-    ranks->first.assign(offset.begin(), offset.end() - 1);
     ranks->brick_slot.reserve(bricks);
     for (std::size_t b = 0; b < bricks; ++b) {
       ranks->brick_slot.emplace(refs[starts[b]].key, static_cast<std::uint32_t>(b));
     }
-    ranks->bits = std::move(merged);
+    ranks->first = std::move(offset);
   }
   return keys;
 }

@@ -5,6 +5,8 @@
 #include <memory>
 #include <optional>
 
+#include <malloc.h>
+
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
 
@@ -74,15 +76,38 @@ struct BrickTriangle {
   bool operator==(const BrickTriangle&) const = default;
 };
 
-// Records the bricks one triangle's voxel runs fall in (consecutive runs mostly share a brick).
+// Records the bricks one triangle's voxels fall in. A triangle whose candidate box spans at most
+// two bricks is binned by that box (walking a brick it misses later costs less than recording its
+// runs now); larger ones record the brick of every run (consecutive runs mostly share one).
 class BrickRecorder {
  public:
+  static constexpr std::int64_t kMaxBoxBricks = 2;
+
+  /// Bins `triangle` by its candidate box when that is small enough; false: record its runs.
+  bool BinByBox(const TriangleVoxelizer& tv, std::uint32_t triangle,
+                std::vector<BrickTriangle>& out) {
+    std::int64_t lo[3], hi[3], bricks = 1;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = tv.lo(a) >> 4;
+      hi[a] = (tv.hi(a) - 1) >> 4;
+      bricks *= hi[a] - lo[a] + 1;
+    }
+    if (bricks > kMaxBoxBricks) return false;
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+        for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+          out.push_back({MortonEncode(Coord(x), Coord(y), Coord(z)), triangle});
+        }
+      }
+    }
+    return true;
+  }
   void Run(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis, std::uint32_t n) {
     VoxelBitSet::ForEachBrickOfRun(
         x, y, z, axis, n,
         [&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint32_t, std::uint32_t) {
-          const std::uint64_t brick = MortonEncode(bx, by, bz);
-          if (bricks_.empty() || bricks_.back() != brick) bricks_.push_back(brick);
+          const std::uint64_t packed = bx | std::uint64_t{by} << 21 | std::uint64_t{bz} << 42;
+          if (packed != last_) bricks_.push_back(MortonEncode(bx, by, bz)), last_ = packed;
         });
   }
   void EndTriangle(std::uint32_t triangle, std::vector<BrickTriangle>& out) {
@@ -90,10 +115,13 @@ class BrickRecorder {
     bricks_.erase(std::unique(bricks_.begin(), bricks_.end()), bricks_.end());
     for (std::uint64_t b : bricks_) out.push_back({b, triangle});
     bricks_.clear();
+    last_ = kNone;
   }
 
  private:
+  static constexpr std::uint64_t kNone = ~std::uint64_t{0};
   std::vector<std::uint64_t> bricks_;
+  std::uint64_t last_ = kNone;
 };
 
 // Area-weighted sums for the voxels of one brick, indexed by local Morton code.
@@ -112,26 +140,24 @@ class BrickAccumulator {
     sum.r += s.color.r * w, sum.g += s.color.g * w, sum.b += s.color.b * w, sum.a += s.color.a * w;
     sum.nx += s.normal.x * w, sum.ny += s.normal.y * w, sum.nz += s.normal.z * w;
   }
-  // Writes the brick's voxels (in key order, from `first` on) and clears the sums.
-  void Finish(const VoxelBitSet::Brick& bits, std::uint64_t first, VoxelSet& set) {
-    std::uint64_t index = first;
-    for (std::size_t w = 0; w < bits.size(); ++w) {
-      for (std::uint64_t word = bits[w]; word != 0; word &= word - 1, ++index) {
-        Sum& sum = sums_[w * 64 + static_cast<std::size_t>(std::countr_zero(word))];
-        const double inv = sum.weight > 0 ? 1.0 / sum.weight : 0.0;
-        set.coverage[index] = static_cast<float>(sum.area);
-        if (set.has_colors()) {
-          set.colors[index] = {static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
-                               static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)};
-        }
-        if (set.has_normals()) {
-          const Vec3f n{static_cast<float>(sum.nx), static_cast<float>(sum.ny),
-                        static_cast<float>(sum.nz)};
-          const float len = Length(n);
-          set.normals[index] = len > 0 ? n / len : Vec3f{};
-        }
-        sum = {};
+  // Writes the brick's voxels, keys [first, last) of `set`, and clears their sums.
+  void Finish(std::uint64_t first, std::uint64_t last, VoxelSet& set) {
+    constexpr std::uint64_t kLocalMask = kVoxels - 1;
+    for (std::uint64_t index = first; index < last; ++index) {
+      Sum& sum = sums_[set.keys[index] & kLocalMask];
+      const double inv = sum.weight > 0 ? 1.0 / sum.weight : 0.0;
+      set.coverage[index] = static_cast<float>(sum.area);
+      if (set.has_colors()) {
+        set.colors[index] = {static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
+                             static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)};
       }
+      if (set.has_normals()) {
+        const Vec3f n{static_cast<float>(sum.nx), static_cast<float>(sum.ny),
+                      static_cast<float>(sum.nz)};
+        const float len = Length(n);
+        set.normals[index] = len > 0 ? n / len : Vec3f{};
+      }
+      sum = {};
     }
   }
 
@@ -209,11 +235,18 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
       return;
     }
     BrickRecorder& recorder = recorders.local();
+    const auto triangle = static_cast<std::uint32_t>(t);
+    if (recorder.BinByBox(tv, triangle, bins.local())) {
+      tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
+        keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
+      });
+      return;
+    }
     tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
       keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
       recorder.Run(Coord(x), Coord(y), Coord(z), axis, Coord(k));
     });
-    recorder.EndTriangle(static_cast<std::uint32_t>(t), bins.local());
+    recorder.EndTriangle(triangle, bins.local());
   };
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task, in Morton order
@@ -278,12 +311,15 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   VoxelBitSet::Ranks ranks;
   set.keys = VoxelBitSet::UnionKeys(parts, attributes ? &ranks : nullptr);
   parts.clear();
+  // The per-thread bricks were many small blocks: hand their pages back before the attribute
+  // arrays are allocated, or they would stay in the peak (~4 B/voxel).
+  malloc_trim(0);
   stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
   stage.reset();
   if (attributes) {
     // Brick by brick: every triangle of the brick's bin, in index order, walks the brick's
     // columns and adds its samples; each voxel's sums thus have one fixed order.
-    Progress::Stage attr_stage(progress, "attributes", ranks.first.size());
+    Progress::Stage attr_stage(progress, "attributes", ranks.brick_slot.size());
     std::vector<BrickTriangle> pairs;
     for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
     bins.clear();
@@ -304,8 +340,13 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         [] { return std::make_unique<BrickAccumulator>(); });
     ParallelChunks(starts.size() - 1, 16, [&](std::size_t begin, std::size_t end) {
       BrickAccumulator& acc = *accumulators.local();
+      AttributeSample samples[16];  // one run's samples (built once: a run is often one voxel)
+      std::size_t finished = 0;
       for (std::size_t g = begin; g < end; ++g) {
         const std::uint64_t brick = pairs[starts[g]].brick;
+        // A brick binned by a triangle's box may hold no voxel at all.
+        const auto slot = ranks.brick_slot.find(brick);
+        if (slot == ranks.brick_slot.end()) continue;
         const MortonCoord bc = MortonDecode(brick);
         const std::int64_t lo[3] = {std::int64_t{bc.x} << 4, std::int64_t{bc.y} << 4,
                                     std::int64_t{bc.z} << 4};
@@ -323,7 +364,6 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                     if (first >= last) return;
                     c[w] = first;
                     const int count = static_cast<int>(last - first);
-                    AttributeSample samples[16];
                     sampler.SampleRun(prepared, c[0], c[1], c[2], w, count, samples);
                     std::uint32_t local =
                         VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
@@ -332,10 +372,10 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                     }
                   });
         }
-        const std::uint32_t slot = ranks.brick_slot.at(brick);
-        acc.Finish(ranks.bits[slot], ranks.first[slot], set);
+        acc.Finish(ranks.first[slot->second], ranks.first[slot->second + 1], set);
+        ++finished;
       }
-      attr_stage.Advance(end - begin);
+      attr_stage.Advance(finished);
     });
   }
   return set;
