@@ -7,41 +7,10 @@
 #include <tbb/parallel_for.h>
 
 #include "svokit/core/morton.hpp"
+#include "svokit/svo/key_index.hpp"
 
 namespace svokit {
 namespace {
-
-// Sorted keys → index, by open addressing (the neighbour lookups of one level).
-class KeyIndex {
- public:
-  explicit KeyIndex(const std::vector<std::uint64_t>& keys) : keys_(keys) {
-    std::size_t capacity = 16;
-    while (capacity < keys.size() * 2) capacity *= 2;
-    mask_ = capacity - 1;
-    slots_.assign(capacity, kEmpty);
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      std::size_t s = Hash(keys[i]) & mask_;
-      while (slots_[s] != kEmpty) s = (s + 1) & mask_;
-      slots_[s] = static_cast<std::uint32_t>(i);
-    }
-  }
-  /// Index of `key`, or −1.
-  std::int64_t Find(std::uint64_t key) const {
-    for (std::size_t s = Hash(key) & mask_;; s = (s + 1) & mask_) {
-      if (slots_[s] == kEmpty) return -1;
-      if (keys_[slots_[s]] == key) return slots_[s];
-    }
-  }
-
- private:
-  static constexpr std::uint32_t kEmpty = ~std::uint32_t{0};
-  static std::size_t Hash(std::uint64_t k) {
-    return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> 20);
-  }
-  const std::vector<std::uint64_t>& keys_;
-  std::vector<std::uint32_t> slots_;
-  std::size_t mask_ = 0;
-};
 
 // The children of a level-L node and of its 26 neighbours: a 6³ block of level L+1 nodes, block
 // coordinate b = 2·(neighbour offset) + child bit + 2, so the node's own children sit at 2..3 per

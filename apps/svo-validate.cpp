@@ -1,0 +1,58 @@
+// svo-validate: checks an .svo file — structure, bricks, contours and, given the mesh it was built
+// from, occupancy against an OpenVDB distance field and contours against the surface. Exit 0 when
+// everything holds, 1 with the findings, 2 for unusable input.
+
+#include <filesystem>
+
+#include "apps/app.hpp"
+#include "formats/svo/svo_file.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/validate/validate.hpp"
+
+int main(int argc, char** argv) {
+  using namespace svokit;
+  const std::string tool = "svo-validate";
+  CLI::App cli{
+      "Validates a sparse voxel octree: checksums, header, masks and indices, bricks (ranges, "
+      "shared borders, the filter), contours, and with --mesh the voxels against an OpenVDB "
+      "distance field of the surface and the contour slabs against sampled surface points.",
+      tool};
+  std::filesystem::path input, mesh_path;
+  bool json = false;
+  app::CommonOptions common;
+  cli.add_option("input", input, "Octree (.svo)")->required();
+  cli.add_option("--mesh", mesh_path,
+                 "The mesh the octree was built from (.svm or any mesh file): enables the "
+                 "occupancy and contour-surface checks");
+  cli.add_flag("--json", json, "Print the report as one JSON object");
+  app::AddCommonOptions(cli, common);
+
+  return app::Run(tool, cli, argc, argv, [&] {
+    ThreadLimit threads(common.threads);
+    Progress progress = common.MakeProgress();
+    StatusOr<LenientSvo> file = [&] {
+      Progress::Stage stage(progress, "read", 1);
+      StatusOr<LenientSvo> f = ReadSvoLenient(input);
+      if (!f.ok()) stage.Cancel();
+      return f;
+    }();
+    if (!file.ok()) return app::Fail(tool, file.status());
+    std::optional<Mesh> mesh;
+    if (!mesh_path.empty()) {
+      StatusOr<Mesh> m = app::ImportStage(progress, mesh_path);
+      if (!m.ok()) return app::Fail(tool, m.status());
+      // The same rule as svo-build: the voxelized mesh lies inside the grid.
+      if (file->complete && !file->svo.grid.GridBounds().Contains(m->Bounds())) {
+        return app::Fail(tool, Status::BadInput("{}: the mesh lies outside {}'s grid: not the "
+                                                "mesh the octree was built from",
+                                                mesh_path.string(), input.string()));
+      }
+      mesh = std::move(*m);
+    }
+    validate::ValidateOptions options;
+    options.mesh = mesh ? &*mesh : nullptr;
+    const validate::Report report = validate::Validate(*file, input.string(), options, progress);
+    fmt::print("{}", json ? report.Json() : report.Text());
+    return report.ok() ? 0 : static_cast<int>(StatusCode::kCheckFailed);
+  });
+}

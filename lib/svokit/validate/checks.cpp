@@ -1,0 +1,292 @@
+#include "svokit/validate/checks.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "svokit/core/morton.hpp"
+#include "svokit/svo/bricks.hpp"
+#include "svokit/svo/key_index.hpp"
+#include "svokit/validate/contour_surface.hpp"
+
+namespace svokit::validate {
+namespace {
+
+std::array<std::int64_t, 3> Coord(std::uint64_t key) {
+  const MortonCoord c = MortonDecode(key);
+  return {c.x, c.y, c.z};
+}
+
+// Findings gathered per node range, merged in node order: the examples are the first in
+// (level, node) order whatever the thread count.
+struct OrderedFindings {
+  struct Part {
+    std::map<std::string, std::uint64_t> counts;
+    std::vector<Finding> examples;
+  };
+  OrderedFindings(std::size_t nodes, std::size_t chunk_size)
+      : chunk(chunk_size), parts((nodes + chunk_size - 1) / chunk_size) {}
+  std::size_t chunks() const { return parts.size(); }
+  void Add(std::size_t part, Finding f, std::size_t keep) {
+    Part& p = parts[part];
+    if (p.counts[f.kind]++ < keep) p.examples.push_back(std::move(f));
+  }
+  void MergeInto(CheckResult& out) {
+    for (Part& p : parts) {
+      std::map<std::string, std::uint64_t> shown;
+      for (Finding& e : p.examples) {
+        ++shown[e.kind];
+        out.Add(std::move(e));
+      }
+      for (const auto& [kind, n] : p.counts) out.AddCount(kind, n - shown[kind]);
+    }
+  }
+  std::size_t chunk;
+  std::vector<Part> parts;
+};
+
+// Runs body(part, first, last) over node ranges in parallel.
+template <class Body>
+void ForChunks(const OrderedFindings& f, std::size_t nodes, const Body& body) {
+  tbb::parallel_for(std::size_t{0}, f.chunks(), [&](std::size_t part) {
+    body(part, part * f.chunk, std::min(nodes, (part + 1) * f.chunk));
+  });
+}
+
+}  // namespace
+
+CheckResult CheckStructure(const LenientSvo& file) {
+  CheckResult r("structure");
+  for (const SvoIssue& issue : file.issues) r.Add({issue.kind, issue.message, {}, {}, {}});
+  std::map<std::string, std::uint64_t> shown;
+  for (const SvoIssue& issue : file.issues) ++shown[issue.kind];
+  for (const auto& [kind, n] : file.issue_counts) r.AddCount(kind, n - shown[kind]);
+  if (file.complete) {
+    std::uint64_t nodes = 0;
+    for (const SvoLevel& lv : file.svo.levels) nodes += lv.node_count;
+    r.Stat("levels", file.svo.levels.size());
+    r.Stat("nodes", nodes);
+  } else {
+    r.note = "the octree could not be walked: later checks skipped";
+  }
+  return r;
+}
+
+CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys) {
+  CheckResult r("bricks");
+  if (svo.brick_side == 0) {
+    r.Skip("no bricks");
+    return r;
+  }
+  const int side = static_cast<int>(svo.brick_side);
+  const std::uint32_t samples = svo.brick_samples();
+  std::uint64_t compared = 0, shared = 0;
+  // Finest level first: a damaged sample is reported before the coarser samples that read it.
+  for (std::uint32_t level = svo.depth + 1; level-- > 0;) {
+    const SvoLevel& lv = svo.levels[level];
+    const std::vector<std::uint64_t>& keys = level_keys[level];
+    const SvoLevel ref = RefilterLevel(svo, level_keys, level);
+    const KeyIndex index(keys);
+    OrderedFindings found(keys.size(), 1024);
+    std::vector<std::uint64_t> shared_parts(found.chunks(), 0);
+    const std::size_t keep = r.max_examples;
+    ForChunks(found, keys.size(), [&](std::size_t part, std::size_t first, std::size_t last) {
+      const auto add = [&](const char* kind, std::size_t node, std::string what) {
+        found.Add(part,
+                  {kind,
+                   fmt::format("level {} node {} {}: {}", level, node,
+                               fmt::join(Coord(keys[node]), ","), what),
+                   Coord(keys[node]),
+                   level,
+                   {}},
+                  keep);
+      };
+      for (std::size_t node = first; node < last; ++node) {
+        const std::size_t base = node * samples;
+        // Codes in range, and the filter's value within one step per channel.
+        for (std::uint32_t s = 0; s < samples; ++s) {
+          const std::size_t i = base + s;
+          const std::uint8_t op = lv.opacity[i];
+          const std::uint32_t color = svo.has_color ? lv.color[i] : 0;
+          const std::uint16_t normal = svo.has_normal ? lv.normal[i] : 0;
+          if (normal != 0 && ((normal & 0xffu) == 0 || (normal >> 8) == 0)) {
+            add("brick_range", node,
+                fmt::format("sample {}: normal code {:#06x} has a zero axis", s, normal));
+          }
+          if (op == 0 && (color != 0 || normal != 0)) {
+            add("brick_range", node,
+                fmt::format("sample {}: empty but carries a colour or normal", s));
+          }
+          const auto off = [](unsigned a, unsigned b) { return a > b ? a - b : b - a; };
+          if (off(op, ref.opacity[i]) > 1) {
+            add("brick_filter", node,
+                fmt::format("sample {}: opacity {} where the filter gives {}", s, op,
+                            ref.opacity[i]));
+            continue;
+          }
+          if (op == 0 || ref.opacity[i] == 0 || level == svo.depth) continue;
+          for (unsigned b = 0; b < 4; ++b) {
+            if (svo.has_color &&
+                off((color >> (8 * b)) & 0xffu, (ref.color[i] >> (8 * b)) & 0xffu) > 1) {
+              add("brick_filter", node,
+                  fmt::format("sample {}: colour {:#010x} where the filter gives {:#010x}", s,
+                              color, ref.color[i]));
+              break;
+            }
+          }
+          if (svo.has_normal && (off(normal & 0xffu, ref.normal[i] & 0xffu) > 1 ||
+                                 off(normal >> 8, ref.normal[i] >> 8) > 1)) {
+            add("brick_filter", node,
+                fmt::format("sample {}: normal {:#06x} where the filter gives {:#06x}", s, normal,
+                            ref.normal[i]));
+          }
+        }
+        // Samples shared with the 13 neighbours ahead in (z, y, x) order, byte for byte.
+        const MortonCoord c = MortonDecode(keys[node]);
+        const std::int64_t limit = std::int64_t{1} << level;
+        for (int dz = 0; dz <= 1; ++dz) {
+          for (int dy = dz ? -1 : 0; dy <= 1; ++dy) {
+            for (int dx = (dz || dy) ? -1 : 1; dx <= 1; ++dx) {
+              const std::int64_t x = c.x + dx, y = c.y + dy, z = c.z + dz;
+              if (x < 0 || y < 0 || x >= limit || y >= limit || z >= limit) continue;
+              const std::int64_t other = index.Find(MortonEncode(static_cast<std::uint32_t>(x),
+                                                                 static_cast<std::uint32_t>(y),
+                                                                 static_cast<std::uint32_t>(z)));
+              if (other < 0) continue;
+              const int d[3] = {dx, dy, dz};
+              int lo[3], hi[3];  // this brick's samples on the shared part, per axis
+              for (int a = 0; a < 3; ++a) {
+                lo[a] = d[a] > 0 ? side - 1 : 0;
+                hi[a] = d[a] < 0 ? 0 : side - 1;
+              }
+              for (int sz = lo[2]; sz <= hi[2]; ++sz) {
+                for (int sy = lo[1]; sy <= hi[1]; ++sy) {
+                  for (int sx = lo[0]; sx <= hi[0]; ++sx) {
+                    const int ox = sx - dx * (side - 1), oy = sy - dy * (side - 1),
+                              oz = sz - dz * (side - 1);
+                    const std::size_t i =
+                        base + static_cast<std::size_t>(sx + side * (sy + side * sz));
+                    const std::size_t j = static_cast<std::size_t>(other) * samples +
+                                          static_cast<std::size_t>(ox + side * (oy + side * oz));
+                    ++shared_parts[part];
+                    if (lv.opacity[i] != lv.opacity[j] ||
+                        (svo.has_color && lv.color[i] != lv.color[j]) ||
+                        (svo.has_normal && lv.normal[i] != lv.normal[j])) {
+                      add("brick_border", node,
+                          fmt::format("sample ({},{},{}) differs from neighbour {} sample "
+                                      "({},{},{})",
+                                      sx, sy, sz, fmt::join(Coord(keys[other]), ","), ox, oy, oz));
+                    }
+                  }
+                }
+              }
+            }
+          }
+        }
+      }
+    });
+    found.MergeInto(r);
+    compared += keys.size() * samples;
+    for (std::uint64_t n : shared_parts) shared += n;
+  }
+  r.Stat("samples", compared);
+  r.Stat("shared_samples", shared);
+  return r;
+}
+
+std::vector<std::vector<std::uint32_t>> NodeContours(const Svo& svo) {
+  std::vector<std::vector<std::uint32_t>> words(svo.levels.size());
+  for (std::uint32_t l = 0; l < svo.levels.size(); ++l) {
+    words[l].assign(svo.levels[l].node_count, 0);
+  }
+  if (!svo.levels.empty() && !svo.levels[0].contours.empty()) {
+    words[0][0] = svo.levels[0].contours[0];
+  }
+  for (std::uint32_t l = 0; l + 1 < svo.levels.size(); ++l) {
+    const std::vector<SvoNode>& nodes = svo.levels[l].nodes;
+    const std::vector<std::uint32_t>& next = svo.levels[l + 1].contours;
+    for (const SvoNode& n : nodes) {
+      for (unsigned c = 0; c < 8; ++c) {
+        if (n.contour_mask & (1u << c)) words[l + 1][n.Child(c)] = next[n.ChildContour(c)];
+      }
+    }
+  }
+  return words;
+}
+
+CheckResult CheckContourRanges(const Svo& svo) {
+  CheckResult r("contours");
+  if (!svo.has_contours) {
+    r.Skip("no contours");
+    return r;
+  }
+  const auto words = NodeContours(svo);
+  std::uint64_t checked = 0;
+  for (std::uint32_t l = 0; l < words.size(); ++l) {
+    std::vector<std::uint64_t> keys;
+    for (std::size_t i = 0; i < words[l].size(); ++i) {
+      if (words[l][i] == 0) continue;
+      ++checked;
+      const Contour c = DecodeContour(words[l][i]);
+      // The cube u ∈ [−½, ½]³ spans n·u ∈ [−L1/2, L1/2]; the slab must meet it.
+      const double half = 0.5 * (std::abs(c.nx) + std::abs(c.ny) + std::abs(c.nz));
+      if (c.Low() > half || c.High() < -half) {
+        if (keys.empty()) keys = svo.LevelKeys(l);
+        r.Add({"contour_range",
+               fmt::format("level {} node {} {}: slab [{}, {}] misses the cube's [{}, {}] along "
+                           "n = ({}, {}, {})",
+                           l, i, fmt::join(Coord(keys[i]), ","), c.Low(), c.High(), -half, half,
+                           c.nx, c.ny, c.nz),
+               Coord(keys[i]),
+               l,
+               {}});
+      }
+    }
+  }
+  r.Stat("contours", checked);
+  return r;
+}
+
+CheckResult CheckContourSurface(const Svo& svo,
+                                const std::vector<std::vector<std::uint64_t>>& level_keys,
+                                const Mesh& mesh) {
+  CheckResult r("contour_surface");
+  if (!svo.has_contours) {
+    r.Skip("no contours");
+    return r;
+  }
+  SlabSampleOptions options;
+  options.max_violations = r.max_examples;
+  const SlabSampleResult s =
+      SampleContourSlabs(mesh, svo.grid, svo.depth, level_keys, NodeContours(svo), options);
+  for (const SlabViolation& v : s.first) {
+    r.Add({"point_outside_slab",
+           fmt::format("surface point ({:.9g}, {:.9g}, {:.9g}) outside the slab of level {} "
+                       "node {},{},{}: n·u = {:.6g} not in [{}, {}]",
+                       v.point.x, v.point.y, v.point.z, v.level, v.node.x, v.node.y, v.node.z,
+                       v.value, v.low, v.high),
+           std::array<std::int64_t, 3>{v.node.x, v.node.y, v.node.z},
+           v.level,
+           {}});
+  }
+  r.AddCount("point_outside_slab", s.violations - s.first.size());
+  // Only a conservative voxelization covers the whole surface; a thin one leaves points out.
+  if (s.orphans && svo.mode == VoxelMode::kConservative) {
+    r.Add({"point_outside_octree",
+           fmt::format("{} (point, level) pairs where no node holds a surface point", s.orphans),
+           {},
+           {},
+           {}});
+    r.AddCount("point_outside_octree", s.orphans - 1);
+  }
+  r.Stat("points", s.points);
+  r.Stat("point_slab_checks", s.checks);
+  return r;
+}
+
+}  // namespace svokit::validate

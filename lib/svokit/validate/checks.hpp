@@ -1,0 +1,49 @@
+#pragma once
+// The checks svo-validate runs on a decoded file, one CheckResult each (report.hpp). Finding
+// kinds are stable keys, listed in the README's svo-validate section.
+
+#include <cstdint>
+#include <vector>
+
+#include "formats/svo/svo_file.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/svo.hpp"
+#include "svokit/validate/report.hpp"
+
+namespace svokit::validate {
+
+/// Container and octree invariants: every issue of the lenient decode (checksums, header and
+/// section table, counts, section sizes, masks and indices, nodes inside the grid).
+CheckResult CheckStructure(const LenientSvo& file);
+
+/// Bricks of a consistent octree: codes in range (no half-zero normal, no colour or normal on an
+/// empty sample), samples shared by neighbouring bricks byte-identical, and every level equal to
+/// RefilterLevel (the builder's filter over the stored finer level; the voxel level's opacity from
+/// the occupancy) within one quantization step per channel. `level_keys` from LevelKeysFromVoxels.
+CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys);
+
+/// Contour words of a consistent octree: the decoded slab meets its node's cube.
+CheckResult CheckContourRanges(const Svo& svo);
+
+/// Contours against the mesh: sampled surface points inside the slabs of the nodes holding them
+/// (contour_surface.hpp), and no surface point outside every node of a level.
+CheckResult CheckContourSurface(const Svo& svo,
+                                const std::vector<std::vector<std::uint64_t>>& level_keys,
+                                const Mesh& mesh);
+
+/// Per level and node, the node's contour word (0 = none), from the parents' contour masks.
+std::vector<std::vector<std::uint32_t>> NodeContours(const Svo& svo);
+
+/// Occupancy against an OpenVDB unsigned distance field of `mesh` in the file's index space
+/// (occupancy_vdb.cpp, the only translation unit that includes OpenVDB):
+///  - conservative files: every voxel whose centre lies within h/2 of the surface is a leaf
+///    ("missing_voxel"), every leaf's centre lies within (√3/2)·h ("extra_voxel");
+///  - thin files: thin ⊆ conservative, so the same bound for extra voxels; a voxel whose centre
+///    lies within h/(2√3) of the surface must be a leaf (the plane test then holds along any
+///    dominant axis and the projections meet every inner diamond).
+/// Distances are compared with a tolerance of kDistanceTolerance voxels.
+CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& leaf_keys,
+                           const Mesh& mesh);
+inline constexpr double kDistanceTolerance = 1e-4;
+
+}  // namespace svokit::validate

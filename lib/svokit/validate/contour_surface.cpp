@@ -1,0 +1,133 @@
+#include "svokit/validate/contour_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include <tbb/parallel_for.h>
+
+#include "svokit/svo/key_index.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit::validate {
+namespace {
+
+struct Partial {
+  std::uint64_t points = 0, checks = 0, violations = 0, orphans = 0;
+  std::vector<SlabViolation> first;
+};
+
+// Per axis, the node coordinates at a level whose closed extent [c·s, (c + 1)·s] holds v (one,
+// or two on a boundary), with a relative slack of 1e-9 node sizes for rounding in the mapping.
+int Candidates(double v, double s, std::int64_t limit, std::int64_t out[2]) {
+  const double t = v / s;
+  int n = 0;
+  const auto lo = static_cast<std::int64_t>(std::floor(t - 1e-9)),
+             hi = static_cast<std::int64_t>(std::floor(t + 1e-9));
+  for (std::int64_t c = lo; c <= hi; ++c) {
+    if (c >= 0 && c < limit && n < 2) out[n++] = c;
+  }
+  return n;
+}
+
+}  // namespace
+
+SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
+                                    std::uint32_t depth,
+                                    std::span<const std::vector<std::uint64_t>> level_keys,
+                                    std::span<const std::vector<std::uint32_t>> words,
+                                    const SlabSampleOptions& options) {
+  std::vector<std::unique_ptr<KeyIndex>> index;
+  for (const auto& keys : level_keys) index.push_back(std::make_unique<KeyIndex>(keys));
+  const double h = grid.voxel_size();
+  const std::size_t triangles = mesh.triangles.size();
+  constexpr std::size_t kChunk = 256;
+  std::vector<Partial> parts((triangles + kChunk - 1) / kChunk);
+  tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t part) {
+    Partial& r = parts[part];
+    std::vector<Vec3d> pts;
+    for (std::size_t t = part * kChunk; t < std::min(triangles, (part + 1) * kChunk); ++t) {
+      const Triangle& tri = mesh.triangles[t];
+      const Vec3d a = mesh.positions[tri[0]], b = mesh.positions[tri[1]],
+                  c = mesh.positions[tri[2]];
+      pts = {a, b, c};
+      for (int e = 1; e <= 8; ++e) {
+        const double w = e / 9.0;
+        pts.push_back(a * (1 - w) + b * w);
+        pts.push_back(b * (1 - w) + c * w);
+        pts.push_back(c * (1 - w) + a * w);
+      }
+      int interior = options.interior;
+      if (interior <= 0) {
+        const double area = 0.5 * Length(Cross(b - a, c - a)) / (h * h);
+        interior = static_cast<int>(std::clamp(std::ceil(2 * area), 4.0, 4096.0));
+      }
+      std::mt19937_64 rng(options.seed ^ (0x9E3779B97F4A7C15ull * (t + 1)));
+      std::uniform_real_distribution<double> uni(0.0, 1.0);
+      for (int i = 0; i < interior; ++i) {
+        double u = uni(rng), v = uni(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        pts.push_back(a * (1 - u - v) + b * u + c * v);
+      }
+      for (const Vec3d& p : pts) {
+        ++r.points;
+        const Vec3d q = grid.WorldToVoxel(p);
+        for (std::uint32_t level = 0; level <= depth; ++level) {
+          const double s = std::ldexp(1.0, static_cast<int>(depth - level));
+          const std::int64_t limit = std::int64_t{1} << level;
+          std::int64_t cx[2], cy[2], cz[2];
+          const int nx = Candidates(q.x, s, limit, cx), ny = Candidates(q.y, s, limit, cy),
+                    nz = Candidates(q.z, s, limit, cz);
+          bool found = false;
+          for (int iz = 0; iz < nz; ++iz) {
+            for (int iy = 0; iy < ny; ++iy) {
+              for (int ix = 0; ix < nx; ++ix) {
+                const std::int64_t node = index[level]->Find(MortonEncode(
+                    static_cast<std::uint32_t>(cx[ix]), static_cast<std::uint32_t>(cy[iy]),
+                    static_cast<std::uint32_t>(cz[iz])));
+                if (node < 0) continue;
+                found = true;
+                const std::uint32_t word = words[level][static_cast<std::size_t>(node)];
+                if (word == 0) continue;  // no contour: the whole cube
+                const Contour ct = DecodeContour(word);
+                const Vec3d u{(q.x - (static_cast<double>(cx[ix]) + 0.5) * s) / s,
+                              (q.y - (static_cast<double>(cy[iy]) + 0.5) * s) / s,
+                              (q.z - (static_cast<double>(cz[iz]) + 0.5) * s) / s};
+                const double d = ct.nx * u.x + ct.ny * u.y + ct.nz * u.z;
+                const double tol = 1e-9 * (std::abs(ct.nx) + std::abs(ct.ny) + std::abs(ct.nz));
+                ++r.checks;
+                if (d < ct.Low() - tol || d > ct.High() + tol) {
+                  if (r.violations++ < options.max_violations) {
+                    r.first.push_back(
+                        {level,
+                         {static_cast<std::uint32_t>(cx[ix]), static_cast<std::uint32_t>(cy[iy]),
+                          static_cast<std::uint32_t>(cz[iz])},
+                         p,
+                         d,
+                         ct.Low(),
+                         ct.High()});
+                  }
+                }
+              }
+            }
+          }
+          if (!found) ++r.orphans;
+        }
+      }
+    }
+  });
+  SlabSampleResult out;
+  for (Partial& p : parts) {
+    out.points += p.points;
+    out.checks += p.checks;
+    out.violations += p.violations;
+    out.orphans += p.orphans;
+    for (SlabViolation& v : p.first) {
+      if (out.first.size() < options.max_violations) out.first.push_back(v);
+    }
+  }
+  return out;
+}
+
+}  // namespace svokit::validate

@@ -1,0 +1,49 @@
+#pragma once
+// Contours against the surface: points sampled on every triangle (vertices, 8 per edge, interior
+// points) must lie inside the decoded slab of every node whose closed cube holds them. Used by
+// svo-validate on files and by tests/svo/contour_test.cpp on FitContours' output.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "svokit/core/grid_transform.hpp"
+#include "svokit/core/morton.hpp"
+#include "svokit/core/vec.hpp"
+#include "svokit/mesh/mesh.hpp"
+
+namespace svokit::validate {
+
+struct SlabSampleOptions {
+  /// Interior points per triangle; 0: two per voxel² of the triangle's area, 4 to 4096.
+  int interior = 0;
+  std::uint64_t seed = 20240601;
+  std::size_t max_violations = 10;  ///< kept in `first`
+};
+
+struct SlabViolation {
+  std::uint32_t level = 0;
+  MortonCoord node{};
+  Vec3d point{};             ///< world space
+  double value = 0;          ///< n·u of the point
+  double low = 0, high = 0;  ///< the slab
+};
+
+struct SlabSampleResult {
+  std::uint64_t points = 0;          ///< surface points sampled
+  std::uint64_t checks = 0;          ///< (point, node with a contour) pairs tested
+  std::uint64_t violations = 0;      ///< point outside the slab
+  std::uint64_t orphans = 0;         ///< (point, level) pairs with no node holding the point
+  std::vector<SlabViolation> first;  ///< the first violations in triangle order
+};
+
+/// `level_keys[L]`: sorted Morton keys of level L's nodes (level `depth` = the voxels of `grid`);
+/// `words[L][i]`: node i's contour word, 0 for none. Deterministic for any thread count (each
+/// triangle's random points come from its own seed).
+SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
+                                    std::uint32_t depth,
+                                    std::span<const std::vector<std::uint64_t>> level_keys,
+                                    std::span<const std::vector<std::uint32_t>> words,
+                                    const SlabSampleOptions& options = {});
+
+}  // namespace svokit::validate

@@ -1,0 +1,185 @@
+// Occupancy against OpenVDB's unsigned distance field: the only translation unit of svo-validate
+// that includes OpenVDB's headers (linked by svo-validate and its tests only).
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/parallel_for.h>
+
+#include "svokit/core/morton.hpp"
+#include "svokit/svo/key_index.hpp"
+#include "svokit/validate/checks.hpp"
+#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/voxel_space.hpp"
+
+namespace svokit::validate {
+namespace {
+
+// The mesh as the voxelizer saw it: vertices snapped to 2⁻¹⁶ voxel (exact doubles), shifted by
+// −½ so OpenVDB's integer index coordinates are voxel centres; triangles that snapping made
+// degenerate are dropped, as the voxelizer drops them.
+struct SnappedMesh {
+  std::vector<openvdb::Vec3d> points;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+
+  std::size_t polygonCount() const { return triangles.size(); }
+  std::size_t pointCount() const { return points.size(); }
+  std::size_t vertexCount(std::size_t) const { return 3; }
+  void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
+    pos = points[triangles[n][v]];
+  }
+};
+
+SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid) {
+  const std::vector<FixedPoint3> fixed = SnapToVoxelSpace(mesh, grid);
+  SnappedMesh out;
+  out.points.reserve(fixed.size());
+  for (const FixedPoint3& p : fixed) {
+    const Vec3d v = FixedToVoxel(p);
+    out.points.emplace_back(v.x - 0.5, v.y - 0.5, v.z - 0.5);
+  }
+  for (const Triangle& t : mesh.triangles) {
+    const FixedPoint3 &a = fixed[t[0]], &b = fixed[t[1]], &c = fixed[t[2]];
+    Int128 e0[3], e1[3];
+    for (int ax = 0; ax < 3; ++ax) {
+      e0[ax] = Int128{b[ax]} - a[ax];
+      e1[ax] = Int128{c[ax]} - a[ax];
+    }
+    const bool degenerate = e0[1] * e1[2] - e0[2] * e1[1] == 0 &&
+                            e0[2] * e1[0] - e0[0] * e1[2] == 0 &&
+                            e0[0] * e1[1] - e0[1] * e1[0] == 0;
+    if (!degenerate) out.triangles.push_back({t[0], t[1], t[2]});
+  }
+  return out;
+}
+
+struct Located {
+  std::uint64_t key;
+  double distance;  // voxels
+};
+
+void InitializeOpenVdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+}  // namespace
+
+CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& leaf_keys,
+                           const Mesh& mesh) {
+  InitializeOpenVdb();
+  CheckResult r("occupancy");
+  const bool thin = svo.mode == VoxelMode::kThin;
+  // Conservative: the inscribed sphere (h/2) touching the surface forces a leaf. Thin: within
+  // h/(2√3) the plane crosses the centre line along the triangle's dominant axis (|n_w| ≥ 1/√3)
+  // and every projection meets the inner diamond (L1 radius ½ ≥ √2·h/(2√3)), so the voxel is in.
+  const double required = thin ? 0.5 / std::sqrt(3.0) : 0.5;
+  const double allowed = 0.5 * std::sqrt(3.0);  // the circumscribed sphere; thin ⊆ conservative
+  const double tol = kDistanceTolerance;
+  r.note = fmt::format("{}: leaf required within {:.4f} h, allowed within {:.4f} h (± {} h)",
+                       thin ? "thin" : "conservative", required, allowed, tol);
+
+  const SnappedMesh snapped = Snap(mesh, svo.grid);
+  const double h = svo.grid.voxel_size();
+  const Vec3d& o = svo.grid.origin();
+  openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
+  transform->postTranslate(openvdb::Vec3d(o.x + 0.5 * h, o.y + 0.5 * h, o.z + 0.5 * h));
+  // A band of 2 voxels: OpenVDB's first pass computes the exact distance (double closest point)
+  // of every voxel within √3/2 voxel of a triangle, and everything else reads as ≥ 2 h.
+  constexpr float kBand = 2.0f;
+  const openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      snapped, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
+  const double to_voxels = 1.0 / static_cast<double>(static_cast<float>(h));
+
+  // Extra voxels: leaves whose centre is farther than allowed. Chunks in key order, each keeping
+  // its first examples, so the reported ones are the first in Morton order for any thread count.
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (leaf_keys.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<Located>> extra(chunks);
+  std::vector<std::uint64_t> extra_counts(chunks, 0);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t part) {
+    auto acc = distance->getConstAccessor();
+    for (std::size_t i = part * kChunk; i < std::min(leaf_keys.size(), (part + 1) * kChunk); ++i) {
+      const MortonCoord c = MortonDecode(leaf_keys[i]);
+      const double d = static_cast<double>(acc.getValue(openvdb::Coord(
+                           static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)))) *
+                       to_voxels;
+      if (d > allowed + tol) {
+        if (extra_counts[part]++ < r.max_examples) extra[part].push_back({leaf_keys[i], d});
+      }
+    }
+  });
+
+  // Missing voxels: distance-grid voxels closer than `required` that are no leaf.
+  const KeyIndex leaves(leaf_keys);
+  openvdb::tree::LeafManager<const openvdb::FloatTree> manager(distance->tree());
+  std::mutex mutex;
+  std::vector<Located> missing;
+  std::uint64_t near = 0;
+  const auto dims = svo.grid.dims();
+  manager.foreach ([&](const openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
+    std::vector<Located> local;
+    std::uint64_t local_near = 0;
+    for (auto it = leaf.cbeginValueOn(); it; ++it) {
+      const double d = static_cast<double>(*it) * to_voxels;
+      if (d > required - tol) continue;
+      const openvdb::Coord ijk = it.getCoord();
+      // The voxelizer clips to the grid; the mesh lies inside it (the app checks), so voxels
+      // outside are never required.
+      if (ijk.x() < 0 || ijk.y() < 0 || ijk.z() < 0 ||
+          static_cast<std::uint32_t>(ijk.x()) >= dims[0] ||
+          static_cast<std::uint32_t>(ijk.y()) >= dims[1] ||
+          static_cast<std::uint32_t>(ijk.z()) >= dims[2]) {
+        continue;
+      }
+      ++local_near;
+      const std::uint64_t key =
+          MortonEncode(static_cast<std::uint32_t>(ijk.x()), static_cast<std::uint32_t>(ijk.y()),
+                       static_cast<std::uint32_t>(ijk.z()));
+      if (leaves.Find(key) < 0) local.push_back({key, d});
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    near += local_near;
+    missing.insert(missing.end(), local.begin(), local.end());
+  });
+  std::sort(missing.begin(), missing.end(),
+            [](const Located& a, const Located& b) { return a.key < b.key; });
+
+  const auto report = [&](const char* kind, const Located& v, const char* what) {
+    const MortonCoord c = MortonDecode(v.key);
+    r.Add({kind,
+           fmt::format("voxel ({}, {}, {}): centre {:.6f} h from the surface, {}", c.x, c.y, c.z,
+                       v.distance, what),
+           std::array<std::int64_t, 3>{c.x, c.y, c.z}, svo.depth, v.distance});
+  };
+  for (std::size_t i = 0; i < missing.size() && i < r.max_examples; ++i) {
+    report("missing_voxel", missing[i], "not a leaf");
+  }
+  if (missing.size() > r.max_examples) r.AddCount("missing_voxel", missing.size() - r.max_examples);
+  std::uint64_t extras = 0;
+  for (std::size_t part = 0; part < chunks; ++part) {
+    for (const Located& v : extra[part]) {
+      if (extras++ < r.max_examples) {
+        report("extra_voxel", v, "a leaf beyond the voxel's circumscribed sphere");
+      } else {
+        r.AddCount("extra_voxel", 1);
+      }
+    }
+    extras += extra_counts[part] - extra[part].size();
+    r.AddCount("extra_voxel", extra_counts[part] - extra[part].size());
+  }
+  r.Stat("leaves", leaf_keys.size());
+  r.Stat("matched", leaf_keys.size() - extras);
+  r.Stat("required", near);
+  r.Stat("missing", missing.size());
+  r.Stat("extra", extras);
+  r.Stat("triangles", snapped.triangles.size());
+  return r;
+}
+
+}  // namespace svokit::validate
