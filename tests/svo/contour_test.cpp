@@ -18,6 +18,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/mesh/import.hpp"
 #include "svokit/svo/svo.hpp"
+#include "svokit/validate/contour_surface.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -88,107 +89,27 @@ Words Fit(const Scene& s, const ContourOptions& options = {}) {
   return FitContours(s.mesh, s.grid, s.depth, s.keys, options);
 }
 
-struct CheckResult {
-  std::uint64_t checks = 0;      // (point, node with contour) pairs tested
-  std::uint64_t violations = 0;  // point outside the decoded slab
-  std::uint64_t orphans = 0;     // (point, level) with no node containing the point
-};
-
 // Every sample point (vertices, 8 points per edge, `interior` random barycentric points per
-// triangle) against every node of every level whose closed world cube contains it.
-CheckResult CheckConservative(const Scene& s, const Words& words, int interior = 80) {
-  CheckResult r;
-  std::mt19937_64 rng(20240601);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  std::vector<Vec3d> pts;
-  const Vec3d o = s.grid.origin();
-  struct NodeBox {
-    std::uint32_t level;
-    std::array<std::int64_t, 3> ijk;
-    Vec3d lo, hi, center;
-    double size;
-    std::uint32_t word;
-  };
-  std::vector<NodeBox> boxes;
-  for (const Triangle& t : s.mesh.triangles) {
-    const Vec3d a = s.mesh.positions[t[0]], b = s.mesh.positions[t[1]], c = s.mesh.positions[t[2]];
-    // The existing nodes whose cubes meet the triangle's bounding box, per level.
-    boxes.clear();
-    for (std::uint32_t level = 0; level <= s.depth; ++level) {
-      const double size = s.grid.voxel_size() * std::ldexp(1.0, int(s.depth - level));
-      std::array<std::int64_t, 3> first{}, last{};
-      for (int ax = 0; ax < 3; ++ax) {
-        const double lo = std::min({a[ax], b[ax], c[ax]}), hi = std::max({a[ax], b[ax], c[ax]});
-        // Nodes whose closed cube may hold part of the bounding box (a relative 1e-7 of slack,
-        // so a point on a cube face reaches the nodes on both sides).
-        first[std::size_t(ax)] =
-            std::max<std::int64_t>(0, std::int64_t(std::floor((lo - o[ax]) / size - 1e-7)));
-        last[std::size_t(ax)] = std::int64_t(std::floor((hi - o[ax]) / size + 1e-7));
-      }
-      const auto& lk = s.keys[level];
-      for (std::int64_t iz = first[2]; iz <= last[2]; ++iz) {
-        for (std::int64_t iy = first[1]; iy <= last[1]; ++iy) {
-          for (std::int64_t ix = first[0]; ix <= last[0]; ++ix) {
-            const std::uint64_t key =
-                MortonEncode(std::uint32_t(ix), std::uint32_t(iy), std::uint32_t(iz));
-            const auto it = std::lower_bound(lk.begin(), lk.end(), key);
-            if (it == lk.end() || *it != key) continue;
-            NodeBox nb{
-                level, {ix, iy, iz}, {}, {}, {}, size, words[level][std::size_t(it - lk.begin())]};
-            for (int ax = 0; ax < 3; ++ax) {
-              const double i = double(nb.ijk[std::size_t(ax)]);
-              nb.lo[ax] = o[ax] + i * size;
-              nb.hi[ax] = o[ax] + (i + 1) * size;
-              nb.center[ax] = o[ax] + (i + 0.5) * size;
-            }
-            boxes.push_back(nb);
-          }
-        }
-      }
-    }
-    pts = {a, b, c};
-    for (int e = 1; e <= 8; ++e) {
-      const double w = e / 9.0;
-      pts.push_back(a * (1 - w) + b * w);
-      pts.push_back(b * (1 - w) + c * w);
-      pts.push_back(c * (1 - w) + a * w);
-    }
-    for (int i = 0; i < interior; ++i) {
-      double u = uni(rng), v = uni(rng);
-      if (u + v > 1) u = 1 - u, v = 1 - v;
-      pts.push_back(a * (1 - u - v) + b * u + c * v);
-    }
-    for (const Vec3d& p : pts) {
-      std::uint64_t levels_found = 0;  // bit L: some node of level L holds p
-      for (const NodeBox& nb : boxes) {
-        if (p.x < nb.lo.x || p.x > nb.hi.x || p.y < nb.lo.y || p.y > nb.hi.y || p.z < nb.lo.z ||
-            p.z > nb.hi.z) {
-          continue;
-        }
-        levels_found |= std::uint64_t{1} << nb.level;
-        if (nb.word == 0) continue;  // no contour: the whole cube
-        const Contour ct = DecodeContour(nb.word);
-        const Vec3d u = (p - nb.center) / nb.size;
-        const double d = ct.nx * u.x + ct.ny * u.y + ct.nz * u.z;
-        const double tol = 1e-9 * (std::abs(ct.nx) + std::abs(ct.ny) + std::abs(ct.nz));
-        ++r.checks;
-        if (d < ct.Low() - tol || d > ct.High() + tol) {
-          if (++r.violations <= 5) {
-            ADD_FAILURE() << "point (" << p.x << ", " << p.y << ", " << p.z
-                          << ") outside the slab of level " << nb.level << " node (" << nb.ijk[0]
-                          << ", " << nb.ijk[1] << ", " << nb.ijk[2] << "): n·u = " << d
-                          << " not in [" << ct.Low() << ", " << ct.High() << "]";
-          }
-        }
-      }
-      r.orphans += std::uint64_t(s.depth + 1 - std::popcount(levels_found));
-    }
+// triangle) against every node of every level whose closed cube contains it: the sampler
+// svo-validate uses (lib/svokit/validate/contour_surface.hpp).
+validate::SlabSampleResult CheckConservative(const Scene& s, const Words& words,
+                                             int interior = 80) {
+  validate::SlabSampleOptions options;
+  options.interior = interior;
+  options.max_violations = 5;
+  const validate::SlabSampleResult r =
+      validate::SampleContourSlabs(s.mesh, s.grid, s.depth, s.keys, words, options);
+  for (const validate::SlabViolation& v : r.first) {
+    ADD_FAILURE() << "point (" << v.point.x << ", " << v.point.y << ", " << v.point.z
+                  << ") outside the slab of level " << v.level << " node (" << v.node.x << ", "
+                  << v.node.y << ", " << v.node.z << "): n·u = " << v.value << " not in [" << v.low
+                  << ", " << v.high << "]";
   }
   return r;
 }
 
 void ExpectConservative(const Scene& s, const Words& words, int interior = 80) {
-  const CheckResult r = CheckConservative(s, words, interior);
+  const validate::SlabSampleResult r = CheckConservative(s, words, interior);
   EXPECT_EQ(r.violations, 0u) << "of " << r.checks << " point/slab checks";
   EXPECT_EQ(r.orphans, 0u) << "sample points with no containing node at some level";
   EXPECT_GT(r.checks, 0u);
