@@ -60,4 +60,13 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
   return r;
 }
 
+/// Every .svo the suite produces goes through svo-validate (with the mesh it came from, when
+/// given): exit 0, or the report in the failure message.
+inline void ExpectValidSvo(const std::string& svo, const std::string& mesh = "") {
+  std::vector<std::string> args = {svo, "-q"};
+  if (!mesh.empty()) args.insert(args.end(), {"--mesh", mesh});
+  const ToolResult r = RunTool("svo-validate", args);
+  EXPECT_EQ(r.exit_code, 0) << "svo-validate " << svo << ":\n" << r.out << r.err;
+}
+
 }  // namespace svokit::test

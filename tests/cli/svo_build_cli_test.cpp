@@ -43,6 +43,8 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
   EXPECT_EQ(sa->metadata, sb->metadata) << "both routes must record the same metadata";
   EXPECT_TRUE(*sa == *sb) << "the octrees differ";
   EXPECT_TRUE(a == b) << "files differ: " << a.size() << " vs " << b.size() << " bytes";
+  ExpectValidSvo(chained, Torus());
+  ExpectValidSvo(direct, Torus());
 
   // What the file holds: the voxels of the .vfrag, bricks 3 with colour and normal, contours,
   // and metadata naming the source and the options.
@@ -77,6 +79,7 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoWithOtherOptions) {
   ASSERT_TRUE(sb.ok()) << sb.status().message();
   EXPECT_EQ(sa->metadata, sb->metadata);
   EXPECT_TRUE(ReadText(dir / "a.svo") == ReadText(dir / "b.svo"));
+  ExpectValidSvo((dir / "a.svo").string(), Torus());  // thin, bricks 2, no contours
 }
 
 TEST(SvoBuildCli, NoContoursNeedsNoMesh) {
@@ -100,6 +103,8 @@ TEST(SvoBuildCli, NoContoursNeedsNoMesh) {
   EXPECT_EQ(bare->LevelKeys(bare->depth), svo->LevelKeys(svo->depth));
   EXPECT_LT(std::filesystem::file_size(dir / "bare.svo"),
             std::filesystem::file_size(dir / "n.svo"));
+  ExpectValidSvo((dir / "n.svo").string(), Torus());
+  ExpectValidSvo((dir / "bare.svo").string(), Torus());
 }
 
 TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
@@ -121,6 +126,7 @@ TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
   EXPECT_TRUE(ReadText(dir / "b1.svo") == ReadText(dir / "b2.svo"))
       << "svo-build -j 1 and -j 2 differ";
   EXPECT_TRUE(ReadText(dir / "b1.svo") == one) << "svo-build differs from mesh2svo at 64";
+  ExpectValidSvo((dir / "m1.svo").string(), Torus());
 }
 
 TEST(SvoBuildCli, Mesh2svoPrintsOneLinePerStageAndASummary) {
@@ -141,6 +147,7 @@ TEST(SvoBuildCli, Mesh2svoPrintsOneLinePerStageAndASummary) {
   }
   auto svo = ReadSvo(out);
   ASSERT_TRUE(svo.ok()) << svo.status().message();
+  ExpectValidSvo(out, Torus());
   // The summary: triangles, voxels, nodes per level (matching the file), time per stage, bytes.
   EXPECT_NE(r.out.find("2304 triangles"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(fmt::format("voxels      {}", svo->voxel_count())), std::string::npos)

@@ -25,6 +25,7 @@ const TempDir& Chain() {
       const ToolResult r = RunTool(step[0], {step.begin() + 1, step.end()});
       EXPECT_EQ(r.exit_code, 0) << step[0] << ": " << r.err;
     }
+    ExpectValidSvo((dir / "torus.svo").string(), svm);
     return true;
   }();
   (void)made;
