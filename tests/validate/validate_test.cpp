@@ -16,6 +16,7 @@
 
 #include "formats/svo/svo_file.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/core/parallel.hpp"
 #include "svokit/mesh/import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/validate/checks.hpp"
@@ -452,6 +453,26 @@ TEST(ValidateMutation, ContourCuttingOffGeometryIsASurfaceFinding) {
   svo.levels[leaf].contours[word] = EncodeContour(c);
   r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
   EXPECT_EQ(Count(Check(r, "contours"), "contour_range"), 1u) << r.Text();
+}
+
+TEST(ValidateMutation, ReportDoesNotDependOnTheThreadCount) {
+  // Many findings of several kinds: a brick byte flipped in every 50th leaf.
+  Svo svo = Base().svo;
+  for (std::size_t i = 0; i < svo.levels[svo.depth].opacity.size(); i += 50 * 27 + 4) {
+    svo.levels[svo.depth].opacity[i] ^= 0x80;
+  }
+  const auto bytes = EncodeSvo(svo);
+  std::string one, two;
+  {
+    ThreadLimit limit(1);
+    one = ValidateBytes(bytes, &Base().mesh).Json();
+  }
+  {
+    ThreadLimit limit(2);
+    two = ValidateBytes(bytes, &Base().mesh).Json();
+  }
+  EXPECT_EQ(one, two);
+  EXPECT_NE(one.find("\"brick_border\""), std::string::npos) << one;
 }
 
 TEST(ValidateMutation, ForeignBytesAreUnusableNotFindings) {
