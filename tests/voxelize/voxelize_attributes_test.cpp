@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <map>
 #include <numbers>
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/mesh/import.hpp"
 #include "svokit/voxelize/voxelize.hpp"
+#include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -85,53 +85,9 @@ TEST(VoxelizeAttributes, TexturedSquareMatchesTheTextureAverage) {
   }
 }
 
-// An icosphere of radius 1 with exact radial per-corner normals, or none (flat facets).
-Mesh Icosphere(int subdivisions, bool corner_normals) {
-  const double t = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vec3d> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                          {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                          {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (Vec3d& q : p) q = q / Length(q);
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
-    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      const Vec3d m = (p[a] + p[b]) * 0.5;
-      p.push_back(m / Length(m));
-      return mid[key] = static_cast<std::uint32_t>(p.size() - 1);
-    };
-    std::vector<Triangle> next;
-    for (const Triangle& tri : f) {
-      const std::uint32_t ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]),
-                          ca = midpoint(tri[2], tri[0]);
-      next.insert(next.end(), {{tri[0], ab, ca}, {tri[1], bc, ab}, {tri[2], ca, bc}, {ab, bc, ca}});
-    }
-    f = std::move(next);
-  }
-  Mesh m;
-  m.positions = p;
-  m.triangles = f;
-  if (corner_normals) {
-    for (const Triangle& tri : f) {
-      for (std::uint32_t v : tri) {
-        m.normals.push_back(
-            {static_cast<float>(p[v].x), static_cast<float>(p[v].y), static_cast<float>(p[v].z)});
-      }
-    }
-  }
-  EnsureDefaultMaterial(m);
-  return m;
-}
-
 TEST(VoxelizeAttributes, SphereNormalsPointOutward) {
   for (bool smooth : {true, false}) {
-    const Mesh m = Icosphere(4, smooth);  // 5120 triangles
+    const Mesh m = test::Icosphere(4, smooth);  // 5120 triangles
     auto grid = GridTransform::FitResolution(m.Bounds(), 64);
     VoxelizeOptions options;
     options.normals = true;
