@@ -3,8 +3,12 @@
 // exit protocol (0 ok, 1 check failed, 2 bad input or usage, 3 internal error; one line on
 // stderr per error). Tools stay thin: options → library calls → report.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <functional>
@@ -73,10 +77,26 @@ inline int Fail(const std::string& tool, const Status& status) {
   return status.exit_code();
 }
 
+/// Re-executes the process once with glibc's malloc asking for transparent huge pages
+/// (glibc.malloc.hugetlb=1; read at start-up only). Where THP is in `madvise` mode (Debian's and
+/// most VMs' default) first-touch page faults dominate the big arrays: with it, 1024³ mesh2svo
+/// runs 1.25× faster and the 4096³ voxelize stage 1.9× (README, design notes). Nothing changes
+/// where the setting is already given (also `hugetlb=0`) or the exec fails.
+inline void UseHugePages(char** argv) {
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.hugetlb") != nullptr) return;
+  const std::string value = tunables != nullptr && *tunables != 0
+                                ? std::string(tunables) + ":glibc.malloc.hugetlb=1"
+                                : std::string("glibc.malloc.hugetlb=1");
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+}
+
 /// Parses the command line and runs `body`, mapping usage errors to exit 2 and anything thrown to
 /// a one-line message with exit 3.
 inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
                const std::function<int()>& body) {
+  UseHugePages(argv);
   try {
     try {
       cli.parse(argc, argv);

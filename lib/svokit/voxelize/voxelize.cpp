@@ -313,7 +313,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   parts.clear();
   // The per-thread bricks were many small blocks: hand their pages back before the attribute
   // arrays are allocated, or they would stay in the peak (~4 B/voxel).
-  malloc_trim(0);
+  if (attributes) malloc_trim(0);
   stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
   stage.reset();
   if (attributes) {
