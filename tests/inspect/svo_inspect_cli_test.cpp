@@ -24,6 +24,7 @@ const std::string& TorusSvo() {
     const ToolResult r =
         RunTool("mesh2svo", {(DataDir() / "uv-torus.obj").string(), "-r", "32", "-o", out, "-q"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
+    ExpectValidSvo(out, (DataDir() / "uv-torus.obj").string());
     return out;
   }();
   return path;
