@@ -13,11 +13,14 @@
 #include <filesystem>
 #include <functional>
 #include <new>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "formats/svo/svo_file.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
@@ -67,6 +70,41 @@ inline StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::pat
     stage.SetSummary(fmt::format("{} triangles", mesh->triangle_count()));
   } else {
     stage.Cancel();
+  }
+  return mesh;
+}
+
+/// Runs `read` (returning a StatusOr) as the "read" stage of `progress`.
+template <class Read>
+auto ReadStage(Progress& progress, const Read& read) -> decltype(read()) {
+  Progress::Stage stage(progress, "read", 1);
+  auto result = read();
+  if (!result.ok()) stage.Cancel();
+  return result;
+}
+
+/// Reads levels 0..`level` of an octree (all of them without `level`; the deeper ones stay on
+/// disk, the file being breadth-first) as the "read" stage; a `level` below the octree's depth is
+/// bad input.
+inline StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& input,
+                                  std::optional<std::uint32_t> level) {
+  StatusOr<Svo> svo = ReadStage(progress, [&] { return ReadSvo(input, level); });
+  if (svo.ok() && level && *level > svo->depth) {
+    return Status::BadInput("{}: --level {} exceeds the octree's depth {}", input.string(), *level,
+                            svo->depth);
+  }
+  return svo;
+}
+
+/// Imports the mesh `input` was made from (`made` says how, for the message) as the "import"
+/// stage; a mesh reaching outside `grid` cannot be that mesh and is bad input.
+inline StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path& mesh_path,
+                                       const GridTransform& grid,
+                                       const std::filesystem::path& input, std::string_view made) {
+  StatusOr<Mesh> mesh = ImportStage(progress, mesh_path);
+  if (mesh.ok() && !grid.GridBounds().Contains(mesh->Bounds())) {
+    return Status::BadInput("{}: the mesh lies outside {}'s grid: not the mesh {}",
+                            mesh_path.string(), input.string(), made);
   }
   return mesh;
 }

@@ -39,22 +39,13 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     VfragMetadata source;
-    StatusOr<VoxelSet> voxels = [&] {
-      Progress::Stage stage(progress, "read", 1);
-      StatusOr<VoxelSet> v = ReadVfrag(input, &source);
-      if (!v.ok()) stage.Cancel();
-      return v;
-    }();
+    StatusOr<VoxelSet> voxels = app::ReadStage(progress, [&] { return ReadVfrag(input, &source); });
     if (!voxels.ok()) return app::Fail(tool, voxels.status());
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
-      StatusOr<Mesh> m = app::ImportStage(progress, mesh_path);
+      StatusOr<Mesh> m =
+          app::ImportSourceMesh(progress, mesh_path, voxels->grid, input, "that was voxelized");
       if (!m.ok()) return app::Fail(tool, m.status());
-      if (!voxels->grid.GridBounds().Contains(m->Bounds())) {
-        return app::Fail(tool, Status::BadInput("{}: the mesh lies outside {}'s grid: not the "
-                                                "mesh that was voxelized",
-                                                mesh_path.string(), input.string()));
-      }
       mesh = std::move(*m);
     }
     const nlohmann::json meta = {{"source", source.source},

@@ -33,18 +33,8 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Svo> svo = [&]() -> StatusOr<Svo> {
-      Progress::Stage stage(progress, "read", 1);
-      // Levels below the exported one are never read (the file is breadth-first).
-      StatusOr<Svo> read = ReadSvo(input, level);
-      if (!read.ok()) stage.Cancel();
-      return read;
-    }();
+    StatusOr<Svo> svo = app::ReadSvoStage(progress, input, level);
     if (!svo.ok()) return app::Fail(tool, svo.status());
-    if (level && *level > svo->depth) {
-      return app::Fail(tool, Status::BadInput("{}: --level {} exceeds the octree's depth {}",
-                                              input.string(), *level, svo->depth));
-    }
 
     ExportOptions options;
     options.level = level;

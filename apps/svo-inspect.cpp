@@ -72,17 +72,8 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Svo> svo = [&]() -> StatusOr<Svo> {
-      Progress::Stage stage(progress, "read", 1);
-      StatusOr<Svo> read = ReadSvo(input, level);  // levels below --level stay on disk
-      if (!read.ok()) stage.Cancel();
-      return read;
-    }();
+    StatusOr<Svo> svo = app::ReadSvoStage(progress, input, level);
     if (!svo.ok()) return app::Fail(tool, svo.status());
-    if (level && *level > svo->depth) {
-      return app::Fail(tool, Status::BadInput("{}: --level {} exceeds the octree's depth {}",
-                                              input.string(), *level, svo->depth));
-    }
 
     nlohmann::ordered_json pictures = {{"render", nullptr}, {"slice", nullptr}};
     std::string picture_lines;

@@ -30,23 +30,15 @@ int main(int argc, char** argv) {
   return app::Run(tool, cli, argc, argv, [&] {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-    StatusOr<LenientSvo> file = [&] {
-      Progress::Stage stage(progress, "read", 1);
-      StatusOr<LenientSvo> f = ReadSvoLenient(input);
-      if (!f.ok()) stage.Cancel();
-      return f;
-    }();
+    StatusOr<LenientSvo> file = app::ReadStage(progress, [&] { return ReadSvoLenient(input); });
     if (!file.ok()) return app::Fail(tool, file.status());
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
-      StatusOr<Mesh> m = app::ImportStage(progress, mesh_path);
+      // A damaged grid cannot vouch for or against the mesh: the checks will say what they can.
+      StatusOr<Mesh> m = file->complete ? app::ImportSourceMesh(progress, mesh_path, file->svo.grid,
+                                                                input, "the octree was built from")
+                                        : app::ImportStage(progress, mesh_path);
       if (!m.ok()) return app::Fail(tool, m.status());
-      // The same rule as svo-build: the voxelized mesh lies inside the grid.
-      if (file->complete && !file->svo.grid.GridBounds().Contains(m->Bounds())) {
-        return app::Fail(tool, Status::BadInput("{}: the mesh lies outside {}'s grid: not the "
-                                                "mesh the octree was built from",
-                                                mesh_path.string(), input.string()));
-      }
       mesh = std::move(*m);
     }
     validate::ValidateOptions options;
