@@ -116,16 +116,19 @@ inline int Fail(const std::string& tool, const Status& status) {
 }
 
 /// Re-executes the process once with glibc's malloc asking for transparent huge pages
-/// (glibc.malloc.hugetlb=1; read at start-up only). Where THP is in `madvise` mode (Debian's and
-/// most VMs' default) first-touch page faults dominate the big arrays: with it, 1024³ mesh2svo
-/// runs 1.25× faster and the 4096³ voxelize stage 1.9× (README, design notes). Nothing changes
-/// where the setting is already given (also `hugetlb=0`) or the exec fails.
+/// (glibc.malloc.hugetlb=1; read at start-up only) and growing its heaps 64 MB at a time
+/// (top_pad), so that whole 2 MB pages lie inside each madvised extension. Where THP is in
+/// `madvise` mode (Debian's and most VMs' default) first-touch page faults dominate the big
+/// arrays: 1024³ voxelize runs 1.5× faster, the 4096³ one 2–3× (README, design notes). Only
+/// touched pages are resident, so the padding costs address space, not memory. Nothing changes
+/// where hugetlb is already given (also `hugetlb=0`) or the exec fails.
 inline void UseHugePages(char** argv) {
+  static constexpr const char* kTunables = "glibc.malloc.hugetlb=1:glibc.malloc.top_pad=67108864";
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.hugetlb") != nullptr) return;
   const std::string value = tunables != nullptr && *tunables != 0
-                                ? std::string(tunables) + ":glibc.malloc.hugetlb=1"
-                                : std::string("glibc.malloc.hugetlb=1");
+                                ? std::string(tunables) + ":" + kTunables
+                                : std::string(kTunables);
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);
 }

@@ -17,6 +17,7 @@ namespace svokit::detail {
 class TextScanner {
  public:
   TextScanner(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {}
+  std::string_view text() const { return text_; }
 
   /// Advances to the next line (without its terminator, '\r' stripped); false at end of text.
   bool NextLine() {

@@ -72,12 +72,18 @@ struct Tables {
     }
   }
 };
-inline const Tables kTables;
+// Built on first use, not at start-up: the 768 KB normal table costs ~200 page faults, which
+// every tool (most never decode a brick) would pay at launch.
+inline const Tables& GetTables() {
+  static const Tables tables;
+  return tables;
+}
 
 inline std::uint32_t EncodeSrgb8(float linear) {
+  const Tables& t = GetTables();
   const float v = std::clamp(linear, 0.f, 1.f);
-  std::uint32_t code = kTables.srgb_start[static_cast<std::size_t>(v * Tables::kBins)];
-  while (v >= kTables.srgb_midpoints[code]) ++code;
+  std::uint32_t code = t.srgb_start[static_cast<std::size_t>(v * Tables::kBins)];
+  while (v >= t.srgb_midpoints[code]) ++code;
   return code;
 }
 
@@ -90,7 +96,7 @@ inline std::uint32_t EncodeColor(const Rgba& c) {
          std::uint32_t{EncodeUnorm8(c.a)} << 24;
 }
 inline Rgba DecodeColor(std::uint32_t v) {
-  const auto& t = codec_detail::kTables.srgb_decode;
+  const auto& t = codec_detail::GetTables().srgb_decode;
   return {t[v & 0xff], t[(v >> 8) & 0xff], t[(v >> 16) & 0xff],
           DecodeUnorm8(static_cast<std::uint8_t>(v >> 24))};
 }
@@ -110,7 +116,7 @@ inline std::uint16_t EncodeNormal(const Vec3f& n) {
   return static_cast<std::uint16_t>(EncodeSnorm8(x) | EncodeSnorm8(y) << 8);
 }
 inline Vec3f DecodeNormal(std::uint16_t oct) {
-  return codec_detail::kTables.normals[oct];
+  return codec_detail::GetTables().normals[oct];
 }
 
 }  // namespace svokit

@@ -89,7 +89,7 @@ BrickStats ComputeBrickStats(const Svo& svo, SvoHistograms& histograms) {
   if (svo.has_color) {
     for (unsigned ch = 0; ch < 3; ++ch) {
       b.color[ch] = RangeOf(counts.color[ch], [](std::uint8_t c) {
-        return double{codec_detail::kTables.srgb_decode[c]};
+        return double{codec_detail::GetTables().srgb_decode[c]};
       });
     }
     b.color[3] = RangeOf(counts.color[3], [](std::uint8_t c) { return double{DecodeUnorm8(c)}; });
