@@ -140,11 +140,40 @@ TEST(ObjImport, AttributesAndSyntaxVariants) {
   EXPECT_EQ(m->uvs[2], (Vec2f{0, 1}));
   EXPECT_EQ(m->uvs[3], (Vec2f{0, 0}));  // corner without vt
   ASSERT_TRUE(m->has_normals());
+  ASSERT_EQ(m->normals.size(), 9u);
+  EXPECT_EQ(m->normals[0], (Vec3f{0, 0, 0}));  // the first face has none
   EXPECT_EQ(m->normals[4], (Vec3f{0, 0, 1}));
   ASSERT_TRUE(m->has_colors());
   EXPECT_EQ(m->colors[1], (Rgba{0, 1, 0, 1}));
   ASSERT_EQ(m->warnings.size(), 1u);  // the skipped line element
   EXPECT_NE(m->warnings[0].find("line/point"), std::string::npos);
+}
+
+TEST(ObjImport, CornerAttributesStartingMidFileAndMidFace) {
+  TempDir dir;
+  // Faces without vt/vn first, then a face whose second corner is the first with vt, then a
+  // quad (two triangles) whose last corner alone has a normal.
+  const auto p = dir.Write("late.obj",
+                           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.5 0.25\nvn 0 1 0\n"
+                           "f 1 2 3\nf 2 4 3\nf 1 2/1 4\nf 1 2 4 3//1\n");
+  auto m = ImportMesh(p);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->triangle_count(), 5u);
+  ASSERT_EQ(m->uvs.size(), 15u);
+  ASSERT_EQ(m->normals.size(), 15u);
+  for (std::size_t c = 0; c < 15; ++c) {
+    EXPECT_EQ(m->uvs[c], (c == 7 ? Vec2f{0.5f, 0.25f} : Vec2f{0, 0})) << c;
+  }
+  int with_normal = 0;
+  for (std::size_t c = 0; c < 15; ++c) {
+    if (m->normals[c] == Vec3f{0, 1, 0}) {
+      ++with_normal;
+      EXPECT_EQ(m->triangles[c / 3][c % 3], 2u) << c;  // only vertex 3 carries the normal
+    } else {
+      EXPECT_EQ(m->normals[c], (Vec3f{0, 0, 0})) << c;
+    }
+  }
+  EXPECT_GE(with_normal, 1);
 }
 
 TEST(ObjImport, MissingLibraryTextureAndMaterialAreWarnings) {
