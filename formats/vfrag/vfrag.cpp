@@ -69,7 +69,13 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
   }
   SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
   SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
-  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
+  if (file->version() >= 2) {
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
+  } else {  // version 1 stored coverage as f32
+    std::vector<float> coverage;
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), coverage));
+    set.coverage.assign(coverage.begin(), coverage.end());
+  }
   for (const Rgba& c : set.colors) {
     if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b) || !std::isfinite(c.a)) {
       return Status::BadInput("{}: non-finite voxel colour", name);

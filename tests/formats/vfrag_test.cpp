@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "formats/container/grid_section.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -54,6 +55,36 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
   bad = DecodeVfrag(EncodeVfrag(s, {}), "nan.vfrag");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("non-finite"), std::string::npos);
+}
+
+// Version 1 stored coverage as f32 (version 2: binary16); a version 2 reader still reads it.
+TEST(Vfrag, Version1CoverageIsReadAsFloat32) {
+  VoxelSet s = Sample();
+  std::vector<float> coverage;
+  for (std::size_t i = 0; i < s.size(); ++i) coverage.push_back(0.1f * static_cast<float>(i));
+  container::FormatId v1 = kVfragFormat;
+  v1.version = 1;
+  container::Writer w(v1, 0);
+  w.AddSection(container::MakeTag("GRID"), EncodeGridSection(s.grid, s.mode));
+  const auto* keys = reinterpret_cast<const std::uint8_t*>(s.keys.data());
+  w.AddSection(container::MakeTag("KEYS"), {keys, keys + 8 * s.size()});
+  const auto* cov = reinterpret_cast<const std::uint8_t*>(coverage.data());
+  w.AddSection(container::MakeTag("COVR"), {cov, cov + 4 * s.size()});
+  auto back = DecodeVfrag(w.Serialize(), "v1.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->coverage.size(), s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(back->coverage[i], Half(coverage[i])) << i;
+  }
+  // Version 2 writes two bytes a voxel.
+  s.coverage.assign(coverage.begin(), coverage.end());
+  const std::vector<std::uint8_t> v2_bytes = EncodeVfrag(s, {});
+  auto v2 = container::Frame::FromBytes(v2_bytes, "v2.vfrag", kVfragFormat);
+  ASSERT_TRUE(v2.ok()) << v2.status().message();
+  EXPECT_EQ(v2->version(), 2u);
+  const auto* section = v2->Find(container::MakeTag("COVR"));
+  ASSERT_NE(section, nullptr);
+  EXPECT_EQ(section->size, 2 * s.size());
 }
 
 TEST(Vfrag, RejectsUnsortedOrOutOfGridKeysAndCorruption) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "svokit/core/grid_transform.hpp"
+#include "svokit/core/half.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/vec.hpp"
 
@@ -23,10 +24,11 @@ struct VoxelSet {
   std::vector<std::uint64_t> keys;  ///< sorted ascending, unique
   /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
   /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
-  /// voxel² (its coverage). Empty when not requested.
+  /// voxel² (its coverage, in binary16: a weight needs no more, and 2 bytes a voxel count at the
+  /// voxelizer's peak). Empty when not requested.
   std::vector<Rgba> colors;
   std::vector<Vec3f> normals;
-  std::vector<float> coverage;
+  std::vector<Half> coverage;
   /// Non-fatal findings of the voxelization (e.g. a texture that could not be decoded, so its
   /// materials used their base colour). Not stored in files.
   std::vector<std::string> warnings;
