@@ -105,10 +105,28 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
     if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
     cells[c] = Premultiply(b);
   }
+  const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
+  const int span = side - 1;  // points per voxel edge
+  // Only the points of the bricks that exist (a surface fills about half the children).
+  std::array<bool, 125> needed{};
+  for (unsigned ch = 0; ch < 8; ++ch) {
+    if (!(parent.child_mask & (1u << ch))) continue;
+    const int ex = static_cast<int>(ch & 1) * span, ey = static_cast<int>((ch >> 1) & 1) * span,
+              ez = static_cast<int>((ch >> 2) & 1) * span;
+    for (int sz = 0; sz < side; ++sz) {
+      for (int sy = 0; sy < side; ++sy) {
+        for (int sx = 0; sx < side; ++sx) {
+          needed[static_cast<std::size_t>((ex + sx) + points * ((ey + sy) + points * (ez + sz)))] =
+              true;
+        }
+      }
+    }
+  }
   std::array<EncodedSample, 125> encoded;
   for (int z = 0; z < points; ++z) {
     for (int y = 0; y < points; ++y) {
       for (int x = 0; x < points; ++x) {
+        if (!needed[static_cast<std::size_t>(x + points * (y + points * z))]) continue;
         // Per axis, the block cells whose closed cube holds the point, in ascending position (the
         // same operands in the same order for every node that computes this point).
         int lo[3], hi[3];
@@ -134,8 +152,6 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
       }
     }
   }
-  const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
-  const int span = side - 1;  // points per voxel edge
   for (unsigned ch = 0; ch < 8; ++ch) {
     if (!(parent.child_mask & (1u << ch))) continue;
     const int ex = static_cast<int>(ch & 1) * span, ey = static_cast<int>((ch >> 1) & 1) * span,
@@ -162,38 +178,53 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
   // Parent sample k sits at lattice index cell + 2k over the block; its tent reads indices
   // [cell − 1, cell − 1 + n): only those lattice points are decoded.
   const int lo = cell - 1, n = 2 * side + 1;
+  // Zero between calls: each call clears the points it filled (a full clear per node cost more
+  // than the filter).
   static thread_local std::vector<PremultipliedSample> lattice;
   static thread_local std::vector<std::uint8_t> filled;
-  lattice.assign(static_cast<std::size_t>(n * n * n), PremultipliedSample{});
-  filled.assign(lattice.size(), 0);
+  static thread_local std::vector<std::uint32_t> filled_points;
+  lattice.resize(static_cast<std::size_t>(n * n * n));
+  filled.resize(lattice.size());
+  filled_points.clear();
   const auto at = [n](int x, int y, int z) {
     return static_cast<std::size_t>(x + n * (y + n * z));
   };
   const std::uint32_t samples = svo.brick_samples();
   const SvoLevel& finer = svo.levels[level + 1];
+  // Per block cell b (per axis), the range of its sample indices that land inside the window:
+  // lattice index (b − 1)·cell + k − lo in [0, n). Most cells of the 6³ block have none.
+  int first_k[kBlock], last_k[kBlock];
+  for (int b = 0; b < kBlock; ++b) {
+    const int offset = (b - 1) * cell - lo;
+    first_k[b] = std::max(0, -offset);
+    last_k[b] = std::min(side - 1, n - 1 - offset);
+  }
   for (int bz = 0; bz < kBlock; ++bz) {
+    if (first_k[bz] > last_k[bz]) continue;
     for (int by = 0; by < kBlock; ++by) {
+      if (first_k[by] > last_k[by]) continue;
       for (int bx = 0; bx < kBlock; ++bx) {
+        if (first_k[bx] > last_k[bx]) continue;
         const std::int64_t f = block[BlockIndex(bx, by, bz)];
         if (f < 0) continue;
         // Samples shared with a neighbour brick are equal: each point is decoded once.
         const std::size_t first = static_cast<std::size_t>(f) * samples;
-        for (int nz = 0; nz < side; ++nz) {
+        for (int nz = first_k[bz]; nz <= last_k[bz]; ++nz) {
           const int z = (bz - 1) * cell + nz - lo;
-          if (z < 0 || z >= n) continue;
-          for (int ny = 0; ny < side; ++ny) {
+          for (int ny = first_k[by]; ny <= last_k[by]; ++ny) {
             const int y = (by - 1) * cell + ny - lo;
-            if (y < 0 || y >= n) continue;
-            for (int nx = 0; nx < side; ++nx) {
+            for (int nx = first_k[bx]; nx <= last_k[bx]; ++nx) {
               const int x = (bx - 1) * cell + nx - lo;
               const std::size_t i = first + static_cast<std::size_t>(nx + side * (ny + side * nz));
-              if (x < 0 || x >= n || finer.opacity[i] == 0 || filled[at(x, y, z)]) continue;
-              filled[at(x, y, z)] = 1;
+              const std::size_t p = at(x, y, z);
+              if (finer.opacity[i] == 0 || filled[p]) continue;
+              filled[p] = 1;
+              filled_points.push_back(static_cast<std::uint32_t>(p));
               BrickSample s;
               s.opacity = DecodeUnorm8(finer.opacity[i]);
               if (svo.has_color) s.color = DecodeColor(finer.color[i]);
               if (svo.has_normal) s.normal = DecodeNormal(finer.normal[i]);
-              lattice[at(x, y, z)] = Premultiply(s);
+              lattice[p] = Premultiply(s);
             }
           }
         }
@@ -235,6 +266,10 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
               node * samples + static_cast<std::size_t>(x + side * (y + side * k)), out);
       }
     }
+  }
+  for (const std::uint32_t p : filled_points) {
+    lattice[p] = PremultipliedSample{};
+    filled[p] = 0;
   }
 }
 
