@@ -22,23 +22,16 @@ constexpr std::size_t BlockIndex(int x, int y, int z) {
   return static_cast<std::size_t>(x + kBlock * (y + kBlock * z));
 }
 
-Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index, std::uint64_t node,
-                     std::uint64_t key) {
+// The block of a level-L node from its 27 neighbours (level-L indices, −1 where absent, in
+// (x, y, z) order with x fastest): each neighbour's children at their block positions.
+Block FillBlock(const std::vector<SvoNode>& nodes, const std::array<std::int64_t, 27>& neighbours) {
   Block block;
   block.fill(-1);
-  const MortonCoord c = MortonDecode(key);
-  const std::int64_t limit = std::int64_t{1} << level;
-  const std::vector<SvoNode>& nodes = svo.levels[level].nodes;
   for (int oz = -1; oz <= 1; ++oz) {
     for (int oy = -1; oy <= 1; ++oy) {
       for (int ox = -1; ox <= 1; ++ox) {
-        const std::int64_t x = c.x + ox, y = c.y + oy, z = c.z + oz;
-        if (x < 0 || y < 0 || z < 0 || x >= limit || y >= limit || z >= limit) continue;
-        const std::int64_t q = (ox | oy | oz) == 0
-                                   ? static_cast<std::int64_t>(node)
-                                   : index.Find(MortonEncode(static_cast<std::uint32_t>(x),
-                                                             static_cast<std::uint32_t>(y),
-                                                             static_cast<std::uint32_t>(z)));
+        const std::int64_t q =
+            neighbours[static_cast<std::size_t>((ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1)))];
         if (q < 0) continue;
         const SvoNode& n = nodes[static_cast<std::size_t>(q)];
         for (unsigned ch = 0; ch < 8; ++ch) {
@@ -51,6 +44,49 @@ Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index,
     }
   }
   return block;
+}
+
+// The block of `node` (level `level`, Morton `key`), its neighbours found by key lookups.
+Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index, std::uint64_t node,
+                     std::uint64_t key) {
+  std::array<std::int64_t, 27> neighbours;
+  const MortonCoord c = MortonDecode(key);
+  const std::int64_t limit = std::int64_t{1} << level;
+  for (int oz = -1; oz <= 1; ++oz) {
+    for (int oy = -1; oy <= 1; ++oy) {
+      for (int ox = -1; ox <= 1; ++ox) {
+        const std::int64_t x = c.x + ox, y = c.y + oy, z = c.z + oz;
+        std::int64_t& q =
+            neighbours[static_cast<std::size_t>((ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1)))];
+        if (x < 0 || y < 0 || z < 0 || x >= limit || y >= limit || z >= limit) {
+          q = -1;
+        } else {
+          q = (ox | oy | oz) == 0 ? static_cast<std::int64_t>(node)
+                                  : index.Find(MortonEncode(static_cast<std::uint32_t>(x),
+                                                            static_cast<std::uint32_t>(y),
+                                                            static_cast<std::uint32_t>(z)));
+        }
+      }
+    }
+  }
+  return FillBlock(svo.levels[level].nodes, neighbours);
+}
+
+// The block of the child `ch` of a node whose block is `parent`: the child's neighbours are
+// the 3³ window of `parent` around the child's own position (2 + bit per axis).
+Block ChildBlock(const Svo& svo, std::uint32_t child_level, const Block& parent, unsigned ch) {
+  std::array<std::int64_t, 27> neighbours;
+  const int bx = 1 + static_cast<int>(ch & 1), by = 1 + static_cast<int>((ch >> 1) & 1),
+            bz = 1 + static_cast<int>((ch >> 2) & 1);
+  for (int z = 0; z < 3; ++z) {
+    for (int y = 0; y < 3; ++y) {
+      for (int x = 0; x < 3; ++x) {
+        neighbours[static_cast<std::size_t>(x + 3 * (y + 3 * z))] =
+            parent[BlockIndex(bx + x, by + y, bz + z)];
+      }
+    }
+  }
+  return FillBlock(svo.levels[child_level].nodes, neighbours);
 }
 
 void Accumulate(PremultipliedSample& acc, const PremultipliedSample& v, float w) {
@@ -301,16 +337,32 @@ BrickSample Unpremultiply(const PremultipliedSample& p) {
 
 namespace {
 
-// Calls body(block, i) for every node i of `level`, in fixed-size chunks over TBB: each node writes
-// its own samples only, so the result does not depend on the thread count.
+// Calls body(block, i) for every node i of `level`. Blocks are derived top-down: key lookups
+// for the nodes three levels up only, then each child's block from the 3³ window of its parent's
+// (no hashing on the big levels). Subtrees spread over TBB; each node writes its own samples
+// only, so the result does not depend on the thread count or the visiting order.
 template <class Body>
 void EachNode(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
               std::uint32_t level, const Body& body) {
-  const KeyIndex index(level_keys[level]);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[level].size(), 256),
+  const std::uint32_t top = level >= 3 ? level - 3 : 0;
+  const KeyIndex index(level_keys[top]);
+  const auto visit = [&](const auto& self, std::uint32_t l, std::size_t node,
+                         const Block& block) -> void {
+    if (l == level) {
+      body(block, node);
+      return;
+    }
+    const SvoNode& n = svo.levels[l].nodes[node];
+    for (unsigned ch = 0; ch < 8; ++ch) {
+      if (!(n.child_mask & (1u << ch))) continue;
+      self(self, l + 1, n.Child(ch), ChildBlock(svo, l + 1, block, ch));
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[top].size(), 4),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        body(GatherChildren(svo, level, index, i, level_keys[level][i]), i);
+                        visit(visit, top, i,
+                              GatherChildren(svo, top, index, i, level_keys[top][i]));
                       }
                     });
 }
