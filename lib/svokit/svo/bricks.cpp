@@ -34,11 +34,12 @@ Block FillBlock(const std::vector<SvoNode>& nodes, const std::array<std::int64_t
             neighbours[static_cast<std::size_t>((ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1)))];
         if (q < 0) continue;
         const SvoNode& n = nodes[static_cast<std::size_t>(q)];
+        std::int64_t child = n.first_child;  // children are stored in child-bit order
         for (unsigned ch = 0; ch < 8; ++ch) {
           if (!(n.child_mask & (1u << ch))) continue;
           block[BlockIndex(2 * ox + static_cast<int>(ch & 1) + 2,
                            2 * oy + static_cast<int>((ch >> 1) & 1) + 2,
-                           2 * oz + static_cast<int>((ch >> 2) & 1) + 2)] = n.Child(ch);
+                           2 * oz + static_cast<int>((ch >> 2) & 1) + 2)] = child++;
         }
       }
     }
@@ -309,34 +310,6 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
   }
 }
 
-}  // namespace
-
-PremultipliedSample Premultiply(const BrickSample& s) {
-  const float o = s.opacity;
-  return {o,
-          s.color.r * o,
-          s.color.g * o,
-          s.color.b * o,
-          s.color.a * o,
-          s.normal.x * o,
-          s.normal.y * o,
-          s.normal.z * o};
-}
-
-BrickSample Unpremultiply(const PremultipliedSample& p) {
-  BrickSample s;
-  s.opacity = p.opacity;
-  if (p.opacity > 0) {
-    const float inv = 1.f / p.opacity;
-    s.color = {p.r * inv, p.g * inv, p.b * inv, p.a * inv};
-    const float len = std::sqrt(p.nx * p.nx + p.ny * p.ny + p.nz * p.nz);
-    if (len > 1e-12f) s.normal = {p.nx / len, p.ny / len, p.nz / len};
-  }
-  return s;
-}
-
-namespace {
-
 // Calls body(block, i) for every node i of `level`. Blocks are derived top-down: key lookups
 // for the nodes three levels up only, then each child's block from the 3³ window of its parent's
 // (no hashing on the big levels). Subtrees spread over TBB; each node writes its own samples
@@ -353,9 +326,10 @@ void EachNode(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& lev
       return;
     }
     const SvoNode& n = svo.levels[l].nodes[node];
+    std::size_t child = n.first_child;
     for (unsigned ch = 0; ch < 8; ++ch) {
       if (!(n.child_mask & (1u << ch))) continue;
-      self(self, l + 1, n.Child(ch), ChildBlock(svo, l + 1, block, ch));
+      self(self, l + 1, child++, ChildBlock(svo, l + 1, block, ch));
     }
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[top].size(), 4),
