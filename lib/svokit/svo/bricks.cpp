@@ -133,14 +133,20 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
   const int side = static_cast<int>(svo.brick_side);
   const int points = 2 * side - 1;     // per axis, over the 2 children
   const int step = side == 3 ? 1 : 2;  // point spacing in half voxels
+  // The points lie within block cells 1..4 per axis (the children and one neighbour layer).
   std::array<PremultipliedSample, kBlock * kBlock * kBlock> cells;
-  for (std::size_t c = 0; c < cells.size(); ++c) {
-    if (block[c] < 0) continue;
-    BrickSample b;
-    b.opacity = 1;
-    if (color) b.color = voxels->colors[static_cast<std::size_t>(block[c])];
-    if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
-    cells[c] = Premultiply(b);
+  for (int cz = 1; cz <= 4; ++cz) {
+    for (int cy = 1; cy <= 4; ++cy) {
+      for (int cx = 1; cx <= 4; ++cx) {
+        const std::size_t c = BlockIndex(cx, cy, cz);
+        if (block[c] < 0) continue;
+        BrickSample b;
+        b.opacity = 1;
+        if (color) b.color = voxels->colors[static_cast<std::size_t>(block[c])];
+        if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
+        cells[c] = Premultiply(b);
+      }
+    }
   }
   const SvoNode& parent = svo.levels[svo.depth - 1].nodes[node];
   const int span = side - 1;  // points per voxel edge
@@ -206,6 +212,28 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
   }
 }
 
+// Premultiply(decoded sample i of `lv`), without the straight sample in between (the same
+// products: absent colour and normal stay 0).
+PremultipliedSample DecodePremultiplied(const SvoLevel& lv, std::size_t i, bool color,
+                                        bool normal) {
+  PremultipliedSample p;
+  const float o = p.opacity = DecodeUnorm8(lv.opacity[i]);
+  if (color) {
+    const Rgba c = DecodeColor(lv.color[i]);
+    p.r = c.r * o;
+    p.g = c.g * o;
+    p.b = c.b * o;
+    p.a = c.a * o;
+  }
+  if (normal) {
+    const Vec3f n = DecodeNormal(lv.normal[i]);
+    p.nx = n.x * o;
+    p.ny = n.y * o;
+    p.nz = n.z * o;
+  }
+  return p;
+}
+
 // The brick of `node` at `level` from the stored level + 1 bricks in `block`, into `out`: the finer
 // bricks are decoded onto one lattice over the block, then filtered by the separable tent.
 void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::uint64_t node,
@@ -257,11 +285,7 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
               if (finer.opacity[i] == 0 || filled[p]) continue;
               filled[p] = 1;
               filled_points.push_back(static_cast<std::uint32_t>(p));
-              BrickSample s;
-              s.opacity = DecodeUnorm8(finer.opacity[i]);
-              if (svo.has_color) s.color = DecodeColor(finer.color[i]);
-              if (svo.has_normal) s.normal = DecodeNormal(finer.normal[i]);
-              lattice[p] = Premultiply(s);
+              lattice[p] = DecodePremultiplied(finer, i, svo.has_color, svo.has_normal);
             }
           }
         }
