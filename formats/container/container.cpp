@@ -38,21 +38,18 @@ void Writer::AddSection(Tag tag, std::vector<std::uint8_t> bytes) {
 }
 
 void Writer::AddSectionView(Tag tag, std::span<const std::uint8_t> bytes) {
-  sections_.push_back({tag, {}, bytes});
+  sections_.push_back({tag, {}, bytes, {}});
 }
 
-std::vector<std::uint8_t> Writer::HeaderAndTable(std::vector<std::uint64_t>& offsets) const {
+void Writer::AddSectionProduced(Tag tag, Producer produce) {
+  sections_.push_back({tag, {}, {}, std::move(produce)});
+}
+
+std::vector<std::uint8_t> Writer::HeaderAndTable(const std::vector<Placed>& placed) const {
   const std::size_t table_end = kHeaderSize + kSectionEntrySize * sections_.size();
-  offsets.clear();
-  std::size_t end = AlignUp(table_end);
-  for (const Section& s : sections_) {
-    offsets.push_back(end);
-    end = AlignUp(end + s.bytes.size());
-  }
   // The file ends right after the last section (no trailing padding).
   const std::size_t file_size =
-      sections_.empty() ? table_end : offsets.back() + sections_.back().bytes.size();
-
+      placed.empty() ? table_end : placed.back().offset + placed.back().size;
   ByteWriter w;
   w.PutArray<char>(format_.magic);
   w.Put(format_.version);
@@ -61,12 +58,11 @@ std::vector<std::uint8_t> Writer::HeaderAndTable(std::vector<std::uint64_t>& off
   w.Put(static_cast<std::uint32_t>(sections_.size()));
   w.Put(std::uint32_t{0});  // header CRC, patched below
   for (std::size_t i = 0; i < sections_.size(); ++i) {
-    const Section& s = sections_[i];
-    w.PutArray<char>(s.tag);
+    w.PutArray<char>(sections_[i].tag);
     w.Put(std::uint32_t{0});
-    w.Put(offsets[i]);
-    w.Put(static_cast<std::uint64_t>(s.bytes.size()));
-    w.Put(Crc32c(s.bytes.data(), s.bytes.size()));
+    w.Put(placed[i].offset);
+    w.Put(placed[i].size);
+    w.Put(placed[i].crc);
     w.Put(std::uint32_t{0});
   }
   std::vector<std::uint8_t>& out = w.bytes();
@@ -76,34 +72,57 @@ std::vector<std::uint8_t> Writer::HeaderAndTable(std::vector<std::uint64_t>& off
   return std::move(out);
 }
 
-template <class Sink>
-Status Writer::Emit(const Sink& sink) const {
-  std::vector<std::uint64_t> offsets;
-  const std::vector<std::uint8_t> head = HeaderAndTable(offsets);
-  SVOKIT_RETURN_IF_ERROR(sink(std::span<const std::uint8_t>(head)));
-  std::uint64_t pos = head.size();
+template <class Sink, class Patch>
+Status Writer::EmitFile(const Sink& sink, const Patch& patch) const {
   static constexpr std::uint8_t kZeros[kAlignment] = {};
-  for (std::size_t i = 0; i < sections_.size(); ++i) {
-    SVOKIT_RETURN_IF_ERROR(sink(std::span<const std::uint8_t>(kZeros, offsets[i] - pos)));
-    SVOKIT_RETURN_IF_ERROR(sink(sections_[i].bytes));
-    pos = offsets[i] + sections_[i].bytes.size();
+  std::uint64_t pos = 0;
+  auto put = [&](std::span<const std::uint8_t> run) {
+    pos += run.size();
+    return sink(run);
+  };
+  // Placeholder for header and table.
+  for (std::size_t left = kHeaderSize + kSectionEntrySize * sections_.size(); left > 0;) {
+    const std::size_t n = std::min(left, kAlignment);
+    SVOKIT_RETURN_IF_ERROR(put({kZeros, n}));
+    left -= n;
   }
-  return Status::Ok();
+  std::vector<Placed> placed(sections_.size());
+  for (std::size_t i = 0; i < sections_.size(); ++i) {
+    SVOKIT_RETURN_IF_ERROR(put({kZeros, AlignUp(pos) - pos}));
+    Placed& p = placed[i];
+    p.offset = pos;
+    const Emit emit = [&](std::span<const std::uint8_t> piece) {
+      p.crc = Crc32c(piece.data(), piece.size(), p.crc);
+      p.size += piece.size();
+      return put(piece);
+    };
+    SVOKIT_RETURN_IF_ERROR(sections_[i].produce ? sections_[i].produce(emit)
+                                                : emit(sections_[i].bytes));
+  }
+  return patch(std::span<const std::uint8_t>(HeaderAndTable(placed)));
 }
 
 std::vector<std::uint8_t> Writer::Serialize() const {
   std::vector<std::uint8_t> out;
-  (void)Emit([&](std::span<const std::uint8_t> run) {
-    out.insert(out.end(), run.begin(), run.end());
-    return Status::Ok();
-  });
+  const Status status = EmitFile(
+      [&](std::span<const std::uint8_t> run) {
+        out.insert(out.end(), run.begin(), run.end());
+        return Status::Ok();
+      },
+      [&](std::span<const std::uint8_t> head) {
+        std::copy(head.begin(), head.end(), out.begin());
+        return Status::Ok();
+      });
+  if (!status.ok()) out.clear();
   return out;
 }
 
 Status Writer::WriteFile(const std::filesystem::path& path) const {
   AtomicFileWriter file(path);
   SVOKIT_RETURN_IF_ERROR(file.Open());
-  SVOKIT_RETURN_IF_ERROR(Emit([&](std::span<const std::uint8_t> run) { return file.Write(run); }));
+  SVOKIT_RETURN_IF_ERROR(
+      EmitFile([&](std::span<const std::uint8_t> run) { return file.Write(run); },
+               [&](std::span<const std::uint8_t> head) { return file.WriteAt(0, head); }));
   return file.Commit();
 }
 

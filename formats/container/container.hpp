@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -41,6 +42,13 @@ class Writer {
   /// A section whose bytes stay owned by the caller (no copy of large arrays); they must outlive
   /// the Writer.
   void AddSectionView(Tag tag, std::span<const std::uint8_t> bytes);
+  /// Receives a produced section's bytes, piece by piece.
+  using Emit = std::function<Status(std::span<const std::uint8_t>)>;
+  /// Calls `emit` once per piece of the payload, in order; may fail.
+  using Producer = std::function<Status(const Emit& emit)>;
+  /// A section encoded while the file is written (e.g. compressed keys): its whole payload is
+  /// never held in memory. Producers run once per Serialize() or WriteFile().
+  void AddSectionProduced(Tag tag, Producer produce);
   /// The whole file as bytes.
   std::vector<std::uint8_t> Serialize() const;
   /// Streams the file to a temporary beside `path` and renames it into place.
@@ -51,12 +59,19 @@ class Writer {
     Tag tag;
     std::vector<std::uint8_t> owned;
     std::span<const std::uint8_t> bytes;  // into `owned` or the caller's memory
+    Producer produce;                     // set: the bytes come from here instead
   };
-  /// Header and section table, followed by each section's offset.
-  std::vector<std::uint8_t> HeaderAndTable(std::vector<std::uint64_t>& offsets) const;
-  /// Emits the file as a sequence of byte runs (header, padding, payloads).
-  template <class Sink>
-  Status Emit(const Sink& sink) const;
+  struct Placed {
+    std::uint64_t offset = 0, size = 0;
+    std::uint32_t crc = 0;
+  };
+  /// Header and section table for sections placed as given.
+  std::vector<std::uint8_t> HeaderAndTable(const std::vector<Placed>& placed) const;
+  /// Emits the file as a sequence of byte runs (a zero placeholder for header and table, padding,
+  /// payloads) to `sink`, then the real header and table to `patch` (at offset 0): sizes and
+  /// checksums are known once the payloads have passed.
+  template <class Sink, class Patch>
+  Status EmitFile(const Sink& sink, const Patch& patch) const;
   FormatId format_;
   std::uint32_t flags_;
   std::vector<Section> sections_;

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <nlohmann/json.hpp>
 
 #include "formats/container/bytes.hpp"
 #include "formats/container/grid_section.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/half.hpp"
+#include "svokit/core/parallel.hpp"
 
 namespace svokit {
 
@@ -26,19 +29,77 @@ std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
   return {reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)};
 }
 
-// An optional per-voxel array: absent, or exactly one T per voxel.
+// An optional per-voxel array: absent, or exactly `per_voxel` T per voxel.
 template <class T>
 Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                    std::vector<T>& out) {
+                    std::vector<T>& out, std::size_t per_voxel = 1) {
   const auto section = file.Find(tag);
   if (!section) return Status::Ok();
-  if (section->size() != voxels * sizeof(T)) {
+  const std::size_t expected = voxels * per_voxel * sizeof(T);
+  if (section->size() != expected) {
     return Status::BadInput("{}: section '{}' holds {} bytes, expected {} for {} voxels",
                             file.name(), std::string(tag.begin(), tag.end()), section->size(),
-                            voxels * sizeof(T), voxels);
+                            expected, voxels);
   }
   ByteReader r(*section, file.name());
-  return r.GetArray(out, voxels);
+  return r.GetArray(out, voxels * per_voxel);
+}
+
+// Version 3 KEYS: u64 count, then per key the gap to the previous one minus one (the first key
+// itself) as an LEB128 varint: sorted surface voxels are mostly a few apart, ~1.3 bytes a key.
+Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
+                  std::vector<std::uint64_t>& keys) {
+  ByteReader r(bytes, name + ": KEYS section");
+  std::uint64_t count = 0;
+  SVOKIT_RETURN_IF_ERROR(r.Get(count));
+  const std::size_t size = bytes.size();
+  if (count > size - sizeof(count)) {  // every key takes at least one byte
+    return Status::BadInput("{}: KEYS section claims {} keys in {} bytes", name, count, size);
+  }
+  keys.resize(count);
+  const std::uint8_t* p = bytes.data() + sizeof(count);
+  const std::uint8_t* end = bytes.data() + size;
+  std::uint64_t prev = ~std::uint64_t{0};  // the first gap is the first key
+  for (std::uint64_t i = 0; i < count; ++i) {
+    std::uint64_t gap = 0;
+    for (int shift = 0;; shift += 7) {
+      // At most 10 bytes; the tenth carries bit 63 only.
+      if (p == end || (shift == 63 && *p > 1)) {
+        return Status::BadInput("{}: KEYS section ends inside or holds a malformed key {}", name,
+                                i);
+      }
+      const std::uint8_t byte = *p++;
+      gap |= std::uint64_t{byte & 0x7fu} << shift;
+      if (!(byte & 0x80u)) break;
+    }
+    // A writer given a smaller key after a larger one wraps the gap to 2^63 or more. Keys with
+    // bit 63 set are refused by the grid check, so the sum cannot wrap unnoticed.
+    if (gap >> 63) {
+      return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
+    }
+    keys[i] = prev = prev + 1 + gap;
+  }
+  if (p != end) return Status::BadInput("{}: KEYS section has {} trailing bytes", name, end - p);
+  return Status::Ok();
+}
+
+// Version 3 COLR / NORM: the float components as binary16 (the voxelizer rounds them so).
+template <class T>
+Status ReadHalves(const container::Reader& file, container::Tag tag, std::size_t voxels,
+                  std::vector<T>& out) {
+  constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
+  std::vector<std::uint16_t> bits;
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, tag, voxels, bits, kComponents));
+  if (bits.empty()) return Status::Ok();
+  out.resize(voxels);
+  ParallelChunks(voxels, 1 << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      float f[kComponents];
+      for (std::size_t c = 0; c < kComponents; ++c) f[c] = HalfBitsToFloat(bits[i * kComponents + c]);
+      std::memcpy(&out[i], f, sizeof(T));
+    }
+  });
+  return Status::Ok();
 }
 
 StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, VfragMetadata* meta) {
@@ -52,23 +113,34 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
   VoxelSet set;
   SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, name, set.grid, set.mode));
   const auto& dims = set.grid.dims();
-  if (keys->size() % sizeof(std::uint64_t) != 0) {
-    return Status::BadInput("{}: KEYS section size is not a multiple of 8", name);
-  }
-  ByteReader k(*keys, name + ": KEYS section");
-  SVOKIT_RETURN_IF_ERROR(k.GetArray(set.keys, keys->size() / sizeof(std::uint64_t)));
-  for (std::size_t i = 0; i < set.keys.size(); ++i) {
-    if (i > 0 && set.keys[i] <= set.keys[i - 1]) {
-      return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
+  if (file->version() >= 3) {
+    SVOKIT_RETURN_IF_ERROR(DecodeKeys(*keys, name, set.keys));
+  } else {  // versions 1 and 2: raw u64 keys
+    if (keys->size() % sizeof(std::uint64_t) != 0) {
+      return Status::BadInput("{}: KEYS section size is not a multiple of 8", name);
     }
+    ByteReader k(*keys, name + ": KEYS section");
+    SVOKIT_RETURN_IF_ERROR(k.GetArray(set.keys, keys->size() / sizeof(std::uint64_t)));
+    for (std::size_t i = 1; i < set.keys.size(); ++i) {
+      if (set.keys[i] <= set.keys[i - 1]) {
+        return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < set.keys.size(); ++i) {
     const MortonCoord c = MortonDecode(set.keys[i]);
     if (set.keys[i] >> 63 || c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) {
       return Status::BadInput("{}: voxel {} lies outside the {}x{}x{} grid", name, i, dims[0],
                               dims[1], dims[2]);
     }
   }
-  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
-  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
+  if (file->version() >= 3) {
+    SVOKIT_RETURN_IF_ERROR(ReadHalves(*file, kColors, set.keys.size(), set.colors));
+    SVOKIT_RETURN_IF_ERROR(ReadHalves(*file, kNormals, set.keys.size(), set.normals));
+  } else {  // versions 1 and 2: f32
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
+  }
   if (file->version() >= 2) {
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
   } else {  // version 1 stored coverage as f32
@@ -101,13 +173,76 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
 
 namespace {
 
-// The container borrows the keys (the largest array); `set` must outlive the returned writer.
+// A per-voxel section encoded while it is written, a batch of chunks at a time, the chunks of a
+// batch in parallel: encode(begin, end, out) appends voxels [begin, end)'s bytes to out.
+template <class Encode>
+container::Writer::Producer Chunked(std::size_t voxels, Encode encode) {
+  return [voxels, encode](const container::Writer::Emit& emit) -> Status {
+    constexpr std::size_t kChunk = 1 << 15, kBatch = 16;
+    std::vector<std::vector<std::uint8_t>> pieces(kBatch);
+    for (std::size_t first = 0; first < voxels; first += kChunk * kBatch) {
+      const std::size_t chunks = std::min(kBatch, (voxels - first + kChunk - 1) / kChunk);
+      ParallelChunks(chunks, 1, [&](std::size_t c0, std::size_t c1) {
+        for (std::size_t c = c0; c < c1; ++c) {
+          const std::size_t begin = first + c * kChunk;
+          pieces[c].clear();
+          encode(begin, std::min(voxels, begin + kChunk), pieces[c]);
+        }
+      });
+      for (std::size_t c = 0; c < chunks; ++c) SVOKIT_RETURN_IF_ERROR(emit(pieces[c]));
+    }
+    return Status::Ok();
+  };
+}
+
+container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys) {
+  const std::uint64_t count = keys.size();
+  auto varints = Chunked(keys.size(), [&keys](std::size_t begin, std::size_t end,
+                                              std::vector<std::uint8_t>& out) {
+    std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
+    for (std::size_t i = begin; i < end; ++i) {
+      std::uint64_t gap = keys[i] - prev - 1;
+      prev = keys[i];
+      while (gap >= 0x80u) {
+        out.push_back(static_cast<std::uint8_t>(gap | 0x80u));
+        gap >>= 7;
+      }
+      out.push_back(static_cast<std::uint8_t>(gap));
+    }
+  });
+  return [count, varints](const container::Writer::Emit& emit) -> Status {
+    std::uint8_t head[sizeof(count)];
+    std::memcpy(head, &count, sizeof(count));
+    SVOKIT_RETURN_IF_ERROR(emit(head));
+    return varints(emit);
+  };
+}
+
+template <class T>
+container::Writer::Producer HalvesProducer(const std::vector<T>& values) {
+  return Chunked(values.size(), [&values](std::size_t begin, std::size_t end,
+                                          std::vector<std::uint8_t>& out) {
+    constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
+    out.resize((end - begin) * kComponents * 2);
+    std::uint8_t* o = out.data();
+    for (std::size_t i = begin; i < end; ++i) {
+      float f[kComponents];
+      std::memcpy(f, &values[i], sizeof(T));
+      for (std::size_t c = 0; c < kComponents; ++c, o += 2) {
+        const std::uint16_t h = FloatToHalfBits(f[c]);
+        std::memcpy(o, &h, 2);
+      }
+    }
+  });
+}
+
+// The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
-  file.AddSectionView(kKeys, Bytes(set.keys));
-  if (set.has_colors()) file.AddSectionView(kColors, Bytes(set.colors));
-  if (set.has_normals()) file.AddSectionView(kNormals, Bytes(set.normals));
+  file.AddSectionProduced(kKeys, KeysProducer(set.keys));
+  if (set.has_colors()) file.AddSectionProduced(kColors, HalvesProducer(set.colors));
+  if (set.has_normals()) file.AddSectionProduced(kNormals, HalvesProducer(set.normals));
   if (!set.coverage.empty()) file.AddSectionView(kCoverage, Bytes(set.coverage));
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};

@@ -42,11 +42,25 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
     s.normals.push_back({0, f, 1});
     s.coverage.push_back(f * 2);
   }
+  // Colours and normals are stored as binary16: each component comes back as its nearest one.
   auto back = DecodeVfrag(EncodeVfrag(s, {}), "attr.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->colors.size(), s.size());
+  ASSERT_EQ(back->normals.size(), s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Rgba& c = s.colors[i];
+    EXPECT_EQ(back->colors[i], (Rgba{RoundToHalf(c.r), RoundToHalf(c.g), RoundToHalf(c.b), 1}));
+    EXPECT_EQ(back->normals[i], (Vec3f{0, RoundToHalf(s.normals[i].y), 1}));
+    EXPECT_NEAR(back->colors[i].r, c.r, c.r / 2048);
+  }
+  EXPECT_EQ(back->coverage, s.coverage);
+  // Values already in binary16 precision (what the voxelizer produces) round-trip exactly.
+  s.colors = back->colors;
+  s.normals = back->normals;
+  back = DecodeVfrag(EncodeVfrag(s, {}), "attr2.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->colors, s.colors);
   EXPECT_EQ(back->normals, s.normals);
-  EXPECT_EQ(back->coverage, s.coverage);
   s.colors.pop_back();
   auto bad = DecodeVfrag(EncodeVfrag(s, {}), "short.vfrag");
   ASSERT_FALSE(bad.ok());
@@ -57,34 +71,132 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
   EXPECT_NE(bad.status().message().find("non-finite"), std::string::npos);
 }
 
-// Version 1 stored coverage as f32 (version 2: binary16); a version 2 reader still reads it.
+template <class T>
+std::vector<std::uint8_t> RawBytes(const std::vector<T>& v) {
+  const auto* p = reinterpret_cast<const std::uint8_t*>(v.data());
+  return {p, p + v.size() * sizeof(T)};
+}
+
+// A file of an earlier version, as its writer laid it out: raw u64 keys, f32 colours and normals,
+// coverage as `Coverage` (f32 in version 1, binary16 in version 2).
+template <class Coverage>
+std::vector<std::uint8_t> LegacyFile(std::uint32_t version, const VoxelSet& s,
+                                     const std::vector<Coverage>& coverage) {
+  container::FormatId format = kVfragFormat;
+  format.version = version;
+  container::Writer w(format, 0);
+  w.AddSection(container::MakeTag("GRID"), EncodeGridSection(s.grid, s.mode));
+  w.AddSection(container::MakeTag("KEYS"), RawBytes(s.keys));
+  if (s.has_colors()) w.AddSection(container::MakeTag("COLR"), RawBytes(s.colors));
+  if (s.has_normals()) w.AddSection(container::MakeTag("NORM"), RawBytes(s.normals));
+  w.AddSection(container::MakeTag("COVR"), RawBytes(coverage));
+  return w.Serialize();
+}
+
+// Version 1 stored coverage as f32 (since version 2: binary16); the reader still reads it.
 TEST(Vfrag, Version1CoverageIsReadAsFloat32) {
   VoxelSet s = Sample();
   std::vector<float> coverage;
   for (std::size_t i = 0; i < s.size(); ++i) coverage.push_back(0.1f * static_cast<float>(i));
-  container::FormatId v1 = kVfragFormat;
-  v1.version = 1;
-  container::Writer w(v1, 0);
-  w.AddSection(container::MakeTag("GRID"), EncodeGridSection(s.grid, s.mode));
-  const auto* keys = reinterpret_cast<const std::uint8_t*>(s.keys.data());
-  w.AddSection(container::MakeTag("KEYS"), {keys, keys + 8 * s.size()});
-  const auto* cov = reinterpret_cast<const std::uint8_t*>(coverage.data());
-  w.AddSection(container::MakeTag("COVR"), {cov, cov + 4 * s.size()});
-  auto back = DecodeVfrag(w.Serialize(), "v1.vfrag");
+  auto back = DecodeVfrag(LegacyFile(1, s, coverage), "v1.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->keys, s.keys);
   ASSERT_EQ(back->coverage.size(), s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     EXPECT_EQ(back->coverage[i], Half(coverage[i])) << i;
   }
-  // Version 2 writes two bytes a voxel.
-  s.coverage.assign(coverage.begin(), coverage.end());
-  const std::vector<std::uint8_t> v2_bytes = EncodeVfrag(s, {});
-  auto v2 = container::Frame::FromBytes(v2_bytes, "v2.vfrag", kVfragFormat);
-  ASSERT_TRUE(v2.ok()) << v2.status().message();
-  EXPECT_EQ(v2->version(), 2u);
-  const auto* section = v2->Find(container::MakeTag("COVR"));
-  ASSERT_NE(section, nullptr);
-  EXPECT_EQ(section->size, 2 * s.size());
+}
+
+// Version 2 stored raw u64 keys and f32 colours and normals; the reader still reads them exactly.
+TEST(Vfrag, Version2RawKeysAndFloatAttributesAreRead) {
+  VoxelSet s = Sample();
+  std::vector<Half> coverage;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const float f = 0.1f + static_cast<float>(i) / 7.f;  // not binary16-representable
+    s.colors.push_back({f, f / 3, 0.25f, 1});
+    s.normals.push_back({f, 0, 1});
+    coverage.push_back(f);
+  }
+  auto back = DecodeVfrag(LegacyFile(2, s, coverage), "v2.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->keys, s.keys);
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_EQ(back->normals, s.normals);
+  EXPECT_EQ(back->coverage, coverage);
+}
+
+// Version 3: per voxel 8 B colour, 6 B normal, 2 B coverage, and keys as varint gaps (spelled out
+// byte by byte here).
+TEST(Vfrag, Version3StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
+  VoxelSet s;
+  s.grid = GridTransform({0, 0, 0}, 1, {(1u << 21) - 1, 1u << 20, 1u << 20});
+  s.keys = {5, 6, 6 + 1 + 200, (std::uint64_t{1} << 60) + 3};
+  s.colors.assign(4, Rgba{0.5f, 0.25f, 1, 1});
+  s.normals.assign(4, Vec3f{0, 0, 1});
+  s.coverage.assign(4, Half(1.f));
+  const std::vector<std::uint8_t> bytes = EncodeVfrag(s, {});
+  auto frame = container::Frame::FromBytes(bytes, "v3.vfrag", kVfragFormat);
+  ASSERT_TRUE(frame.ok()) << frame.status().message();
+  EXPECT_EQ(frame->version(), 3u);
+  const auto* keys = frame->Find(container::MakeTag("KEYS"));
+  ASSERT_NE(keys, nullptr);
+  // count 4; gaps 5, 0, 200 = 0xC8 0x01, 2^60 + 3 − 207 − 1 = 2^60 − 205.
+  std::vector<std::uint8_t> expected = {4, 0, 0, 0, 0, 0, 0, 0, 5, 0, 0xC8, 0x01};
+  for (std::uint64_t gap = (std::uint64_t{1} << 60) - 205; gap >= 0x80; gap >>= 7) {
+    expected.push_back(static_cast<std::uint8_t>(gap | 0x80));
+  }
+  expected.push_back(static_cast<std::uint8_t>(((std::uint64_t{1} << 60) - 205) >> 56));
+  EXPECT_EQ(std::vector<std::uint8_t>(keys->bytes.begin(), keys->bytes.end()), expected);
+  EXPECT_EQ(frame->Find(container::MakeTag("COLR"))->size, 8 * s.size());
+  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 6 * s.size());
+  EXPECT_EQ(frame->Find(container::MakeTag("COVR"))->size, 2 * s.size());
+  auto back = DecodeVfrag(bytes, "v3.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->keys, s.keys);
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_EQ(back->normals, s.normals);
+}
+
+TEST(Vfrag, MalformedKeyVarintsAreRefused) {
+  const VoxelSet s = Sample();
+  auto with_keys = [&](std::vector<std::uint8_t> keys) {
+    container::Writer w(kVfragFormat, 0);
+    w.AddSection(container::MakeTag("GRID"), EncodeGridSection(s.grid, s.mode));
+    w.AddSection(container::MakeTag("KEYS"), std::move(keys));
+    return DecodeVfrag(w.Serialize(), "keys.vfrag");
+  };
+  auto message = [](const StatusOr<VoxelSet>& r) {
+    return r.ok() ? std::string("ok") : r.status().message();
+  };
+  // count 2: keys 1, 3.
+  EXPECT_TRUE(with_keys({2, 0, 0, 0, 0, 0, 0, 0, 1, 1}).ok());
+  EXPECT_NE(message(with_keys({2, 0, 0, 0, 0, 0, 0, 0, 0x81, 0x81})).find("ends inside"),
+            std::string::npos);
+  EXPECT_NE(message(with_keys({2, 0, 0, 0, 0, 0, 0, 0, 1, 0x81})).find("ends inside"),
+            std::string::npos);
+  EXPECT_NE(message(with_keys({2, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0})).find("1 trailing bytes"),
+            std::string::npos);
+  EXPECT_NE(message(with_keys({0xff, 0, 0, 0, 0, 0, 0, 0, 1, 1})).find("claims 255 keys"),
+            std::string::npos);
+  EXPECT_NE(message(with_keys({1, 0, 0})).find("KEYS section"), std::string::npos);
+  // An 11-byte varint, and a 10th byte with more than bit 63.
+  std::vector<std::uint8_t> long_varint = {1, 0, 0, 0, 0, 0, 0, 0};
+  long_varint.insert(long_varint.end(), 10, 0x80);
+  long_varint.push_back(0);
+  EXPECT_NE(message(with_keys(long_varint)).find("malformed key 0"), std::string::npos);
+  std::vector<std::uint8_t> wide = {1, 0, 0, 0, 0, 0, 0, 0};
+  wide.insert(wide.end(), 9, 0x80);
+  wide.push_back(2);
+  EXPECT_NE(message(with_keys(wide)).find("malformed key 0"), std::string::npos);
+  // Gap 2^63 (a decreasing key, wrapped): not increasing; gap 2^62: beyond the grid.
+  std::vector<std::uint8_t> wrapped = {1, 0, 0, 0, 0, 0, 0, 0};
+  wrapped.insert(wrapped.end(), 9, 0x80);
+  wrapped.push_back(1);
+  EXPECT_NE(message(with_keys(wrapped)).find("not strictly increasing"), std::string::npos);
+  std::vector<std::uint8_t> far = {1, 0, 0, 0, 0, 0, 0, 0};
+  far.insert(far.end(), 8, 0x80);
+  far.push_back(0x40);
+  EXPECT_NE(message(with_keys(far)).find("outside the 5x6x7 grid"), std::string::npos);
 }
 
 TEST(Vfrag, RejectsUnsortedOrOutOfGridKeysAndCorruption) {

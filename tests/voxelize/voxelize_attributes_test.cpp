@@ -99,7 +99,7 @@ TEST(VoxelizeAttributes, SphereNormalsPointOutward) {
       const Vec3d centre = grid->VoxelCenter({c.x, c.y, c.z});
       const Vec3d radial = centre / Length(centre);
       const Vec3f n = set->normals[i];
-      ASSERT_NEAR(Length(n), 1.f, 1e-4f);
+      ASSERT_NEAR(Length(n), 1.f, 1e-3f);  // unit, in binary16 components
       const double cosine = Dot(radial, Vec3d{n.x, n.y, n.z});
       worst = std::max(worst, std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / std::numbers::pi);
     }

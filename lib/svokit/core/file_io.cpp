@@ -97,6 +97,26 @@ Status AtomicFileWriter::Write(std::span<const std::uint8_t> bytes) {
   return Status::Ok();
 }
 
+Status AtomicFileWriter::WriteAt(std::uint64_t offset, std::span<const std::uint8_t> bytes) {
+  if (!file_) return Status::Internal("{}: write to a writer that is not open", path_.string());
+  if (offset + bytes.size() > bytes_written_) {
+    return Status::Internal("{}: rewrite past the end of what was written", path_.string());
+  }
+  bool ok = std::fflush(file_) == 0;
+  for (std::size_t done = 0; ok && done < bytes.size();) {
+    const ssize_t n = ::pwrite(::fileno(file_), bytes.data() + done, bytes.size() - done,
+                               static_cast<off_t>(offset + done));
+    ok = n > 0;
+    if (ok) done += static_cast<std::size_t>(n);
+  }
+  if (!ok) {
+    const int err = errno;
+    Discard();
+    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+  }
+  return Status::Ok();
+}
+
 Status AtomicFileWriter::Commit() {
   if (!file_) return Status::Internal("{}: commit of a writer that is not open", path_.string());
   const bool flushed = std::fflush(file_) == 0;

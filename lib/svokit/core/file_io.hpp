@@ -33,6 +33,8 @@ class AtomicFileWriter {
   Status Write(const void* data, std::size_t size) {
     return Write({static_cast<const std::uint8_t*>(data), size});
   }
+  /// Overwrites bytes already written, at `offset` (e.g. a header completed last).
+  Status WriteAt(std::uint64_t offset, std::span<const std::uint8_t> bytes);
   /// Flushes, closes and renames onto the final path.
   Status Commit();
   std::uint64_t bytes_written() const { return bytes_written_; }

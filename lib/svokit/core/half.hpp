@@ -45,6 +45,11 @@ inline float HalfBitsToFloat(std::uint16_t h) {
   return std::bit_cast<float>(sign | (exponent + 112) << 23 | mantissa << 13);
 }
 
+/// The binary16 value nearest `value`, as a float: what a binary16 file would give back.
+inline float RoundToHalf(float value) {
+  return HalfBitsToFloat(FloatToHalfBits(value));
+}
+
 /// A binary16 value that converts to and from float implicitly.
 struct Half {
   std::uint16_t bits = 0;
