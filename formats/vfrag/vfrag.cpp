@@ -95,7 +95,8 @@ Status ReadHalves(const container::Reader& file, container::Tag tag, std::size_t
   ParallelChunks(voxels, 1 << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       float f[kComponents];
-      for (std::size_t c = 0; c < kComponents; ++c) f[c] = HalfBitsToFloat(bits[i * kComponents + c]);
+      for (std::size_t c = 0; c < kComponents; ++c)
+        f[c] = HalfBitsToFloat(bits[i * kComponents + c]);
       std::memcpy(&out[i], f, sizeof(T));
     }
   });
@@ -197,19 +198,19 @@ container::Writer::Producer Chunked(std::size_t voxels, Encode encode) {
 
 container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys) {
   const std::uint64_t count = keys.size();
-  auto varints = Chunked(keys.size(), [&keys](std::size_t begin, std::size_t end,
-                                              std::vector<std::uint8_t>& out) {
-    std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
-    for (std::size_t i = begin; i < end; ++i) {
-      std::uint64_t gap = keys[i] - prev - 1;
-      prev = keys[i];
-      while (gap >= 0x80u) {
-        out.push_back(static_cast<std::uint8_t>(gap | 0x80u));
-        gap >>= 7;
-      }
-      out.push_back(static_cast<std::uint8_t>(gap));
-    }
-  });
+  auto varints = Chunked(
+      keys.size(), [&keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
+        std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
+        for (std::size_t i = begin; i < end; ++i) {
+          std::uint64_t gap = keys[i] - prev - 1;
+          prev = keys[i];
+          while (gap >= 0x80u) {
+            out.push_back(static_cast<std::uint8_t>(gap | 0x80u));
+            gap >>= 7;
+          }
+          out.push_back(static_cast<std::uint8_t>(gap));
+        }
+      });
   return [count, varints](const container::Writer::Emit& emit) -> Status {
     std::uint8_t head[sizeof(count)];
     std::memcpy(head, &count, sizeof(count));
@@ -220,20 +221,20 @@ container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys)
 
 template <class T>
 container::Writer::Producer HalvesProducer(const std::vector<T>& values) {
-  return Chunked(values.size(), [&values](std::size_t begin, std::size_t end,
-                                          std::vector<std::uint8_t>& out) {
-    constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
-    out.resize((end - begin) * kComponents * 2);
-    std::uint8_t* o = out.data();
-    for (std::size_t i = begin; i < end; ++i) {
-      float f[kComponents];
-      std::memcpy(f, &values[i], sizeof(T));
-      for (std::size_t c = 0; c < kComponents; ++c, o += 2) {
-        const std::uint16_t h = FloatToHalfBits(f[c]);
-        std::memcpy(o, &h, 2);
-      }
-    }
-  });
+  return Chunked(values.size(),
+                 [&values](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
+                   constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
+                   out.resize((end - begin) * kComponents * 2);
+                   std::uint8_t* o = out.data();
+                   for (std::size_t i = begin; i < end; ++i) {
+                     float f[kComponents];
+                     std::memcpy(f, &values[i], sizeof(T));
+                     for (std::size_t c = 0; c < kComponents; ++c, o += 2) {
+                       const std::uint16_t h = FloatToHalfBits(f[c]);
+                       std::memcpy(o, &h, 2);
+                     }
+                   }
+                 });
 }
 
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
