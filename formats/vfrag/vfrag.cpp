@@ -83,24 +83,18 @@ Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
   return Status::Ok();
 }
 
-// Version 3 COLR / NORM: the float components as binary16 (the voxelizer rounds them so).
-template <class T>
-Status ReadHalves(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                  std::vector<T>& out) {
-  constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
-  std::vector<std::uint16_t> bits;
-  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, tag, voxels, bits, kComponents));
-  if (bits.empty()) return Status::Ok();
-  out.resize(voxels);
-  ParallelChunks(voxels, 1 << 16, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      float f[kComponents];
-      for (std::size_t c = 0; c < kComponents; ++c)
-        f[c] = HalfBitsToFloat(bits[i * kComponents + c]);
-      std::memcpy(&out[i], f, sizeof(T));
-    }
-  });
+// Versions 1 and 2 stored COLR / NORM as f32: read, then held in binary16 like version 3's.
+template <class Float, class Half16>
+Status ReadFloatsAsHalves(const container::Reader& file, container::Tag tag, std::size_t voxels,
+                          std::vector<Half16>& out) {
+  std::vector<Float> floats;
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, tag, voxels, floats));
+  out.assign(floats.begin(), floats.end());
   return Status::Ok();
+}
+
+bool IsFiniteHalf(Half h) {
+  return (h.bits & 0x7c00u) != 0x7c00u;
 }
 
 StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, VfragMetadata* meta) {
@@ -136,11 +130,12 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
     }
   }
   if (file->version() >= 3) {
-    SVOKIT_RETURN_IF_ERROR(ReadHalves(*file, kColors, set.keys.size(), set.colors));
-    SVOKIT_RETURN_IF_ERROR(ReadHalves(*file, kNormals, set.keys.size(), set.normals));
-  } else {  // versions 1 and 2: f32
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
+  } else {
+    SVOKIT_RETURN_IF_ERROR(ReadFloatsAsHalves<Rgba>(*file, kColors, set.keys.size(), set.colors));
+    SVOKIT_RETURN_IF_ERROR(
+        ReadFloatsAsHalves<Vec3f>(*file, kNormals, set.keys.size(), set.normals));
   }
   if (file->version() >= 2) {
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
@@ -149,13 +144,15 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), coverage));
     set.coverage.assign(coverage.begin(), coverage.end());
   }
-  for (const Rgba& c : set.colors) {
-    if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b) || !std::isfinite(c.a)) {
+  for (const HalfRgba& c : set.colors) {
+    if (!IsFiniteHalf(c.r) || !IsFiniteHalf(c.g) || !IsFiniteHalf(c.b) || !IsFiniteHalf(c.a)) {
       return Status::BadInput("{}: non-finite voxel colour", name);
     }
   }
-  for (const Vec3f& n : set.normals) {
-    if (!IsFinite(n)) return Status::BadInput("{}: non-finite voxel normal", name);
+  for (const HalfVec3& n : set.normals) {
+    if (!IsFiniteHalf(n.x) || !IsFiniteHalf(n.y) || !IsFiniteHalf(n.z)) {
+      return Status::BadInput("{}: non-finite voxel normal", name);
+    }
   }
   if (meta != nullptr) {
     *meta = {};
@@ -219,31 +216,13 @@ container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys)
   };
 }
 
-template <class T>
-container::Writer::Producer HalvesProducer(const std::vector<T>& values) {
-  return Chunked(values.size(),
-                 [&values](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
-                   constexpr std::size_t kComponents = sizeof(T) / sizeof(float);
-                   out.resize((end - begin) * kComponents * 2);
-                   std::uint8_t* o = out.data();
-                   for (std::size_t i = begin; i < end; ++i) {
-                     float f[kComponents];
-                     std::memcpy(f, &values[i], sizeof(T));
-                     for (std::size_t c = 0; c < kComponents; ++c, o += 2) {
-                       const std::uint16_t h = FloatToHalfBits(f[c]);
-                       std::memcpy(o, &h, 2);
-                     }
-                   }
-                 });
-}
-
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
   file.AddSectionProduced(kKeys, KeysProducer(set.keys));
-  if (set.has_colors()) file.AddSectionProduced(kColors, HalvesProducer(set.colors));
-  if (set.has_normals()) file.AddSectionProduced(kNormals, HalvesProducer(set.normals));
+  if (set.has_colors()) file.AddSectionView(kColors, Bytes(set.colors));
+  if (set.has_normals()) file.AddSectionView(kNormals, Bytes(set.normals));
   if (!set.coverage.empty()) file.AddSectionView(kCoverage, Bytes(set.coverage));
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
@@ -307,11 +286,12 @@ Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path) {
     w.Put(static_cast<float>(p.x));
     w.Put(static_cast<float>(p.y));
     w.Put(static_cast<float>(p.z));
-    if (set.has_normals()) w.Put(set.normals[i]);
+    if (set.has_normals()) w.Put(Vec3f(set.normals[i]));
     if (set.has_colors()) {
-      w.Put(to_byte(set.colors[i].r));
-      w.Put(to_byte(set.colors[i].g));
-      w.Put(to_byte(set.colors[i].b));
+      const Rgba color = set.colors[i];
+      w.Put(to_byte(color.r));
+      w.Put(to_byte(color.g));
+      w.Put(to_byte(color.b));
     }
   }
   return WriteFileAtomic(path, w.bytes());

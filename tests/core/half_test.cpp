@@ -18,6 +18,8 @@ TEST(Half, EveryFiniteValueRoundTripsAndMatchesTheDefinition) {
     const float f = HalfBitsToFloat(bits);
     if (e == 31) {
       EXPECT_EQ(std::isnan(f), m != 0) << h;
+      EXPECT_EQ(std::isinf(f), m == 0) << h;
+      EXPECT_EQ(std::signbit(f), (h & 0x8000u) != 0) << h;
       continue;
     }
     const double magnitude = e == 0 ? std::ldexp(m, -24) : std::ldexp(1024 + m, e - 25);

@@ -453,11 +453,12 @@ void CheckVdb(const Svo& svo, const std::filesystem::path& path, std::uint32_t l
       ASSERT_TRUE(g.color->tree().isValueOn(ijk));
       EXPECT_EQ(g.color->transform(), g.occupancy->transform());
       const openvdb::Vec3f c = g.color->tree().getValue(ijk);
-      ExpectNear({c.x(), c.y(), c.z()}, {n.color.r, n.color.g, n.color.b}, 1e-6f, "colour");
+      // Exported through a voxel set, which holds binary16 (relative error ≤ 2^-11).
+      ExpectNear({c.x(), c.y(), c.z()}, {n.color.r, n.color.g, n.color.b}, 5e-4f, "colour");
     }
     if (g.normal) {
       const openvdb::Vec3f v = g.normal->tree().getValue(ijk);
-      ExpectNear({v.x(), v.y(), v.z()}, n.normal, 1e-6f, "normal");
+      ExpectNear({v.x(), v.y(), v.z()}, n.normal, 5e-4f, "normal");
     }
   }
   if (g.color) {
@@ -664,7 +665,7 @@ TEST(Export, PlyPointsAtNodeCentresWithColoursAndNormals) {
       ExpectNear(ply.position[i],
                  {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)}, 0.f,
                  "position");
-      ExpectNear(ply.normal[i], nodes[i].normal, 1e-6f, "normal");
+      ExpectNear(ply.normal[i], nodes[i].normal, 5e-4f, "normal");  // binary16, as above
       EXPECT_EQ(ply.color[i], ToSrgb8(nodes[i].color));
     }
   }

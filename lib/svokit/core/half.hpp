@@ -6,6 +6,8 @@
 #include <bit>
 #include <cstdint>
 
+#include "svokit/core/vec.hpp"
+
 namespace svokit {
 
 inline std::uint16_t FloatToHalfBits(float value) {
@@ -36,13 +38,12 @@ inline std::uint16_t FloatToHalfBits(float value) {
 
 inline float HalfBitsToFloat(std::uint16_t h) {
   const std::uint32_t sign = std::uint32_t{h & 0x8000u} << 16;
-  const std::uint32_t exponent = (h >> 10) & 0x1fu, mantissa = h & 0x3ffu;
-  if (exponent == 0) {  // zero or subnormal: mantissa · 2^-24, exact in float
-    const float magnitude = static_cast<float>(mantissa) * 0x1p-24f;
-    return sign ? -magnitude : magnitude;
-  }
-  if (exponent == 31) return std::bit_cast<float>(sign | 0x7f800000u | mantissa << 13);
-  return std::bit_cast<float>(sign | (exponent + 112) << 23 | mantissa << 13);
+  const std::uint32_t magnitude = std::uint32_t{h & 0x7fffu} << 13;
+  // The exponent rebias as one multiplication: exact for normal and subnormal halves alike (a
+  // subnormal half lands on a subnormal float), and no branch on the common path.
+  float f = std::bit_cast<float>(magnitude) * 0x1p112f;
+  if (magnitude >= 0x0f800000u) f = std::bit_cast<float>(magnitude | 0x7f800000u);  // inf, NaN
+  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) | sign);
 }
 
 /// The binary16 value nearest `value`, as a float: what a binary16 file would give back.
@@ -58,5 +59,27 @@ struct Half {
   operator float() const { return HalfBitsToFloat(bits); }
   bool operator==(const Half&) const = default;
 };
+
+/// Linear RGBA in binary16, 8 bytes: how voxel sets hold colours (and .vfrag stores them).
+/// Converts to and from Rgba implicitly; opaque white by default, like Rgba.
+struct HalfRgba {
+  Half r{1.f}, g{1.f}, b{1.f}, a{1.f};
+  HalfRgba() = default;
+  HalfRgba(float r_, float g_, float b_, float a_) : r(r_), g(g_), b(b_), a(a_) {}
+  HalfRgba(const Rgba& c) : HalfRgba(c.r, c.g, c.b, c.a) {}  // NOLINT: implicit by design
+  operator Rgba() const { return {r, g, b, a}; }
+  bool operator==(const HalfRgba&) const = default;
+};
+
+/// A vector in binary16, 6 bytes: how voxel sets hold unit normals. Converts like HalfRgba.
+struct HalfVec3 {
+  Half x, y, z;
+  HalfVec3() = default;
+  HalfVec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
+  HalfVec3(const Vec3f& v) : HalfVec3(v.x, v.y, v.z) {}  // NOLINT: implicit by design
+  operator Vec3f() const { return {x, y, z}; }
+  bool operator==(const HalfVec3&) const = default;
+};
+static_assert(sizeof(HalfRgba) == 8 && sizeof(HalfVec3) == 6, "stored as raw binary16 arrays");
 
 }  // namespace svokit

@@ -24,10 +24,11 @@ struct VoxelSet {
   std::vector<std::uint64_t> keys;  ///< sorted ascending, unique
   /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
   /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
-  /// voxel² (its coverage, in binary16: a weight needs no more, and 2 bytes a voxel count at the
-  /// voxelizer's peak). Empty when not requested.
-  std::vector<Rgba> colors;
-  std::vector<Vec3f> normals;
+  /// voxel² (its coverage). All in binary16, as .vfrag stores them: ~3 significant digits are
+  /// all a filtered colour, a normal or a weight needs, and the 16 bytes a voxel saved over floats
+  /// are fresh memory the voxelizer would otherwise have to touch. Empty when not requested.
+  std::vector<HalfRgba> colors;
+  std::vector<HalfVec3> normals;
   std::vector<Half> coverage;
   /// Non-fatal findings of the voxelization (e.g. a texture that could not be decoded, so its
   /// materials used their base colour). Not stored in files.

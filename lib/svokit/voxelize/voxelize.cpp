@@ -147,17 +147,16 @@ class BrickAccumulator {
       Sum& sum = sums_[set.keys[index] & kLocalMask];
       const double inv = sum.weight > 0 ? 1.0 / sum.weight : 0.0;
       set.coverage[index] = static_cast<float>(sum.area);
-      // Colours and normals in binary16 precision, as .vfrag stores them: a voxel set is the
-      // same in memory (mesh2svo) and read back from a file (svo-build).
-      auto half = [](double v) { return RoundToHalf(static_cast<float>(v)); };
       if (set.has_colors()) {
-        set.colors[index] = {half(sum.r * inv), half(sum.g * inv), half(sum.b * inv),
-                             half(sum.a * inv)};
+        set.colors[index] = Rgba{static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
+                                 static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)};
       }
       if (set.has_normals()) {
         const double len = std::sqrt(sum.nx * sum.nx + sum.ny * sum.ny + sum.nz * sum.nz);
         const double scale = len > 0 ? 1.0 / len : 0.0;
-        set.normals[index] = {half(sum.nx * scale), half(sum.ny * scale), half(sum.nz * scale)};
+        set.normals[index] =
+            Vec3f{static_cast<float>(sum.nx * scale), static_cast<float>(sum.ny * scale),
+                  static_cast<float>(sum.nz * scale)};
       }
       sum = {};
     }
