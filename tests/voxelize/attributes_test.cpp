@@ -195,6 +195,69 @@ TEST(AttributeClip, AreasOverAllVoxelsSumToTheTriangleAndMatchTheExactOverlapTes
   }
 }
 
+// Uniform triangles (no texture, vertex colours or normals) take SampleColumn's projection path:
+// per voxel, the same area as clipping the triangle to the voxel's box (an independent
+// computation: 3D polygons in barycentric coordinates), the same colour and normal; a column the
+// walk calls interior holds the whole square lifted onto the plane (area |N| / |N[w]|).
+TEST(AttributeClip, ProjectedColumnAreasOfUniformTrianglesEqualClippedAreas) {
+  std::mt19937_64 rng(20261123);
+  std::uniform_int_distribution<std::int64_t> coord(0, 12 * kFixedPointOne);
+  const IBox3 grid{{-2, -2, -2}, {20, 20, 20}};
+  int interior_columns = 0, boundary_columns = 0;
+  for (int iter = 0; iter < 400; ++iter) {
+    TestMesh m({{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, {{0, 1, 2}});
+    m.mesh.materials[0].base_color = {0.25f, 0.5f, 0.75f, 1};
+    for (int k = 0; k < 3; ++k) {
+      for (int a = 0; a < 3; ++a) {
+        std::int64_t c = coord(rng);
+        if (iter % 4 == 1) c &= ~(kFixedPointOne / 2 - 1);  // multiples of half a voxel
+        m.vertices[k][a] = c;
+      }
+    }
+    if (iter % 8 == 3) {  // a face in a voxel boundary plane: counts in both voxels
+      const int a = iter % 3;
+      for (int k = 0; k < 3; ++k) m.vertices[k][a] = 5 * kFixedPointOne;
+    }
+    const AttributeSampler sampler(m.mesh, m.vertices, true, true);
+    const AttributeSampler::Prepared p = sampler.Prepare(0);
+    if (p.normal_length == 0) continue;
+    ASSERT_TRUE(p.uniform);
+    for (VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
+      const TriangleVoxelizer tv(m.vertices[0], m.vertices[1], m.vertices[2], mode, grid);
+      const int w = tv.dominant_axis();
+      tv.RunsWithInterior(
+          tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(),
+          [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t n, bool interior) {
+            ASSERT_LE(n, 16);
+            ASSERT_TRUE(!interior || mode == VoxelMode::kConservative);
+            AttributeSample column[16];
+            sampler.SampleColumn(p, x, y, z, w, static_cast<int>(n), interior, column);
+            std::int64_t c[3] = {x, y, z};
+            double sum = 0;
+            for (int i = 0; i < n; ++i, ++c[w]) {
+              const AttributeSample clipped = sampler.Sample(0, c[0], c[1], c[2]);
+              EXPECT_NEAR(column[i].area, clipped.area, 1e-9 * (1 + clipped.area))
+                  << iter << " voxel " << c[0] << " " << c[1] << " " << c[2];
+              EXPECT_EQ(column[i].color, clipped.color);
+              EXPECT_EQ(column[i].normal, clipped.normal);
+              sum += column[i].area;
+            }
+            if (interior) {
+              ++interior_columns;
+              // A face in a voxel boundary plane has a run of two voxels and counts in both.
+              const bool flat = p.slope_u == 0 && p.slope_v == 0;
+              const double lifted = p.secant * (flat ? static_cast<double>(n) : 1.0);
+              EXPECT_NEAR(sum, lifted, 1e-9 * lifted) << iter;
+            } else {
+              ++boundary_columns;
+            }
+          });
+    }
+  }
+  EXPECT_GT(interior_columns, 1000);
+  EXPECT_GT(boundary_columns, 1000);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Texture sampler
 

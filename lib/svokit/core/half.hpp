@@ -14,24 +14,22 @@ inline std::uint16_t FloatToHalfBits(float value) {
   std::uint32_t x = std::bit_cast<std::uint32_t>(value);
   const auto sign = static_cast<std::uint16_t>((x >> 16) & 0x8000u);
   x &= 0x7fffffffu;
+  if (x >= 0x38800000u && x < 0x477ff000u) [[likely]] {
+    // Normal half: round the 13 dropped bits to nearest, ties to even, by one addition (a carry
+    // out of the mantissa correctly bumps the exponent), then rebias the exponent.
+    return static_cast<std::uint16_t>(sign | (((x + 0xfffu + ((x >> 13) & 1u)) >> 13) - 0x1c000u));
+  }
   if (x >= 0x7f800000u) {  // infinity, or NaN (kept quiet)
     return static_cast<std::uint16_t>(sign | 0x7c00u | (x > 0x7f800000u ? 0x200u : 0u));
   }
   if (x >= 0x477ff000u) return static_cast<std::uint16_t>(sign | 0x7c00u);  // ≥ 65520: overflow
-  std::uint32_t bits, rest, halfway;
-  if (x >= 0x38800000u) {  // normal half: rebias the exponent, keep 10 mantissa bits
-    bits = (x >> 13) - 0x1c000u;
-    rest = x & 0x1fffu;
-    halfway = 0x1000u;
-  } else {  // subnormal half (units of 2^-24), or zero
-    const std::uint32_t exponent = x >> 23;
-    if (exponent < 102) return sign;  // < 2^-25: rounds to zero
-    const std::uint32_t mantissa = (x & 0x7fffffu) | 0x800000u;
-    const std::uint32_t shift = 126 - exponent;  // 14 … 24
-    bits = mantissa >> shift;
-    rest = mantissa & ((1u << shift) - 1);
-    halfway = 1u << (shift - 1);
-  }
+  // Subnormal half (units of 2^-24), or zero.
+  const std::uint32_t exponent = x >> 23;
+  if (exponent < 102) return sign;  // < 2^-25: rounds to zero
+  const std::uint32_t mantissa = (x & 0x7fffffu) | 0x800000u;
+  const std::uint32_t shift = 126 - exponent;  // 14 … 24
+  std::uint32_t bits = mantissa >> shift;
+  const std::uint32_t rest = mantissa & ((1u << shift) - 1), halfway = 1u << (shift - 1);
   if (rest > halfway || (rest == halfway && (bits & 1u))) ++bits;  // a carry is still right
   return static_cast<std::uint16_t>(sign | bits);
 }

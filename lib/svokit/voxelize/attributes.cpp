@@ -122,6 +122,91 @@ int ClipToColumn(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
   return n;
 }
 
+// Projected (2D) geometry of uniform triangles: a polygon in the column's unit square, with each
+// vertex's plane height relative to the run's first voxel.
+struct Point2 {
+  double s, t;
+};
+
+// Sutherland–Hodgman in 2D against s (kAxis 0) or t ≥ 0 (kUpper false) or ≤ 1; branch-free
+// like ClipPlane.
+template <int kAxis, bool kUpper>
+int ClipSquareSide(const Point2* in, int n, Point2* out) {
+  auto dist = [](const Point2& q) {
+    const double c = kAxis == 0 ? q.s : q.t;
+    return kUpper ? 1.0 - c : c;
+  };
+  int m = 0;
+  Point2 prev = in[n - 1];
+  double dprev = dist(prev);
+  for (int i = 0; i < n; ++i) {
+    const Point2 cur = in[i];
+    const double dcur = dist(cur);
+    const double r = dprev / (dprev - dcur);
+    out[m] = {prev.s + r * (cur.s - prev.s), prev.t + r * (cur.t - prev.t)};
+    m += dprev * dcur < 0;
+    out[m] = cur;
+    m += dcur >= 0;
+    m = std::min(m, kMaxPolygon);
+    prev = cur;
+    dprev = dcur;
+  }
+  return m;
+}
+
+// Clips to the sides of the unit square along kAxis that the polygon crosses.
+template <int kAxis>
+int ClipSquareAxis(Point2*& poly, Point2*& spare, int n) {
+  double lo = kAxis == 0 ? poly[0].s : poly[0].t, hi = lo;
+  for (int i = 1; i < n; ++i) {
+    const double c = kAxis == 0 ? poly[i].s : poly[i].t;
+    lo = std::min(lo, c);
+    hi = std::max(hi, c);
+  }
+  if (hi < 0 || lo > 1) return 0;
+  if (lo < 0) n = ClipSquareSide<kAxis, false>(poly, n, spare), std::swap(poly, spare);
+  if (hi > 1 && n > 0) n = ClipSquareSide<kAxis, true>(poly, n, spare), std::swap(poly, spare);
+  return n;
+}
+
+double TwiceArea(const Point2* q, int n) {
+  double twice = 0;
+  for (int i = 0, j = n - 1; i < n; j = i++) twice += q[j].s * q[i].t - q[j].t * q[i].s;
+  return std::abs(twice);
+}
+
+// Area of the part of polygon q[0..n) where the plane height h (per vertex) is ≤ level: the
+// polygon clipped by that line (branch-free, as above), then the shoelace formula.
+double AreaBelow(const Point2* q, const double* h, int n, double level) {
+  Point2 out[kClipCapacity];
+  int m = 0;
+  Point2 prev = q[n - 1];
+  double dprev = level - h[n - 1];
+  for (int i = 0; i < n; ++i) {
+    const double dcur = level - h[i];
+    const double r = dprev / (dprev - dcur);
+    out[m] = {prev.s + r * (q[i].s - prev.s), prev.t + r * (q[i].t - prev.t)};
+    m += dprev * dcur < 0;
+    out[m] = q[i];
+    m += dcur >= 0;
+    m = std::min(m, kMaxPolygon);
+    prev = q[i];
+    dprev = dcur;
+  }
+  return 0.5 * TwiceArea(out, m);
+}
+
+// Area of {(s, t) ∈ [0,1]²: p·s + q·t ≤ x} for p ≥ q ≥ 0, p > 0: the distribution function of
+// a sum of two uniform variables (quadratic, linear, quadratic).
+double SquareAreaBelow(double p, double q, double x) {
+  if (x <= 0) return 0;
+  if (x >= p + q) return 1;
+  if (x < q) return x * x / (2 * p * q);
+  if (x <= p) return (x - 0.5 * q) / p;
+  const double r = p + q - x;
+  return 1 - r * r / (2 * p * q);
+}
+
 }  // namespace
 
 AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoint3>& vertices,
@@ -195,6 +280,24 @@ AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const
   p.normal_length = Length(p.normal);
   const double nx = std::abs(p.normal.x), ny = std::abs(p.normal.y), nz = std::abs(p.normal.z);
   p.axis = nx > ny && nx > nz ? 0 : (ny > nz ? 1 : 2);
+
+  const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
+  const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  const bool textured = material && material->texture && mesh_.has_uvs();
+  p.uniform = p.normal_length > 0 && !(want_color_ && (textured || mesh_.has_colors())) &&
+              !(want_normal_ && mesh_.has_normals());
+  if (p.uniform) {
+    if (want_color_ && material) p.color = material->base_color;
+    if (want_normal_) {
+      const Vec3d g = p.normal / p.normal_length;
+      p.unit_normal = {static_cast<float>(g.x), static_cast<float>(g.y), static_cast<float>(g.z)};
+    }
+    const int u = (p.axis + 1) % 3, v = (p.axis + 2) % 3;
+    const double n[3] = {p.normal.x, p.normal.y, p.normal.z};
+    p.slope_u = -n[u] / n[p.axis];
+    p.slope_v = -n[v] / n[p.axis];
+    p.secant = p.normal_length / std::abs(n[p.axis]);
+  }
   return p;
 }
 
@@ -214,6 +317,75 @@ void AttributeSampler::SampleRun(const Prepared& p, std::int64_t x, std::int64_t
       return SampleRunAlong<2, 0, 1>(p, x, y, z, axis, n, out);
     default:
       return SampleRunAlong<0, 1, 2>(p, x, y, z, axis, n, out);
+  }
+}
+
+void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int64_t y,
+                                    std::int64_t z, int axis, int n, bool interior,
+                                    AttributeSample* out) const {
+  if (!p.uniform || axis != p.axis) return SampleRun(p, x, y, z, axis, n, out);
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const std::int64_t corner[3] = {x, y, z};
+  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
+  // The first vertex relative to the run's first voxel corner: exact fixed-point differences.
+  double a[3];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = static_cast<double>(p.v0[k] - corner[k] * kFixedPointOne) * kScale;
+  }
+  // Plane height over the column's corner (s = t = 0), in voxels above the run's first voxel.
+  const double h00 = a[axis] - p.slope_u * a[u] - p.slope_v * a[v];
+  // below(level): projected area of the column's part of the triangle under the plane height
+  // `level`; voxel i of the run holds what lies between levels i and i + 1.
+  double below_prev = 0;
+  if (interior) {
+    const double gs = std::abs(p.slope_u), gt = std::abs(p.slope_v);
+    const double big = std::max(gs, gt), small = std::min(gs, gt);
+    const double offset = h00 + std::min(p.slope_u, 0.0) + std::min(p.slope_v, 0.0);
+    for (int i = 0; i < n; ++i) {
+      double area;
+      if (big == 0) {  // a face in a voxel boundary counts fully on both sides (closed boxes)
+        area = i <= h00 && h00 <= i + 1 ? 1.0 : 0.0;
+      } else {
+        if (i == 0) below_prev = SquareAreaBelow(big, small, -offset);
+        const double below = SquareAreaBelow(big, small, i + 1 - offset);
+        area = std::max(below - below_prev, 0.0);
+        below_prev = below;
+      }
+      out[i] = {area * p.secant, p.color, p.unit_normal};
+    }
+    return;
+  }
+  // The projected triangle clipped to the column's square.
+  Point2 buffers[2][kClipCapacity];
+  Point2* poly = buffers[0];
+  Point2* spare = buffers[1];
+  poly[0] = {a[u], a[v]};
+  poly[1] = {a[u] + p.e1[u], a[v] + p.e1[v]};
+  poly[2] = {a[u] + p.e2[u], a[v] + p.e2[v]};
+  int m = ClipSquareAxis<0>(poly, spare, 3);
+  if (m > 0) m = ClipSquareAxis<1>(poly, spare, m);
+  double h[kClipCapacity];
+  double lo = 0, hi = 0;
+  for (int k = 0; k < m; ++k) {
+    h[k] = h00 + p.slope_u * poly[k].s + p.slope_v * poly[k].t;
+    lo = k == 0 ? h[k] : std::min(lo, h[k]);
+    hi = k == 0 ? h[k] : std::max(hi, h[k]);
+  }
+  const double total = m > 0 ? 0.5 * TwiceArea(poly, m) : 0.0;
+  auto below = [&](double level) {
+    return level <= lo ? 0.0 : level >= hi ? total : AreaBelow(poly, h, m, level);
+  };
+  below_prev = below(0);
+  for (int i = 0; i < n; ++i) {
+    double area;
+    if (lo == hi) {  // flat, as above
+      area = i <= lo && lo <= i + 1 ? total : 0.0;
+    } else {
+      const double next = below(i + 1);
+      area = std::max(next - below_prev, 0.0);
+      below_prev = next;
+    }
+    out[i] = {area * p.secant, p.color, p.unit_normal};
   }
 }
 

@@ -67,8 +67,23 @@ class AttributeSampler {
     Vec3d normal;                   // e1 × e2
     double normal_length = 0;
     int axis = 2;  // dominant axis of the normal, clipped last
+    // A uniform triangle's samples differ only in area: no texture, vertex colour or shading
+    // normal varies over it (every STL, most scans). Its colour and normal, and its plane over the
+    // dominant-axis projection: w = w0 + slope_u·u + slope_v·v, |slopes| ≤ 1, and the plane's
+    // area per unit of projected area, |N| / |N[axis]|.
+    bool uniform = false;
+    Rgba color;
+    Vec3f unit_normal;
+    double slope_u = 0, slope_v = 0, secant = 0;
   };
   Prepared Prepare(std::size_t triangle) const;
+  /// SampleRun() along the triangle's dominant axis, the columns the voxelizer walks; `interior`:
+  /// the column's square lies inside the triangle's projection (TriangleVoxelizer's exact test).
+  /// A uniform triangle's areas come from its projection instead of clipped polygons: the column's
+  /// part of the projected triangle split at the voxel levels (for an interior column, the unit
+  /// square, in closed form). The same areas as SampleRun()'s up to rounding.
+  void SampleColumn(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis,
+                    int n, bool interior, AttributeSample* out) const;
   /// Sample() for the `n` voxels from (x, y, z) on along `axis`, into out[0..n), identical voxel
   /// by voxel; a run along the triangle's dominant axis clips to its column once.
   void SampleRun(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis, int n,

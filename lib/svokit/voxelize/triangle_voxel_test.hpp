@@ -45,6 +45,12 @@ class TriangleVoxelizer {
   template <class EmitRun>
   void Runs(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
             const EmitRun& emit) const;
+  /// Runs(), also telling whether the column's closed square lies inside the projected triangle
+  /// (conservative mode; exact): emit(x, y, z, n, interior). The run is then the column's meeting
+  /// with the plane, and the triangle's part in the column is the square lifted onto the plane.
+  template <class EmitRun>
+  void RunsWithInterior(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
+                        const EmitRun& emit) const;
   /// The same voxels one by one: emit(x, y, z).
   template <class Emit>
   void Columns(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,

@@ -20,6 +20,15 @@ Int128 FloorDiv(Int128 a, Int128 b);
 template <class EmitRun>
 void TriangleVoxelizer::Runs(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
                              const EmitRun& emit) const {
+  RunsWithInterior(u0, u1, v0, v1,
+                   [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t n, bool) {
+                     emit(x, y, z, n);
+                   });
+}
+
+template <class EmitRun>
+void TriangleVoxelizer::RunsWithInterior(std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                                         std::int64_t v1, const EmitRun& emit) const {
   if (empty_) return;
   if (fits_int64_) {
     RunsWith(narrow_, u0, u1, v0, v1, emit);
@@ -110,11 +119,12 @@ void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::
       const bool single = ClipDepth(depth, w0, w1);
       if (w0 > w1) continue;
       xyz[u_] = lu + origin_[u_];
-      if (single || (shortcut && ((e0 - inner[0]) | (e1 - inner[1]) | (e2 - inner[2])) >= 0)) {
+      const bool interior = shortcut && ((e0 - inner[0]) | (e1 - inner[1]) | (e2 - inner[2])) >= 0;
+      if (single || interior) {
         // A one-voxel plane run needs no side tests either: the triangle's points in this
         // column all lie in that voxel (exact for conservative mode only).
         xyz[w_] = w0 + origin_[w_];
-        emit(xyz[0], xyz[1], xyz[2], w1 - w0 + 1);
+        emit(xyz[0], xyz[1], xyz[2], w1 - w0 + 1, interior);
         continue;
       }
       // Maximal runs of voxels passing the six side tests.
@@ -128,7 +138,7 @@ void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::
         do ++lw, run.Step();
         while (lw <= w1 && run.Inside());
         xyz[w_] = start + origin_[w_];
-        emit(xyz[0], xyz[1], xyz[2], lw - start);
+        emit(xyz[0], xyz[1], xyz[2], lw - start, false);
       }
     }
   }

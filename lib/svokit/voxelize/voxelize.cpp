@@ -356,22 +356,22 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
           const TriangleVoxelizer tv = voxelizer.Triangle(t);
           const AttributeSampler::Prepared prepared = sampler.Prepare(t);
           const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
-          tv.Runs(lo[u], lo[u] + 16, lo[v], lo[v] + 16,
-                  [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
-                    // The part of the run inside the brick.
-                    std::int64_t c[3] = {x, y, z};
-                    const std::int64_t first = std::max(c[w], lo[w]);
-                    const std::int64_t last = std::min(c[w] + k, lo[w] + 16);
-                    if (first >= last) return;
-                    c[w] = first;
-                    const int count = static_cast<int>(last - first);
-                    sampler.SampleRun(prepared, c[0], c[1], c[2], w, count, samples);
-                    std::uint32_t local =
-                        VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
-                    for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
-                      acc.Add(local, samples[s]);
-                    }
-                  });
+          tv.RunsWithInterior(
+              lo[u], lo[u] + 16, lo[v], lo[v] + 16,
+              [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k, bool interior) {
+                // The part of the run inside the brick.
+                std::int64_t c[3] = {x, y, z};
+                const std::int64_t first = std::max(c[w], lo[w]);
+                const std::int64_t last = std::min(c[w] + k, lo[w] + 16);
+                if (first >= last) return;
+                c[w] = first;
+                const int count = static_cast<int>(last - first);
+                sampler.SampleColumn(prepared, c[0], c[1], c[2], w, count, interior, samples);
+                std::uint32_t local = VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
+                for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+                  acc.Add(local, samples[s]);
+                }
+              });
         }
         acc.Finish(ranks.first[slot->second], ranks.first[slot->second + 1], set);
         ++finished;
