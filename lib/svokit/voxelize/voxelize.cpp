@@ -8,6 +8,7 @@
 #include <malloc.h>
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
 #include "svokit/core/parallel.hpp"
@@ -322,21 +323,28 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     // columns and adds its samples; each voxel's sums thus have one fixed order.
     Progress::Stage attr_stage(progress, "attributes", ranks.brick_slot.size());
     std::vector<BrickTriangle> pairs;
-    for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
-    bins.clear();
-    tbb::parallel_sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
     std::vector<std::size_t> starts;
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
-    }
-    starts.push_back(pairs.size());
-
+    auto sort_bins = [&] {
+      for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
+      bins.clear();
+      tbb::parallel_sort(pairs.begin(), pairs.end());
+      pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+      for (std::size_t i = 0; i < pairs.size(); ++i) {
+        if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
+      }
+      starts.push_back(pairs.size());
+    };
+    // The output arrays are fresh memory, whose first touch is slow on VMs: they are filled
+    // side by side, and beside the sorting of the bins.
+    const std::size_t voxels = set.keys.size();
+    tbb::parallel_invoke([&] { set.colors.resize(options.colors ? voxels : 0); },
+                         [&] {
+                           set.normals.resize(options.normals ? voxels : 0);
+                           set.coverage.resize(voxels);
+                         },
+                         sort_bins);
     const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
     set.warnings = sampler.warnings();
-    if (options.colors) set.colors.resize(set.keys.size());
-    if (options.normals) set.normals.resize(set.keys.size());
-    set.coverage.resize(set.keys.size());
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
         [] { return std::make_unique<BrickAccumulator>(); });
     ParallelChunks(starts.size() - 1, 16, [&](std::size_t begin, std::size_t end) {
