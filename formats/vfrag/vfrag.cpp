@@ -1,6 +1,7 @@
 #include "formats/vfrag/vfrag.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -29,20 +30,27 @@ std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
   return {reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)};
 }
 
-// An optional per-voxel array: absent, or exactly `per_voxel` T per voxel.
+// An optional per-voxel array: absent, or one T per voxel; since version 4 also a single T that
+// every voxel shares (`uniform_allowed`).
 template <class T>
 Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                    std::vector<T>& out, std::size_t per_voxel = 1) {
+                    std::vector<T>& out, bool uniform_allowed = false) {
   const auto section = file.Find(tag);
   if (!section) return Status::Ok();
-  const std::size_t expected = voxels * per_voxel * sizeof(T);
+  ByteReader r(*section, file.name());
+  if (uniform_allowed && section->size() == sizeof(T)) {
+    T value;
+    SVOKIT_RETURN_IF_ERROR(r.Get(value));
+    out.assign(voxels, value);
+    return Status::Ok();
+  }
+  const std::size_t expected = voxels * sizeof(T);
   if (section->size() != expected) {
     return Status::BadInput("{}: section '{}' holds {} bytes, expected {} for {} voxels",
                             file.name(), std::string(tag.begin(), tag.end()), section->size(),
                             expected, voxels);
   }
-  ByteReader r(*section, file.name());
-  return r.GetArray(out, voxels * per_voxel);
+  return r.GetArray(out, voxels);
 }
 
 // Version 3 KEYS: u64 count, then per key the gap to the previous one minus one (the first key
@@ -129,16 +137,20 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
                               dims[1], dims[2]);
     }
   }
+  const bool uniform_allowed = file->version() >= 4;
   if (file->version() >= 3) {
-    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors));
-    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals));
+    SVOKIT_RETURN_IF_ERROR(
+        ReadPerVoxel(*file, kColors, set.keys.size(), set.colors, uniform_allowed));
+    SVOKIT_RETURN_IF_ERROR(
+        ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals, uniform_allowed));
   } else {
     SVOKIT_RETURN_IF_ERROR(ReadFloatsAsHalves<Rgba>(*file, kColors, set.keys.size(), set.colors));
     SVOKIT_RETURN_IF_ERROR(
         ReadFloatsAsHalves<Vec3f>(*file, kNormals, set.keys.size(), set.normals));
   }
   if (file->version() >= 2) {
-    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage));
+    SVOKIT_RETURN_IF_ERROR(
+        ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage, uniform_allowed));
   } else {  // version 1 stored coverage as f32
     std::vector<float> coverage;
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), coverage));
@@ -216,14 +228,30 @@ container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys)
   };
 }
 
+// A per-voxel array's section: the array, or its one value when every voxel has the same (an
+// untextured mesh without vertex colours: one colour for millions of voxels).
+template <class T>
+std::span<const std::uint8_t> PerVoxelBytes(const std::vector<T>& values) {
+  std::atomic<bool> uniform = values.size() > 1;
+  ParallelChunks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
+    if (uniform.load(std::memory_order_relaxed) &&
+        !std::all_of(values.begin() + begin, values.begin() + end,
+                     [&](const T& v) { return v == values[0]; })) {
+      uniform.store(false, std::memory_order_relaxed);
+    }
+  });
+  const std::span<const std::uint8_t> all = Bytes(values);
+  return uniform ? all.first(sizeof(T)) : all;
+}
+
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
   file.AddSectionProduced(kKeys, KeysProducer(set.keys));
-  if (set.has_colors()) file.AddSectionView(kColors, Bytes(set.colors));
-  if (set.has_normals()) file.AddSectionView(kNormals, Bytes(set.normals));
-  if (!set.coverage.empty()) file.AddSectionView(kCoverage, Bytes(set.coverage));
+  if (set.has_colors()) file.AddSectionView(kColors, PerVoxelBytes(set.colors));
+  if (set.has_normals()) file.AddSectionView(kNormals, PerVoxelBytes(set.normals));
+  if (!set.coverage.empty()) file.AddSectionView(kCoverage, PerVoxelBytes(set.coverage));
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
   const std::string text = j.dump();

@@ -133,19 +133,22 @@ TEST(Vfrag, Version2RawKeysAndFloatAttributesAreRead) {
   EXPECT_EQ(back->coverage, coverage);
 }
 
-// Version 3: per voxel 8 B colour, 6 B normal, 2 B coverage, and keys as varint gaps (spelled out
+// Version 4: per voxel 8 B colour, 6 B normal, 2 B coverage, and keys as varint gaps (spelled out
 // byte by byte here).
-TEST(Vfrag, Version3StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
+TEST(Vfrag, Version4StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
   VoxelSet s;
   s.grid = GridTransform({0, 0, 0}, 1, {(1u << 21) - 1, 1u << 20, 1u << 20});
   s.keys = {5, 6, 6 + 1 + 200, (std::uint64_t{1} << 60) + 3};
-  s.colors.assign(4, Rgba{0.5f, 0.25f, 1, 1});
-  s.normals.assign(4, Vec3f{0, 0, 1});
-  s.coverage.assign(4, Half(1.f));
+  for (int i = 0; i < 4; ++i) {
+    const float f = 0.25f * static_cast<float>(i);
+    s.colors.push_back({f, 0.25f, 1, 1});
+    s.normals.push_back({0, f, 1});
+    s.coverage.push_back(f);
+  }
   const std::vector<std::uint8_t> bytes = EncodeVfrag(s, {});
-  auto frame = container::Frame::FromBytes(bytes, "v3.vfrag", kVfragFormat);
+  auto frame = container::Frame::FromBytes(bytes, "v4.vfrag", kVfragFormat);
   ASSERT_TRUE(frame.ok()) << frame.status().message();
-  EXPECT_EQ(frame->version(), 3u);
+  EXPECT_EQ(frame->version(), 4u);
   const auto* keys = frame->Find(container::MakeTag("KEYS"));
   ASSERT_NE(keys, nullptr);
   // count 4; gaps 5, 0, 200 = 0xC8 0x01, 2^60 + 3 − 207 − 1 = 2^60 − 205.
@@ -158,11 +161,58 @@ TEST(Vfrag, Version3StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
   EXPECT_EQ(frame->Find(container::MakeTag("COLR"))->size, 8 * s.size());
   EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 6 * s.size());
   EXPECT_EQ(frame->Find(container::MakeTag("COVR"))->size, 2 * s.size());
-  auto back = DecodeVfrag(bytes, "v3.vfrag");
+  // COLR holds binary16 r, g, b, a per voxel: voxel 1 is (0.25, 0.25, 1, 1).
+  const std::uint8_t* colr = frame->Find(container::MakeTag("COLR"))->bytes.data();
+  const std::vector<std::uint8_t> voxel1(colr + 8, colr + 16);
+  EXPECT_EQ(voxel1, (std::vector<std::uint8_t>{0x00, 0x34, 0x00, 0x34, 0x00, 0x3c, 0x00, 0x3c}));
+  auto back = DecodeVfrag(bytes, "v4.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->keys, s.keys);
   EXPECT_EQ(back->colors, s.colors);
   EXPECT_EQ(back->normals, s.normals);
+  EXPECT_EQ(back->coverage, s.coverage);
+}
+
+// An attribute every voxel shares (an untextured mesh's colour) is stored once; earlier versions
+// must hold one per voxel, and a section of any other size is refused.
+TEST(Vfrag, Version4StoresAnAttributeEveryVoxelSharesOnce) {
+  VoxelSet s = Sample();
+  ASSERT_GT(s.size(), 2u);
+  s.colors.assign(s.size(), Rgba{0.5f, 0.25f, 1, 1});
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.normals.push_back(Vec3f{0, static_cast<float>(i), 1});
+  }
+  s.coverage.assign(s.size(), Half(1.f));
+  const std::vector<std::uint8_t> bytes = EncodeVfrag(s, {});
+  auto frame = container::Frame::FromBytes(bytes, "uniform.vfrag", kVfragFormat);
+  ASSERT_TRUE(frame.ok()) << frame.status().message();
+  EXPECT_EQ(frame->Find(container::MakeTag("COLR"))->size, 8u);
+  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 6 * s.size());
+  EXPECT_EQ(frame->Find(container::MakeTag("COVR"))->size, 2u);
+  auto back = DecodeVfrag(bytes, "uniform.vfrag");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_EQ(back->normals, s.normals);
+  EXPECT_EQ(back->coverage, s.coverage);
+  // The same sections in a version 3 file are refused.
+  auto with_version = [&](std::uint32_t version, std::size_t colors) {
+    container::FormatId format = kVfragFormat;
+    format.version = version;
+    container::Writer w(format, 0);
+    w.AddSection(container::MakeTag("GRID"), EncodeGridSection(s.grid, s.mode));
+    const auto keys = frame->Find(container::MakeTag("KEYS"))->bytes;
+    w.AddSection(container::MakeTag("KEYS"), std::vector<std::uint8_t>(keys.begin(), keys.end()));
+    std::vector<HalfRgba> c(colors, HalfRgba(Rgba{0.5f, 0.25f, 1, 1}));
+    w.AddSection(container::MakeTag("COLR"), RawBytes(c));
+    return DecodeVfrag(w.Serialize(), "versioned.vfrag");
+  };
+  EXPECT_TRUE(with_version(4, 1).ok());
+  auto v3 = with_version(3, 1);
+  ASSERT_FALSE(v3.ok());
+  EXPECT_NE(v3.status().message().find("section 'COLR' holds 8 bytes"), std::string::npos);
+  auto two = with_version(4, 2);
+  ASSERT_FALSE(two.ok());
+  EXPECT_NE(two.status().message().find("holds 16 bytes, expected"), std::string::npos);
 }
 
 TEST(Vfrag, MalformedKeyVarintsAreRefused) {
