@@ -125,6 +125,32 @@ class BrickRecorder {
   std::uint64_t last_ = kNone;
 };
 
+// A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
+// triangle spans a few bricks and a task's bricks are Morton neighbours, so most (brick,
+// triangle) pairs find it here. Both are functions of the triangle alone: hits change only time.
+class TriangleCache {
+ public:
+  struct Entry {
+    std::uint32_t triangle = ~0u;
+    std::optional<TriangleVoxelizer> tv;
+    AttributeSampler::Prepared prepared;
+  };
+  const Entry& Get(std::uint32_t t, const MeshVoxelizer& voxelizer,
+                   const AttributeSampler& sampler) {
+    Entry& e = entries_[t % kEntries];
+    if (e.triangle != t) {
+      e.triangle = t;
+      e.tv.emplace(voxelizer.Triangle(t));
+      e.prepared = sampler.Prepare(t);
+    }
+    return e;
+  }
+
+ private:
+  static constexpr std::size_t kEntries = 64;
+  std::array<Entry, kEntries> entries_;
+};
+
 // Area-weighted sums for the voxels of one brick, indexed by local Morton code.
 class BrickAccumulator {
  public:
@@ -347,8 +373,11 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     set.warnings = sampler.warnings();
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
         [] { return std::make_unique<BrickAccumulator>(); });
+    tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
+        [] { return std::make_unique<TriangleCache>(); });
     ParallelChunks(starts.size() - 1, 16, [&](std::size_t begin, std::size_t end) {
       BrickAccumulator& acc = *accumulators.local();
+      TriangleCache& cache = *caches.local();
       AttributeSample samples[16];  // one run's samples (built once: a run is often one voxel)
       std::size_t finished = 0;
       for (std::size_t g = begin; g < end; ++g) {
@@ -360,9 +389,9 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         const std::int64_t lo[3] = {std::int64_t{bc.x} << 4, std::int64_t{bc.y} << 4,
                                     std::int64_t{bc.z} << 4};
         for (std::size_t i = starts[g]; i < starts[g + 1]; ++i) {
-          const std::uint32_t t = pairs[i].triangle;
-          const TriangleVoxelizer tv = voxelizer.Triangle(t);
-          const AttributeSampler::Prepared prepared = sampler.Prepare(t);
+          const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer, sampler);
+          const TriangleVoxelizer& tv = *entry.tv;
+          const AttributeSampler::Prepared& prepared = entry.prepared;
           const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
           tv.RunsWithInterior(
               lo[u], lo[u] + 16, lo[v], lo[v] + 16,
