@@ -30,27 +30,29 @@ struct Frame {
   }
 };
 
-// Sutherland–Hodgman against one plane of the unit box: keeps p[kAxis] ≥ 0 (kUpper false) or
-// p[kAxis] ≤ 1. Vertices on the plane are kept; an edge yields an intersection only when it
-// crosses strictly, so touching never duplicates a vertex (an edge or corner contact stays a
-// segment or a point, with zero area). Branch-free in the loop body: which vertices survive
-// depends on the voxel, and mispredicted branches would dominate the cost, so every candidate is
-// written and the output count advanced only for the kept ones.
-template <int kAxis, bool kUpper>
-int ClipPlane(const Frame& f, const ClipVertex* in, int n, ClipVertex* out) {
+// Sutherland–Hodgman against one half-plane: keeps the vertices with distance(v) ≥ 0. Vertices on
+// the line are kept; an edge yields an intersection only when it crosses strictly, so touching
+// never duplicates a vertex (an edge or corner contact stays a segment or a point, with zero
+// area). Branch-free in the loop body: which vertices survive depends on the voxel, and
+// mispredicted branches would dominate the cost, so every candidate is written and the output
+// count advanced only for the kept ones. Vertex: any aggregate of two doubles.
+template <class Vertex, class Distance>
+int ClipHalfPlane(const Vertex* in, int n, Vertex* out, const Distance& distance) {
   int m = 0;
-  ClipVertex prev = in[n - 1];
-  double dprev = kUpper ? 1.0 - f.Coord<kAxis>(prev) : f.Coord<kAxis>(prev);
+  Vertex prev = in[n - 1];
+  double dprev = distance(prev);
   for (int i = 0; i < n; ++i) {
-    const ClipVertex cur = in[i];
-    const double dcur = kUpper ? 1.0 - f.Coord<kAxis>(cur) : f.Coord<kAxis>(cur);
+    const Vertex cur = in[i];
+    const double dcur = distance(cur);
     // Strictly opposite signs. (A product underflowing to zero would only drop an intersection
     // within 1e-150 of a kept vertex.)
     const bool crosses = dprev * dcur < 0;
     // Without a crossing the quotient may be ±inf or NaN (IEEE, no trap): the candidate written
     // below is then overwritten, never read. No branch here: it would mispredict.
     const double t = dprev / (dprev - dcur);
-    out[m] = {prev.b1 + t * (cur.b1 - prev.b1), prev.b2 + t * (cur.b2 - prev.b2)};
+    const auto [p0, p1] = prev;
+    const auto [c0, c1] = cur;
+    out[m] = {p0 + t * (c0 - p0), p1 + t * (c1 - p1)};
     m += crosses;
     out[m] = cur;
     m += dcur >= 0;
@@ -61,26 +63,33 @@ int ClipPlane(const Frame& f, const ClipVertex* in, int n, ClipVertex* out) {
   return m;
 }
 
-// Clips against the planes of axis kAxis that the current polygon crosses (often none: a small
-// triangle inside the box, or the last axis once the other two have cut the polygon down).
-template <int kAxis>
-int ClipAxis(const Frame& f, ClipVertex*& poly, ClipVertex*& spare, int n) {
-  double lo = f.Coord<kAxis>(poly[0]), hi = lo;
+// Clips the polygon (in `poly`, `spare` the other buffer) to 0 ≤ coord(v) ≤ 1, by the lines it
+// crosses only (often none: a small triangle inside the box, or the last axis once the other two
+// have cut the polygon down).
+template <class Vertex, class Coord>
+int ClipToUnitSlab(Vertex*& poly, Vertex*& spare, int n, const Coord& coord) {
+  double lo = coord(poly[0]), hi = lo;
   for (int i = 1; i < n; ++i) {
-    const double c = f.Coord<kAxis>(poly[i]);
+    const double c = coord(poly[i]);
     lo = std::min(lo, c);
     hi = std::max(hi, c);
   }
   if (hi < 0 || lo > 1) return 0;
   if (lo < 0) {
-    n = ClipPlane<kAxis, false>(f, poly, n, spare);
+    n = ClipHalfPlane(poly, n, spare, coord);
     std::swap(poly, spare);
   }
   if (hi > 1 && n > 0) {
-    n = ClipPlane<kAxis, true>(f, poly, n, spare);
+    n = ClipHalfPlane(poly, n, spare, [&](const Vertex& v) { return 1.0 - coord(v); });
     std::swap(poly, spare);
   }
   return n;
+}
+
+// Clips against the planes of axis kAxis of the unit box.
+template <int kAxis>
+int ClipAxis(const Frame& f, ClipVertex*& poly, ClipVertex*& spare, int n) {
+  return ClipToUnitSlab(poly, spare, n, [&](const ClipVertex& q) { return f.Coord<kAxis>(q); });
 }
 
 // Clips the triangle to the voxel's column, the unit square in (kU, kV) (the polygon ends up in
@@ -128,71 +137,18 @@ struct Point2 {
   double s, t;
 };
 
-// Sutherland–Hodgman in 2D against s (kAxis 0) or t ≥ 0 (kUpper false) or ≤ 1; branch-free
-// like ClipPlane.
-template <int kAxis, bool kUpper>
-int ClipSquareSide(const Point2* in, int n, Point2* out) {
-  auto dist = [](const Point2& q) {
-    const double c = kAxis == 0 ? q.s : q.t;
-    return kUpper ? 1.0 - c : c;
-  };
-  int m = 0;
-  Point2 prev = in[n - 1];
-  double dprev = dist(prev);
-  for (int i = 0; i < n; ++i) {
-    const Point2 cur = in[i];
-    const double dcur = dist(cur);
-    const double r = dprev / (dprev - dcur);
-    out[m] = {prev.s + r * (cur.s - prev.s), prev.t + r * (cur.t - prev.t)};
-    m += dprev * dcur < 0;
-    out[m] = cur;
-    m += dcur >= 0;
-    m = std::min(m, kMaxPolygon);
-    prev = cur;
-    dprev = dcur;
-  }
-  return m;
-}
-
-// Clips to the sides of the unit square along kAxis that the polygon crosses.
-template <int kAxis>
-int ClipSquareAxis(Point2*& poly, Point2*& spare, int n) {
-  double lo = kAxis == 0 ? poly[0].s : poly[0].t, hi = lo;
-  for (int i = 1; i < n; ++i) {
-    const double c = kAxis == 0 ? poly[i].s : poly[i].t;
-    lo = std::min(lo, c);
-    hi = std::max(hi, c);
-  }
-  if (hi < 0 || lo > 1) return 0;
-  if (lo < 0) n = ClipSquareSide<kAxis, false>(poly, n, spare), std::swap(poly, spare);
-  if (hi > 1 && n > 0) n = ClipSquareSide<kAxis, true>(poly, n, spare), std::swap(poly, spare);
-  return n;
-}
-
+// Twice the polygon's area (shoelace formula), whichever its orientation.
 double TwiceArea(const Point2* q, int n) {
   double twice = 0;
   for (int i = 0, j = n - 1; i < n; j = i++) twice += q[j].s * q[i].t - q[j].t * q[i].s;
   return std::abs(twice);
 }
 
-// Area of the part of polygon q[0..n) where the plane height h (per vertex) is ≤ level: the
-// polygon clipped by that line (branch-free, as above), then the shoelace formula.
-double AreaBelow(const Point2* q, const double* h, int n, double level) {
+// Area of the part of polygon q[0..n) where `height` (the plane's, linear) is ≤ level.
+template <class Height>
+double AreaBelow(const Point2* q, int n, const Height& height, double level) {
   Point2 out[kClipCapacity];
-  int m = 0;
-  Point2 prev = q[n - 1];
-  double dprev = level - h[n - 1];
-  for (int i = 0; i < n; ++i) {
-    const double dcur = level - h[i];
-    const double r = dprev / (dprev - dcur);
-    out[m] = {prev.s + r * (q[i].s - prev.s), prev.t + r * (q[i].t - prev.t)};
-    m += dprev * dcur < 0;
-    out[m] = q[i];
-    m += dcur >= 0;
-    m = std::min(m, kMaxPolygon);
-    prev = q[i];
-    dprev = dcur;
-  }
+  const int m = ClipHalfPlane(q, n, out, [&](const Point2& p) { return level - height(p); });
   return 0.5 * TwiceArea(out, m);
 }
 
@@ -362,18 +318,18 @@ void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int6
   poly[0] = {a[u], a[v]};
   poly[1] = {a[u] + p.e1[u], a[v] + p.e1[v]};
   poly[2] = {a[u] + p.e2[u], a[v] + p.e2[v]};
-  int m = ClipSquareAxis<0>(poly, spare, 3);
-  if (m > 0) m = ClipSquareAxis<1>(poly, spare, m);
-  double h[kClipCapacity];
+  int m = ClipToUnitSlab(poly, spare, 3, [](const Point2& q) { return q.s; });
+  if (m > 0) m = ClipToUnitSlab(poly, spare, m, [](const Point2& q) { return q.t; });
+  auto height = [&](const Point2& q) { return h00 + p.slope_u * q.s + p.slope_v * q.t; };
   double lo = 0, hi = 0;
   for (int k = 0; k < m; ++k) {
-    h[k] = h00 + p.slope_u * poly[k].s + p.slope_v * poly[k].t;
-    lo = k == 0 ? h[k] : std::min(lo, h[k]);
-    hi = k == 0 ? h[k] : std::max(hi, h[k]);
+    const double h = height(poly[k]);
+    lo = k == 0 ? h : std::min(lo, h);
+    hi = k == 0 ? h : std::max(hi, h);
   }
   const double total = m > 0 ? 0.5 * TwiceArea(poly, m) : 0.0;
   auto below = [&](double level) {
-    return level <= lo ? 0.0 : level >= hi ? total : AreaBelow(poly, h, m, level);
+    return level <= lo ? 0.0 : level >= hi ? total : AreaBelow(poly, m, height, level);
   };
   below_prev = below(0);
   for (int i = 0; i < n; ++i) {
