@@ -126,8 +126,9 @@ class BrickRecorder {
 };
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
-// triangle spans a few bricks and a task's bricks are Morton neighbours, so most (brick,
-// triangle) pairs find it here. Both are functions of the triangle alone: hits change only time.
+// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 31 % of the
+// (brick, triangle) pairs hit at 1024³, 78 % at 4096³). Both are functions of the triangle
+// alone, so hits change only the time.
 class TriangleCache {
  public:
   struct Entry {
