@@ -195,10 +195,12 @@ TEST(AttributeClip, AreasOverAllVoxelsSumToTheTriangleAndMatchTheExactOverlapTes
   }
 }
 
-// Uniform triangles (no texture, vertex colours or normals) take SampleColumn's projection path:
+// Uniform triangles (no texture, vertex colours or normals) take ColumnSampler's projection path:
 // per voxel, the same area as clipping the triangle to the voxel's box (an independent
 // computation: 3D polygons in barycentric coordinates), the same colour and normal; a column the
-// walk calls interior holds the whole square lifted onto the plane (area |N| / |N[w]|).
+// walk calls interior holds the whole square lifted onto the plane (area |N| / |N[w]|). One
+// sampler follows the walk (rows split off column by column), another gets the columns in
+// reverse order (each row started afresh), a third is fresh per column: all three agree.
 TEST(AttributeClip, ProjectedColumnAreasOfUniformTrianglesEqualClippedAreas) {
   std::mt19937_64 rng(20261123);
   std::uniform_int_distribution<std::int64_t> coord(0, 12 * kFixedPointOne);
@@ -225,33 +227,50 @@ TEST(AttributeClip, ProjectedColumnAreasOfUniformTrianglesEqualClippedAreas) {
     for (VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
       const TriangleVoxelizer tv(m.vertices[0], m.vertices[1], m.vertices[2], mode, grid);
       const int w = tv.dominant_axis();
+      struct Run {
+        std::int64_t x, y, z, n;
+        bool interior;
+      };
+      std::vector<Run> runs;
+      AttributeSampler::ColumnSampler walk_order(sampler, p), reverse_order(sampler, p);
+      std::vector<std::vector<AttributeSample>> walked;
       tv.RunsWithInterior(
           tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(),
           [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t n, bool interior) {
             ASSERT_LE(n, 16);
-            ASSERT_TRUE(!interior || mode == VoxelMode::kConservative);
-            AttributeSample column[16];
-            sampler.SampleColumn(p, x, y, z, w, static_cast<int>(n), interior, column);
-            std::int64_t c[3] = {x, y, z};
-            double sum = 0;
-            for (int i = 0; i < n; ++i, ++c[w]) {
-              const AttributeSample clipped = sampler.Sample(0, c[0], c[1], c[2]);
-              EXPECT_NEAR(column[i].area, clipped.area, 1e-9 * (1 + clipped.area))
-                  << iter << " voxel " << c[0] << " " << c[1] << " " << c[2];
-              EXPECT_EQ(column[i].color, clipped.color);
-              EXPECT_EQ(column[i].normal, clipped.normal);
-              sum += column[i].area;
-            }
-            if (interior) {
-              ++interior_columns;
-              // A face in a voxel boundary plane has a run of two voxels and counts in both.
-              const bool flat = p.slope_u == 0 && p.slope_v == 0;
-              const double lifted = p.secant * (flat ? static_cast<double>(n) : 1.0);
-              EXPECT_NEAR(sum, lifted, 1e-9 * lifted) << iter;
-            } else {
-              ++boundary_columns;
-            }
+            runs.push_back({x, y, z, n, interior});
+            walked.emplace_back(n);
+            walk_order.Sample(x, y, z, w, static_cast<int>(n), interior, walked.back().data());
           });
+      ASSERT_FALSE(runs.empty());
+      for (std::size_t r = runs.size(); r-- > 0;) {
+        const auto [x, y, z, n, interior] = runs[r];
+        ASSERT_TRUE(!interior || mode == VoxelMode::kConservative);
+        AttributeSample fresh[16], reversed[16];
+        sampler.SampleColumn(p, x, y, z, w, static_cast<int>(n), interior, fresh);
+        reverse_order.Sample(x, y, z, w, static_cast<int>(n), interior, reversed);
+        std::int64_t c[3] = {x, y, z};
+        double sum = 0;
+        for (int i = 0; i < n; ++i, ++c[w]) {
+          const AttributeSample clipped = sampler.Sample(0, c[0], c[1], c[2]);
+          for (const AttributeSample& column : {walked[r][i], fresh[i], reversed[i]}) {
+            EXPECT_NEAR(column.area, clipped.area, 1e-9 * (1 + clipped.area))
+                << iter << " voxel " << c[0] << " " << c[1] << " " << c[2];
+            EXPECT_EQ(column.color, clipped.color);
+            EXPECT_EQ(column.normal, clipped.normal);
+          }
+          sum += walked[r][i].area;
+        }
+        if (interior) {
+          ++interior_columns;
+          // A face in a voxel boundary plane has a run of two voxels and counts in both.
+          const bool flat = p.slope_u == 0 && p.slope_v == 0;
+          const double lifted = p.secant * (flat ? static_cast<double>(n) : 1.0);
+          EXPECT_NEAR(sum, lifted, 1e-9 * lifted) << iter;
+        } else {
+          ++boundary_columns;
+        }
+      }
     }
   }
   EXPECT_GT(interior_columns, 1000);

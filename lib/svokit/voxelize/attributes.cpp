@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "svokit/core/parallel.hpp"
 
@@ -9,16 +10,10 @@ namespace svokit {
 
 namespace {
 
-// A triangle clipped by the 6 planes of a box has at most 3 + 6 = 9 vertices (each plane adds at
-// most one to a convex polygon). Rounding could in principle make a near-degenerate polygon
-// non-convex and add more; the clipper caps the count at kMaxPolygon (dropping vertices of such a
-// sliver, never writing out of bounds).
-constexpr int kMaxPolygon = 16;
-// The branch-free clipper writes up to two vertices per input vertex before deciding to keep
-// them: buffers have room for that past kMaxPolygon.
-constexpr int kClipCapacity = kMaxPolygon + 2;
-
 using attributes_detail::ClipVertex;
+using attributes_detail::kClipCapacity;
+using attributes_detail::kMaxPolygon;
+using attributes_detail::Point2;
 
 // The triangle in voxel-local coordinates (the box is [0, 1]³): p(b) = a + b1·e1 + b2·e2. All
 // three are fixed-point differences, exact in doubles, so the original corners map back exactly.
@@ -30,15 +25,17 @@ struct Frame {
   }
 };
 
-// Sutherland–Hodgman against one half-plane: keeps the vertices with distance(v) ≥ 0. Vertices on
-// the line are kept; an edge yields an intersection only when it crosses strictly, so touching
-// never duplicates a vertex (an edge or corner contact stays a segment or a point, with zero
-// area). Branch-free in the loop body: which vertices survive depends on the voxel, and
-// mispredicted branches would dominate the cost, so every candidate is written and the output
-// count advanced only for the kept ones. Vertex: any aggregate of two doubles.
-template <class Vertex, class Distance>
-int ClipHalfPlane(const Vertex* in, int n, Vertex* out, const Distance& distance) {
-  int m = 0;
+// Sutherland–Hodgman against one line: the vertices with distance(v) ≥ 0 go to `out`, and, for a
+// split (kSplit), those with distance(v) ≤ 0 to `rest` (*rest_n of them). Vertices on the line go
+// to both sides; an edge yields an intersection only when it crosses strictly, so touching never
+// duplicates a vertex (an edge or corner contact stays a segment or a point, with zero area).
+// Branch-free in the loop body: which vertices survive depends on the voxel, and mispredicted
+// branches would dominate the cost, so every candidate is written and the output counts advanced
+// only for the kept ones. Vertex: any aggregate of two doubles.
+template <bool kSplit, class Vertex, class Distance>
+int CutByLine(const Vertex* in, int n, Vertex* out, Vertex* rest, int* rest_n,
+              const Distance& distance) {
+  int m = 0, r = 0;
   Vertex prev = in[n - 1];
   double dprev = distance(prev);
   for (int i = 0; i < n; ++i) {
@@ -52,15 +49,30 @@ int ClipHalfPlane(const Vertex* in, int n, Vertex* out, const Distance& distance
     const double t = dprev / (dprev - dcur);
     const auto [p0, p1] = prev;
     const auto [c0, c1] = cur;
-    out[m] = {p0 + t * (c0 - p0), p1 + t * (c1 - p1)};
+    const Vertex cut = {p0 + t * (c0 - p0), p1 + t * (c1 - p1)};
+    out[m] = cut;
     m += crosses;
     out[m] = cur;
     m += dcur >= 0;
     m = std::min(m, kMaxPolygon);
+    if constexpr (kSplit) {
+      rest[r] = cut;
+      r += crosses;
+      rest[r] = cur;
+      r += dcur <= 0;
+      r = std::min(r, kMaxPolygon);
+    }
     prev = cur;
     dprev = dcur;
   }
+  if constexpr (kSplit) *rest_n = r;
   return m;
+}
+
+// Keeps the part of the polygon in[0..n) with distance(v) ≥ 0, in out[0..return value).
+template <class Vertex, class Distance>
+int ClipHalfPlane(const Vertex* in, int n, Vertex* out, const Distance& distance) {
+  return CutByLine<false, Vertex>(in, n, out, nullptr, nullptr, distance);
 }
 
 // Clips the polygon (in `poly`, `spare` the other buffer) to 0 ≤ coord(v) ≤ 1, by the lines it
@@ -130,12 +142,6 @@ int ClipToColumn(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
   if (n > 0) n = ClipAxis<kV>(f, poly, spare, n);
   return n;
 }
-
-// Projected (2D) geometry of uniform triangles: a polygon in the column's unit square, with each
-// vertex's plane height relative to the run's first voxel.
-struct Point2 {
-  double s, t;
-};
 
 // Twice the polygon's area (shoelace formula), whichever its orientation.
 double TwiceArea(const Point2* q, int n) {
@@ -279,7 +285,33 @@ void AttributeSampler::SampleRun(const Prepared& p, std::int64_t x, std::int64_t
 void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int64_t y,
                                     std::int64_t z, int axis, int n, bool interior,
                                     AttributeSample* out) const {
-  if (!p.uniform || axis != p.axis) return SampleRun(p, x, y, z, axis, n, out);
+  ColumnSampler(*this, p).Sample(x, y, z, axis, n, interior, out);
+}
+
+void AttributeSampler::ColumnSampler::StartRow(std::int64_t u, std::int64_t v) {
+  const int iu = (p_.axis + 1) % 3, iv = (p_.axis + 2) % 3;
+  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
+  // The first vertex relative to the column's corner: exact fixed-point differences.
+  const double s0 = static_cast<double>(p_.v0[iu] - u * kFixedPointOne) * kScale;
+  const double t0 = static_cast<double>(p_.v0[iv] - v * kFixedPointOne) * kScale;
+  Point2 spare[kClipCapacity];
+  Point2* poly = row_;
+  Point2* other = spare;
+  poly[0] = {s0, t0};
+  poly[1] = {s0 + p_.e1[iu], t0 + p_.e1[iv]};
+  poly[2] = {s0 + p_.e2[iu], t0 + p_.e2[iv]};
+  row_n_ = ClipToUnitSlab(poly, other, 3, [](const Point2& q) { return q.t; });
+  if (poly != row_) std::copy(poly, poly + row_n_, row_);
+  row_valid_ = true;
+  row_u_ = u;
+  row_v_ = v;
+  next_u_ = std::numeric_limits<std::int64_t>::min();
+}
+
+void AttributeSampler::ColumnSampler::Sample(std::int64_t x, std::int64_t y, std::int64_t z,
+                                             int axis, int n, bool interior, AttributeSample* out) {
+  const Prepared& p = p_;
+  if (!p.uniform || axis != p.axis) return sampler_.SampleRun(p, x, y, z, axis, n, out);
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const std::int64_t corner[3] = {x, y, z};
   constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
@@ -311,16 +343,36 @@ void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int6
     }
     return;
   }
-  // The projected triangle clipped to the column's square.
-  Point2 buffers[2][kClipCapacity];
-  Point2* poly = buffers[0];
-  Point2* spare = buffers[1];
-  poly[0] = {a[u], a[v]};
-  poly[1] = {a[u] + p.e1[u], a[v] + p.e1[v]};
-  poly[2] = {a[u] + p.e2[u], a[v] + p.e2[v]};
-  int m = ClipToUnitSlab(poly, spare, 3, [](const Point2& q) { return q.s; });
-  if (m > 0) m = ClipToUnitSlab(poly, spare, m, [](const Point2& q) { return q.t; });
-  auto height = [&](const Point2& q) { return h00 + p.slope_u * q.s + p.slope_v * q.t; };
+  // The projected triangle clipped to the column's square: the row's part left of the column's
+  // far side, split off the row (s relative to the row's first column, t to the row).
+  if (!row_valid_ || corner[v] != row_v_ || corner[u] < next_u_) StartRow(corner[u], corner[v]);
+  const double s_lo = static_cast<double>(corner[u] - row_u_), s_hi = s_lo + 1;
+  Point2 buffer[kClipCapacity];
+  Point2* poly = buffer;
+  int m = 0;
+  if (row_n_ > 0) {
+    double lo = row_[0].s, hi = lo;
+    for (int k = 1; k < row_n_; ++k) lo = std::min(lo, row_[k].s), hi = std::max(hi, row_[k].s);
+    if (next_u_ != corner[u] && lo < s_lo) {  // columns skipped (interior ones, or row start)
+      Point2 kept[kClipCapacity];
+      row_n_ = ClipHalfPlane(row_, row_n_, kept, [&](const Point2& q) { return q.s - s_lo; });
+      std::copy(kept, kept + row_n_, row_);
+    }
+    if (hi <= s_hi) {  // the row ends in this column
+      poly = row_;
+      m = row_n_;
+      row_n_ = 0;
+    } else if (row_n_ > 0) {
+      Point2 rest[kClipCapacity];
+      const int rest_n = CutByLine<true>(row_, row_n_, rest, buffer, &m,
+                                         [&](const Point2& q) { return q.s - s_hi; });
+      std::copy(rest, rest + rest_n, row_);
+      row_n_ = rest_n;
+    }
+  }
+  next_u_ = corner[u] + 1;
+  const double h0 = h00 - p.slope_u * s_lo;  // height over (s, t) = (0, 0) of the row's frame
+  auto height = [&](const Point2& q) { return h0 + p.slope_u * q.s + p.slope_v * q.t; };
   double lo = 0, hi = 0;
   for (int k = 0; k < m; ++k) {
     const double h = height(poly[k]);

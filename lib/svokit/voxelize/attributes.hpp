@@ -25,6 +25,18 @@ namespace attributes_detail {
 struct ClipVertex {
   double b1, b2;
 };
+// A point of a uniform triangle's dominant-axis projection.
+struct Point2 {
+  double s, t;
+};
+// A triangle clipped by the 6 planes of a box has at most 3 + 6 = 9 vertices (each plane adds at
+// most one to a convex polygon). Rounding could in principle make a near-degenerate polygon
+// non-convex and add more; the clipper caps the count at kMaxPolygon (dropping vertices of such a
+// sliver, never writing out of bounds).
+constexpr int kMaxPolygon = 16;
+// The branch-free clipper writes up to two vertices per input vertex before deciding to keep
+// them: buffers have room for that past kMaxPolygon.
+constexpr int kClipCapacity = kMaxPolygon + 2;
 }  // namespace attributes_detail
 
 /// What one triangle contributes to one voxel.
@@ -77,11 +89,35 @@ class AttributeSampler {
     double slope_u = 0, slope_v = 0, secant = 0;
   };
   Prepared Prepare(std::size_t triangle) const;
-  /// SampleRun() along the triangle's dominant axis, the columns the voxelizer walks; `interior`:
-  /// the column's square lies inside the triangle's projection (TriangleVoxelizer's exact test).
-  /// A uniform triangle's areas come from its projection instead of clipped polygons: the column's
+
+  /// SampleRun() along the triangle's dominant axis, for the columns the voxelizer walks. A
+  /// uniform triangle's areas come from its projection instead of clipped polygons: the column's
   /// part of the projected triangle split at the voxel levels (for an interior column, the unit
-  /// square, in closed form). The same areas as SampleRun()'s up to rounding.
+  /// square, in closed form). The same areas as SampleRun()'s up to rounding (~1e-14 voxel²).
+  /// Columns asked for in the walk's order (rows of increasing v, increasing u within a row) are
+  /// cut off one row polygon in turn, each by one split; any other order is correct, only slower.
+  class ColumnSampler {
+   public:
+    ColumnSampler(const AttributeSampler& sampler, const Prepared& p) : sampler_(sampler), p_(p) {}
+    /// `interior`: the column's square lies inside the triangle's projection (TriangleVoxelizer's
+    /// exact test).
+    void Sample(std::int64_t x, std::int64_t y, std::int64_t z, int axis, int n, bool interior,
+                AttributeSample* out);
+
+   private:
+    // Makes row_ the part of the projected triangle in the row's strip v ≤ t ≤ v + 1, in
+    // coordinates relative to column (u, v); the part left of column u is dropped on use.
+    void StartRow(std::int64_t u, std::int64_t v);
+
+    const AttributeSampler& sampler_;
+    const Prepared& p_;
+    attributes_detail::Point2 row_[attributes_detail::kClipCapacity];
+    int row_n_ = 0;
+    bool row_valid_ = false;
+    std::int64_t row_u_ = 0, row_v_ = 0;  // the column the row's coordinates are relative to
+    std::int64_t next_u_ = 0;             // row_ holds only the part with u ≥ next_u_
+  };
+  /// ColumnSampler::Sample() of a fresh sampler: one column, out of any order.
   void SampleColumn(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis,
                     int n, bool interior, AttributeSample* out) const;
   /// Sample() for the `n` voxels from (x, y, z) on along `axis`, into out[0..n), identical voxel

@@ -5,8 +5,6 @@
 #include <memory>
 #include <optional>
 
-#include <malloc.h>
-
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
@@ -340,9 +338,6 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   VoxelBitSet::Ranks ranks;
   set.keys = VoxelBitSet::UnionKeys(parts, attributes ? &ranks : nullptr);
   parts.clear();
-  // The per-thread bricks were many small blocks: hand their pages back before the attribute
-  // arrays are allocated, or they would stay in the peak (~4 B/voxel).
-  if (attributes) malloc_trim(0);
   stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
   stage.reset();
   if (attributes) {
@@ -394,6 +389,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
           const TriangleVoxelizer& tv = *entry.tv;
           const AttributeSampler::Prepared& prepared = entry.prepared;
           const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
+          AttributeSampler::ColumnSampler columns(sampler, prepared);
           tv.RunsWithInterior(
               lo[u], lo[u] + 16, lo[v], lo[v] + 16,
               [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k, bool interior) {
@@ -404,7 +400,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                 if (first >= last) return;
                 c[w] = first;
                 const int count = static_cast<int>(last - first);
-                sampler.SampleColumn(prepared, c[0], c[1], c[2], w, count, interior, samples);
+                columns.Sample(c[0], c[1], c[2], w, count, interior, samples);
                 std::uint32_t local = VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
                 for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
                   acc.Add(local, samples[s]);
