@@ -31,17 +31,19 @@ std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
 }
 
 // An optional per-voxel array: absent, or one T per voxel; since version 4 also a single T that
-// every voxel shares (`uniform_allowed`).
+// every voxel shares (`shared`: refused, given to every voxel, or kept once as VoxelSet::colors
+// does).
+enum class Shared { kRefused, kExpanded, kKept };
 template <class T>
 Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                    std::vector<T>& out, bool uniform_allowed = false) {
+                    std::vector<T>& out, Shared shared = Shared::kRefused) {
   const auto section = file.Find(tag);
   if (!section) return Status::Ok();
   ByteReader r(*section, file.name());
-  if (uniform_allowed && section->size() == sizeof(T)) {
+  if (shared != Shared::kRefused && section->size() == sizeof(T)) {
     T value;
     SVOKIT_RETURN_IF_ERROR(r.Get(value));
-    out.assign(voxels, value);
+    out.assign(shared == Shared::kKept ? 1 : voxels, value);
     return Status::Ok();
   }
   const std::size_t expected = voxels * sizeof(T);
@@ -137,20 +139,19 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
                               dims[1], dims[2]);
     }
   }
-  const bool uniform_allowed = file->version() >= 4;
+  const bool v4 = file->version() >= 4;
+  const Shared expanded = v4 ? Shared::kExpanded : Shared::kRefused;
   if (file->version() >= 3) {
-    SVOKIT_RETURN_IF_ERROR(
-        ReadPerVoxel(*file, kColors, set.keys.size(), set.colors, uniform_allowed));
-    SVOKIT_RETURN_IF_ERROR(
-        ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals, uniform_allowed));
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors,
+                                        v4 ? Shared::kKept : Shared::kRefused));
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals, expanded));
   } else {
     SVOKIT_RETURN_IF_ERROR(ReadFloatsAsHalves<Rgba>(*file, kColors, set.keys.size(), set.colors));
     SVOKIT_RETURN_IF_ERROR(
         ReadFloatsAsHalves<Vec3f>(*file, kNormals, set.keys.size(), set.normals));
   }
   if (file->version() >= 2) {
-    SVOKIT_RETURN_IF_ERROR(
-        ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage, uniform_allowed));
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage, expanded));
   } else {  // version 1 stored coverage as f32
     std::vector<float> coverage;
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), coverage));
@@ -316,7 +317,7 @@ Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path) {
     w.Put(static_cast<float>(p.z));
     if (set.has_normals()) w.Put(Vec3f(set.normals[i]));
     if (set.has_colors()) {
-      const Rgba color = set.colors[i];
+      const Rgba color = set.color(i);
       w.Put(to_byte(color.r));
       w.Put(to_byte(color.g));
       w.Put(to_byte(color.b));

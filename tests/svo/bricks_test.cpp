@@ -795,6 +795,33 @@ TEST(Bricks, RealMeshParentSamplesAreTheTentOfTheirFinerSamplesSideTwo) {
   CheckParentsAreTents(r);
 }
 
+TEST(Bricks, AColourHeldOnceBuildsTheBricksOfTheSameColourPerVoxel) {
+  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(mesh.ok());
+  mesh->textures.clear();  // untextured: its material's base colour everywhere
+  for (Material& m : mesh->materials) m.texture = -1;
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), 32);
+  ASSERT_TRUE(grid.ok());
+  VoxelizeOptions options;
+  options.colors = options.normals = true;
+  auto once = Voxelize(*mesh, *grid, options);
+  ASSERT_TRUE(once.ok());
+  ASSERT_EQ(once->colors.size(), 1u);
+  VoxelSet per_voxel = *once;
+  per_voxel.colors.assign(per_voxel.size(), once->colors[0]);
+  BuildOptions build;
+  build.contours = false;
+  auto a = BuildSvo(*once, nullptr, build);
+  auto b = BuildSvo(per_voxel, nullptr, build);
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->levels.size(), b->levels.size());
+  for (std::size_t l = 0; l < a->levels.size(); ++l) {
+    EXPECT_FALSE(a->levels[l].color.empty());
+    EXPECT_EQ(a->levels[l].color, b->levels[l].color) << l;
+    EXPECT_EQ(a->levels[l].normal, b->levels[l].normal) << l;
+  }
+}
+
 TEST(Bricks, RealMeshVoxelSamplesFollowTheDefinition) {
   // Voxel level from the voxel attributes directly: every sample the mean over the 2^k voxels
   // whose closed cube holds it (empty ones count with opacity 0).
@@ -834,7 +861,7 @@ TEST(Bricks, RealMeshVoxelSamplesFollowTheDefinition) {
             const auto it = index.find(Key({x, y, z}));
             if (it == index.end()) continue;
             o += 1;
-            const Rgba& c = voxels->colors[it->second];
+            const Rgba c = voxels->color(it->second);
             rgb[0] += c.r;
             rgb[1] += c.g;
             rgb[2] += c.b;

@@ -278,7 +278,9 @@ TEST(SvoBuild, RejectsEmptySetBadBrickSideContoursWithoutMeshAndAttributeMismatc
   EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
   EXPECT_NE(r.status().message().find("mesh"), std::string::npos) << r.status().message();
 
-  VoxelSet short_colors = good;
+  // One colour per voxel, or one for all: any other count is refused.
+  const VoxelSet three = MakeSet(Grid(4, 4, 4), {{1, 1, 1}, {2, 2, 2}, {3, 3, 3}});
+  VoxelSet short_colors = three;
   short_colors.colors.pop_back();
   r = BuildSvo(short_colors, nullptr, NoContours());
   ASSERT_FALSE(r.ok());

@@ -143,5 +143,65 @@ TEST(VoxelizeAttributes, DeterministicAcrossMethodsAndThreads) {
   EXPECT_GT(coverage, 0);
 }
 
+// A colour every point of the surface has is every voxel's colour: held once. Materials sharing
+// one base colour count as one; two base colours, a texture or vertex colours make it per voxel,
+// and voxels whose surface has one material get that colour exactly (binary16-exact colours).
+TEST(VoxelizeAttributes, OneColourEverywhereIsHeldOnce) {
+  const Rgba warm{0.75f, 0.25f, 0.5f, 1}, cold{0.125f, 0.5f, 1, 1};
+  Mesh m = test::Icosphere(3, false);
+  auto grid = GridTransform::FitResolution(m.Bounds(), 48);
+  ASSERT_TRUE(grid.ok());
+  VoxelizeOptions options;
+  options.colors = options.normals = true;
+  auto voxelize = [&] {
+    auto set = Voxelize(m, *grid, options);
+    EXPECT_TRUE(set.ok()) << set.status().message();
+    return std::move(set).value();
+  };
+  // The upper half of the triangles (by centroid) get material 1.
+  std::vector<std::uint32_t> halves;
+  for (const Triangle& t : m.triangles) {
+    halves.push_back(m.positions[t[0]].z + m.positions[t[1]].z + m.positions[t[2]].z > 0);
+  }
+
+  m.materials = {{.name = "a", .base_color = warm}};
+  m.material_ids.assign(m.triangles.size(), 0);
+  const VoxelSet one = voxelize();
+  ASSERT_EQ(one.colors.size(), 1u);
+  EXPECT_EQ(one.color(one.size() - 1), HalfRgba(warm));
+  ASSERT_EQ(one.normals.size(), one.size());
+
+  m.materials.push_back({.name = "b", .base_color = warm});
+  m.material_ids = halves;
+  const VoxelSet same = voxelize();
+  EXPECT_EQ(same.colors, one.colors);
+  EXPECT_EQ(same.normals, one.normals);
+  EXPECT_EQ(same.coverage, one.coverage);
+
+  m.materials[1].base_color = cold;
+  const VoxelSet two = voxelize();
+  ASSERT_EQ(two.colors.size(), two.size());
+  std::size_t warm_voxels = 0, cold_voxels = 0;
+  for (std::size_t i = 0; i < two.size(); ++i) {
+    const MortonCoord k = MortonDecode(two.keys[i]);
+    const double z = grid->VoxelCenter({k.x, k.y, k.z}).z;
+    // Voxels well away from the equator see one material only.
+    if (std::abs(z) < 3 * grid->voxel_size()) continue;
+    EXPECT_EQ(two.colors[i], z < 0 ? HalfRgba(warm) : HalfRgba(cold)) << i;
+    (z < 0 ? warm_voxels : cold_voxels)++;
+  }
+  EXPECT_GT(warm_voxels, 500u);
+  EXPECT_GT(cold_voxels, 500u);
+  EXPECT_EQ(two.normals, one.normals);
+
+  m.materials[1].base_color = warm;
+  m.colors.assign(3 * m.triangles.size(), Rgba{1, 1, 1, 1});  // white vertex colours
+  const VoxelSet vertex_colored = voxelize();
+  ASSERT_EQ(vertex_colored.colors.size(), vertex_colored.size());
+  for (std::size_t i = 0; i < vertex_colored.size(); ++i) {
+    ASSERT_EQ(vertex_colored.colors[i], HalfRgba(warm)) << i;
+  }
+}
+
 }  // namespace
 }  // namespace svokit

@@ -142,7 +142,7 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
         if (block[c] < 0) continue;
         BrickSample b;
         b.opacity = 1;
-        if (color) b.color = voxels->colors[static_cast<std::size_t>(block[c])];
+        if (color) b.color = voxels->color(static_cast<std::size_t>(block[c]));
         if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
         cells[c] = Premultiply(b);
       }

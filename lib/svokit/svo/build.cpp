@@ -80,7 +80,7 @@ StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
   if (options.contours && mesh == nullptr) {
     return Status::BadInput("contours need the mesh the voxels came from");
   }
-  if ((voxels.has_colors() && voxels.colors.size() != voxels.size()) ||
+  if ((voxels.has_colors() && voxels.colors.size() != voxels.size() && voxels.colors.size() != 1) ||
       (voxels.has_normals() && voxels.normals.size() != voxels.size())) {
     return Status::BadInput("voxel attribute arrays do not match the voxel count");
   }

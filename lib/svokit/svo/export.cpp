@@ -273,8 +273,10 @@ Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& pa
 
 Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path) {
   std::vector<std::uint32_t> rgb(voxels.size(), 0xffffffu);  // white without colours
-  for (std::size_t i = 0; i < voxels.colors.size(); ++i) {
-    rgb[i] = EncodeColor(voxels.colors[i]) & 0xffffffu;
+  if (voxels.has_colors()) {
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      rgb[i] = EncodeColor(voxels.color(i)) & 0xffffffu;
+    }
   }
   const Palette palette = MedianCut(rgb);
 

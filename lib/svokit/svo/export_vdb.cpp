@@ -48,7 +48,7 @@ Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path)
                              static_cast<openvdb::Int32>(c.z));
     occupied.setValueOn(ijk, true);
     if (voxels.has_colors()) {
-      const Rgba& rgba = voxels.colors[i];
+      const Rgba rgba = voxels.color(i);
       colored.setValueOn(ijk, openvdb::Vec3f(rgba.r, rgba.g, rgba.b));
     }
     if (voxels.has_normals()) {

@@ -225,6 +225,25 @@ AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoin
   }
 }
 
+std::optional<Rgba> AttributeSampler::SharedColor() const {
+  if (!want_color_ || mesh_.has_colors()) return std::nullopt;
+  // The materials the triangles use (index materials_.size(): none, opaque white).
+  std::vector<std::uint8_t> used(materials_.size() + 1, 0);
+  for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    const std::uint32_t id = t < mesh_.material_ids.size() ? mesh_.material_ids[t] : 0;
+    used[std::min<std::size_t>(id, materials_.size())] = 1;
+  }
+  std::optional<Rgba> shared;
+  for (std::size_t m = 0; m < used.size(); ++m) {
+    if (!used[m]) continue;
+    if (m < materials_.size() && materials_[m].texture && mesh_.has_uvs()) return std::nullopt;
+    const Rgba color = m < materials_.size() ? materials_[m].base_color : Rgba{};
+    if (shared && !(*shared == color)) return std::nullopt;
+    shared = color;
+  }
+  return shared;
+}
+
 AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const {
   Prepared p;
   p.triangle = triangle;

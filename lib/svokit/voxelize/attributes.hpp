@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -124,6 +125,10 @@ class AttributeSampler {
   /// by voxel; a run along the triangle's dominant axis clips to its column once.
   void SampleRun(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis, int n,
                  AttributeSample* out) const;
+
+  /// The colour of every point of every triangle, when there is one (no vertex colours, and the
+  /// materials the triangles use are untextured and share one base colour): every voxel's mean.
+  std::optional<Rgba> SharedColor() const;
 
   /// Textures that could not be decoded, one message each (their materials use the base colour).
   const std::vector<std::string>& warnings() const { return warnings_; }

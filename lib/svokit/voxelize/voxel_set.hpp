@@ -27,6 +27,8 @@ struct VoxelSet {
   /// voxel² (its coverage). All in binary16, as .vfrag stores them: ~3 significant digits are
   /// all a filtered colour, a normal or a weight needs, and the 16 bytes a voxel saved over floats
   /// are fresh memory the voxelizer would otherwise have to touch. Empty when not requested.
+  /// A colour every voxel has (an untextured mesh without vertex colours, one material colour)
+  /// is held once: `colors` then has one entry; read colours through color(i).
   std::vector<HalfRgba> colors;
   std::vector<HalfVec3> normals;
   std::vector<Half> coverage;
@@ -36,6 +38,8 @@ struct VoxelSet {
 
   std::size_t size() const { return keys.size(); }
   bool has_colors() const { return !colors.empty(); }
+  /// Voxel i's colour (has_colors()), whether held per voxel or once for all.
+  HalfRgba color(std::size_t i) const { return colors[colors.size() == 1 ? 0 : i]; }
   bool has_normals() const { return !normals.empty(); }
 };
 

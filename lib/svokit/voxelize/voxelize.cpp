@@ -150,9 +150,11 @@ class TriangleCache {
   std::array<Entry, kEntries> entries_;
 };
 
-// Area-weighted sums for the voxels of one brick, indexed by local Morton code.
+// Area-weighted sums for the voxels of one brick, indexed by local Morton code. Colours are
+// summed only when they differ between voxels (`colors`; else the set holds the shared one).
 class BrickAccumulator {
  public:
+  explicit BrickAccumulator(bool colors) : colors_(colors) {}
   static constexpr std::size_t kVoxels = std::size_t{1} << VoxelBitSet::kBrickBits;
   // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
   // only that way still averages its contacts.
@@ -163,7 +165,10 @@ class BrickAccumulator {
     const double w = s.area + kMinWeight;
     sum.weight += w;
     sum.area += s.area;
-    sum.r += s.color.r * w, sum.g += s.color.g * w, sum.b += s.color.b * w, sum.a += s.color.a * w;
+    if (colors_) {
+      sum.r += s.color.r * w, sum.g += s.color.g * w, sum.b += s.color.b * w;
+      sum.a += s.color.a * w;
+    }
     sum.nx += s.normal.x * w, sum.ny += s.normal.y * w, sum.nz += s.normal.z * w;
   }
   // Writes the brick's voxels, keys [first, last) of `set`, and clears their sums.
@@ -173,7 +178,7 @@ class BrickAccumulator {
       Sum& sum = sums_[set.keys[index] & kLocalMask];
       const double inv = sum.weight > 0 ? 1.0 / sum.weight : 0.0;
       set.coverage[index] = static_cast<float>(sum.area);
-      if (set.has_colors()) {
+      if (colors_) {
         set.colors[index] = Rgba{static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
                                  static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)};
       }
@@ -193,6 +198,7 @@ class BrickAccumulator {
     double weight = 0, area = 0, r = 0, g = 0, b = 0, a = 0, nx = 0, ny = 0, nz = 0;
   };
   std::array<Sum, kVoxels> sums_{};
+  bool colors_;
 };
 
 }  // namespace
@@ -356,19 +362,22 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
       }
       starts.push_back(pairs.size());
     };
+    const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
+    set.warnings = sampler.warnings();
+    const std::optional<Rgba> shared_color = sampler.SharedColor();
+    if (shared_color) set.colors.assign(1, *shared_color);
+    const bool color_per_voxel = options.colors && !shared_color;
     // The output arrays are fresh memory, whose first touch is slow on VMs: they are filled
     // side by side, and beside the sorting of the bins.
     const std::size_t voxels = set.keys.size();
-    tbb::parallel_invoke([&] { set.colors.resize(options.colors ? voxels : 0); },
+    tbb::parallel_invoke([&] { set.colors.resize(color_per_voxel ? voxels : set.colors.size()); },
                          [&] {
                            set.normals.resize(options.normals ? voxels : 0);
                            set.coverage.resize(voxels);
                          },
                          sort_bins);
-    const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
-    set.warnings = sampler.warnings();
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
-        [] { return std::make_unique<BrickAccumulator>(); });
+        [&] { return std::make_unique<BrickAccumulator>(color_per_voxel); });
     tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
         [] { return std::make_unique<TriangleCache>(); });
     ParallelChunks(starts.size() - 1, 16, [&](std::size_t begin, std::size_t end) {
