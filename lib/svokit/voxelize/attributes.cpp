@@ -308,19 +308,34 @@ void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int6
 }
 
 void AttributeSampler::ColumnSampler::StartRow(std::int64_t u, std::int64_t v) {
-  const int iu = (p_.axis + 1) % 3, iv = (p_.axis + 2) % 3;
-  constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
-  // The first vertex relative to the column's corner: exact fixed-point differences.
-  const double s0 = static_cast<double>(p_.v0[iu] - u * kFixedPointOne) * kScale;
-  const double t0 = static_cast<double>(p_.v0[iv] - v * kFixedPointOne) * kScale;
-  Point2 spare[kClipCapacity];
-  Point2* poly = row_;
-  Point2* other = spare;
-  poly[0] = {s0, t0};
-  poly[1] = {s0 + p_.e1[iu], t0 + p_.e1[iv]};
-  poly[2] = {s0 + p_.e2[iu], t0 + p_.e2[iv]};
-  row_n_ = ClipToUnitSlab(poly, other, 3, [](const Point2& q) { return q.t; });
-  if (poly != row_) std::copy(poly, poly + row_n_, row_);
+  Point2 poly[kClipCapacity];
+  int n;
+  if (row_valid_ && v == row_v_ + 1) {  // the previous row's upper part, moved to this frame
+    const double ds = static_cast<double>(u - row_u_);
+    n = above_n_;
+    for (int k = 0; k < n; ++k) poly[k] = {above_[k].s - ds, above_[k].t - 1};
+  } else {
+    const int iu = (p_.axis + 1) % 3, iv = (p_.axis + 2) % 3;
+    constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
+    // The first vertex relative to the column's corner: exact fixed-point differences.
+    const double s0 = static_cast<double>(p_.v0[iu] - u * kFixedPointOne) * kScale;
+    const double t0 = static_cast<double>(p_.v0[iv] - v * kFixedPointOne) * kScale;
+    Point2 triangle[3] = {
+        {s0, t0}, {s0 + p_.e1[iu], t0 + p_.e1[iv]}, {s0 + p_.e2[iu], t0 + p_.e2[iv]}};
+    n = ClipHalfPlane(triangle, 3, poly, [](const Point2& q) { return q.t; });
+  }
+  double hi = 0;
+  for (int k = 0; k < n; ++k) hi = std::max(hi, poly[k].t);
+  if (hi <= 1) {
+    std::copy(poly, poly + n, row_);
+    row_n_ = n;
+    above_n_ = 0;
+  } else if (n > 0) {
+    above_n_ =
+        CutByLine<true>(poly, n, above_, row_, &row_n_, [](const Point2& q) { return q.t - 1; });
+  } else {
+    row_n_ = above_n_ = 0;
+  }
   row_valid_ = true;
   row_u_ = u;
   row_v_ = v;

@@ -107,13 +107,15 @@ class AttributeSampler {
 
    private:
     // Makes row_ the part of the projected triangle in the row's strip v ≤ t ≤ v + 1, in
-    // coordinates relative to column (u, v); the part left of column u is dropped on use.
+    // coordinates relative to column (u, v), and above_ the part above it; the next row splits
+    // above_ (walks go up row by row). The part left of column u is dropped on use.
     void StartRow(std::int64_t u, std::int64_t v);
 
     const AttributeSampler& sampler_;
     const Prepared& p_;
     attributes_detail::Point2 row_[attributes_detail::kClipCapacity];
-    int row_n_ = 0;
+    attributes_detail::Point2 above_[attributes_detail::kClipCapacity];
+    int row_n_ = 0, above_n_ = 0;
     bool row_valid_ = false;
     std::int64_t row_u_ = 0, row_v_ = 0;  // the column the row's coordinates are relative to
     std::int64_t next_u_ = 0;             // row_ holds only the part with u ≥ next_u_
