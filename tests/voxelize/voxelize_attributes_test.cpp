@@ -143,6 +143,36 @@ TEST(VoxelizeAttributes, DeterministicAcrossMethodsAndThreads) {
   EXPECT_GT(coverage, 0);
 }
 
+// With attributes the voxels are found brick by brick (triangles binned to bricks by their box
+// or by walking them); without, by the method's own split: the same voxels either way, for
+// small triangles (box-binned), huge ones (walked, and cut into tiles by the fragment path) and
+// both modes.
+TEST(VoxelizeAttributes, AttributesFindTheSameVoxelsAsGeometryOnly) {
+  auto torus = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(torus.ok());
+  const Mesh coarse_sphere = test::Icosphere(0, false);  // 20 triangles
+  const std::pair<const Mesh*, std::uint32_t> cases[] = {{&*torus, 96}, {&coarse_sphere, 200}};
+  for (const auto& [mesh, resolution] : cases) {
+    auto grid = GridTransform::FitResolution(mesh->Bounds(), resolution);
+    ASSERT_TRUE(grid.ok());
+    for (VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
+      for (VoxelMethod method : {VoxelMethod::kTriangle, VoxelMethod::kFragment}) {
+        VoxelizeOptions options;
+        options.mode = mode;
+        options.method = method;
+        auto geometry = Voxelize(*mesh, *grid, options);
+        options.colors = options.normals = true;
+        auto attributed = Voxelize(*mesh, *grid, options);
+        ASSERT_TRUE(geometry.ok() && attributed.ok());
+        EXPECT_GT(geometry->size(), 1000u);
+        EXPECT_EQ(attributed->keys, geometry->keys) << resolution;
+        EXPECT_EQ(attributed->normals.size(), attributed->size());
+        EXPECT_EQ(attributed->coverage.size(), attributed->size());
+      }
+    }
+  }
+}
+
 // A colour every point of the surface has is every voxel's colour: held once. Materials sharing
 // one base colour count as one; two base colours, a texture or vertex colours make it per voxel,
 // and voxels whose surface has one material get that colour exactly (binary16-exact colours).

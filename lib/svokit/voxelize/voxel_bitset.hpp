@@ -70,17 +70,9 @@ class VoxelBitSet {
   std::uint64_t brick_key(std::size_t i) const { return keys_[i]; }
   const Brick& brick(std::size_t i) const { return bricks_[i]; }
 
-  /// Where each brick of a union sits in its sorted key array: its voxels are keys
-  /// [first[slot], first[slot + 1]).
-  struct Ranks {
-    std::unordered_map<std::uint64_t, std::uint32_t> brick_slot;
-    std::vector<std::uint64_t> first;  // per slot, and one past the last
-  };
-
-  /// The union of `sets` as sorted unique Morton keys (thread-count independent); fills `ranks`
-  /// when given.
+  /// The union of `sets` as sorted unique Morton keys (thread-count independent).
   template <class Sets>
-  static std::vector<std::uint64_t> UnionKeys(const Sets& sets, Ranks* ranks = nullptr);
+  static std::vector<std::uint64_t> UnionKeys(const Sets& sets);
 
  private:
   // The bits of brick (bx, by, bz), created empty on first use.
@@ -119,7 +111,7 @@ class VoxelBitSet {
 // Union of bit sets: group bricks by key, OR each group, and write every brick's keys at its
 // prefix-sum offset. The result does not depend on how voxels were spread over the sets.
 template <class Sets>
-std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks) {
+std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
   // Every (brick key, bitmap) of every set, grouped by key; pointers only, no copies.
   struct Ref {
     std::uint64_t key;
@@ -166,13 +158,6 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets, Ranks* ranks
       }
     }
   });
-  if (ranks) {
-    ranks->brick_slot.reserve(bricks);
-    for (std::size_t b = 0; b < bricks; ++b) {
-      ranks->brick_slot.emplace(refs[starts[b]].key, static_cast<std::uint32_t>(b));
-    }
-    ranks->first = std::move(offset);
-  }
   return keys;
 }
 
