@@ -127,9 +127,9 @@ class BrickRecorder {
 };
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
-// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 31 % of the
-// (brick, triangle) pairs hit at 1024³, 78 % at 4096³). Both are functions of the triangle
-// alone, so hits change only the time.
+// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 44 % of the
+// 152 k (brick, triangle) pairs hit at 1024³, 76 % of 497 k at 4096³; 64 entries: 33 %, 70 %).
+// Both are functions of the triangle alone, so hits change only the time.
 class TriangleCache {
  public:
   struct Entry {
@@ -149,7 +149,7 @@ class TriangleCache {
   }
 
  private:
-  static constexpr std::size_t kEntries = 64;
+  static constexpr std::size_t kEntries = 256;
   std::array<Entry, kEntries> entries_;
 };
 
