@@ -55,8 +55,8 @@ class ByteReader {
     pos_ += sizeof(T);
     return Status::Ok();
   }
-  template <class T>
-  Status GetArray(std::vector<T>& values, std::size_t count) {
+  template <class T, class Allocator>
+  Status GetArray(std::vector<T, Allocator>& values, std::size_t count) {
     static_assert(std::is_trivially_copyable_v<T>);
     if (count > remaining() / sizeof(T)) return Overrun(count * sizeof(T));
     values.resize(count);

@@ -58,7 +58,7 @@ Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size
 // Version 3 KEYS: u64 count, then per key the gap to the previous one minus one (the first key
 // itself) as an LEB128 varint: sorted surface voxels are mostly a few apart, ~1.3 bytes a key.
 Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
-                  std::vector<std::uint64_t>& keys) {
+                  DefaultInitVector<std::uint64_t>& keys) {
   ByteReader r(bytes, name + ": KEYS section");
   std::uint64_t count = 0;
   SVOKIT_RETURN_IF_ERROR(r.Get(count));
@@ -206,10 +206,10 @@ container::Writer::Producer Chunked(std::size_t voxels, Encode encode) {
   };
 }
 
-container::Writer::Producer KeysProducer(const std::vector<std::uint64_t>& keys) {
+container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys) {
   const std::uint64_t count = keys.size();
   auto varints = Chunked(
-      keys.size(), [&keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
+      keys.size(), [keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
         std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
         for (std::size_t i = begin; i < end; ++i) {
           std::uint64_t gap = keys[i] - prev - 1;

@@ -50,7 +50,8 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
   // and metadata naming the source and the options.
   auto voxels = ReadVfrag(vfrag);
   ASSERT_TRUE(voxels.ok());
-  EXPECT_EQ(sa->LevelKeys(sa->depth), voxels->keys);
+  EXPECT_EQ(sa->LevelKeys(sa->depth),
+            std::vector<std::uint64_t>(voxels->keys.begin(), voxels->keys.end()));
   EXPECT_EQ(sa->grid, voxels->grid);
   EXPECT_EQ(sa->depth, 6u);
   EXPECT_EQ(sa->brick_side, 3u);

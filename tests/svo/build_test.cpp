@@ -319,7 +319,8 @@ TEST(SvoBuild, RealMeshStructureIsConsistent) {
   ASSERT_GT(torus.voxels.size(), 1000u);
   const Svo svo = BuildOk(torus.voxels, NoContours());
   EXPECT_EQ(svo.depth, 6u);
-  EXPECT_EQ(svo.LevelKeys(svo.depth), torus.voxels.keys);
+  EXPECT_EQ(svo.LevelKeys(svo.depth),
+            std::vector<std::uint64_t>(torus.voxels.keys.begin(), torus.voxels.keys.end()));
   const auto keys = LevelKeysFromVoxels(torus.voxels.keys, svo.depth);
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
     EXPECT_EQ(svo.LevelKeys(l), keys[l]) << "level " << l;

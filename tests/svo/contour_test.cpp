@@ -35,9 +35,9 @@ std::uint32_t Depth(const GridTransform& grid) {
   while ((std::uint64_t{1} << d) < grid.max_dim()) ++d;
   return d;
 }
-Keys LevelKeys(const std::vector<std::uint64_t>& voxels, std::uint32_t depth) {
+Keys LevelKeys(std::span<const std::uint64_t> voxels, std::uint32_t depth) {
   Keys keys(depth + 1);
-  keys[depth] = voxels;
+  keys[depth].assign(voxels.begin(), voxels.end());
   for (std::uint32_t l = depth; l > 0; --l) {
     auto& up = keys[l - 1];
     for (const std::uint64_t k : keys[l]) {

@@ -647,7 +647,7 @@ std::vector<std::uint64_t> Run(const Mesh& mesh, const GridTransform& grid, Voxe
   EXPECT_EQ(set->mode, mode);
   EXPECT_EQ(set->grid, grid);
   EXPECT_TRUE(std::is_sorted(set->keys.begin(), set->keys.end()));
-  return std::move(set->keys);
+  return {set->keys.begin(), set->keys.end()};
 }
 
 /// For a voxel where mesh and reference disagree, the triangles responsible, as reproducers.
@@ -1024,7 +1024,8 @@ TEST(VoxelBitSetRuns, RunsAcrossBricksMatchPerVoxelKeys) {
   }
   std::sort(want.begin(), want.end());
   want.erase(std::unique(want.begin(), want.end()), want.end());
-  EXPECT_EQ(VoxelBitSet::UnionKeys(sets), want);
+  const DefaultInitVector<std::uint64_t> got = VoxelBitSet::UnionKeys(sets);
+  EXPECT_EQ(std::vector<std::uint64_t>(got.begin(), got.end()), want);
 }
 
 }  // namespace

@@ -12,10 +12,10 @@ std::uint32_t OctreeDepth(const GridTransform& grid) {
   return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
 }
 
-std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(const std::vector<std::uint64_t>& keys,
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth) {
   std::vector<std::vector<std::uint64_t>> levels(depth + 1);
-  levels[depth] = keys;
+  levels[depth].assign(keys.begin(), keys.end());
   for (std::uint32_t l = depth; l-- > 0;) {
     const std::vector<std::uint64_t>& finer = levels[l + 1];
     std::vector<std::uint64_t>& coarser = levels[l];

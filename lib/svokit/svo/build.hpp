@@ -3,6 +3,7 @@
 // level; bricks filtered level by level (bricks.hpp), contours fitted to the mesh (contour.hpp).
 
 #include <cstdint>
+#include <span>
 
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
@@ -25,7 +26,7 @@ StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
                        std::string metadata = "{}", Progress& progress = Progress::Silent());
 
 /// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending.
-std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(const std::vector<std::uint64_t>& keys,
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth);
 /// The depth whose 2^depth cube encloses the grid.
 std::uint32_t OctreeDepth(const GridTransform& grid);

@@ -200,7 +200,8 @@ VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
   for (std::uint32_t& d : dims) d = ((d - 1) >> shift) + 1;
   set.grid = GridTransform(svo.grid.origin(), svo.NodeSize(level), dims);
   set.mode = svo.mode;
-  set.keys = svo.LevelKeys(level);
+  const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
+  set.keys.assign(keys.begin(), keys.end());
   const std::vector<std::uint32_t> samples = NodeSamples(svo.brick_side);
   if (samples.empty()) return set;
   if (svo.has_color) set.colors.resize(set.keys.size());

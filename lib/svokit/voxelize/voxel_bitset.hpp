@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "svokit/core/default_init.hpp"
 #include "svokit/core/morton.hpp"
 
 namespace svokit {
@@ -72,7 +73,7 @@ class VoxelBitSet {
 
   /// The union of `sets` as sorted unique Morton keys (thread-count independent).
   template <class Sets>
-  static std::vector<std::uint64_t> UnionKeys(const Sets& sets);
+  static DefaultInitVector<std::uint64_t> UnionKeys(const Sets& sets);
 
  private:
   // The bits of brick (bx, by, bz), created empty on first use.
@@ -111,7 +112,7 @@ class VoxelBitSet {
 // Union of bit sets: group bricks by key, OR each group, and write every brick's keys at its
 // prefix-sum offset. The result does not depend on how voxels were spread over the sets.
 template <class Sets>
-std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
+DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
   // Every (brick key, bitmap) of every set, grouped by key; pointers only, no copies.
   struct Ref {
     std::uint64_t key;
@@ -147,7 +148,7 @@ std::vector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
     offset[b + 1] = count;
   });
   for (std::size_t b = 0; b < bricks; ++b) offset[b + 1] += offset[b];
-  std::vector<std::uint64_t> keys(offset[bricks]);
+  DefaultInitVector<std::uint64_t> keys(offset[bricks]);  // first touched by the writes below
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
     const Brick m = merge(b);
     std::uint64_t* out = keys.data() + offset[b];

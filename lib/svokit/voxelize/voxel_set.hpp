@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "svokit/core/default_init.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/morton.hpp"
@@ -21,7 +22,8 @@ enum class VoxelMode : std::uint32_t {
 struct VoxelSet {
   GridTransform grid;
   VoxelMode mode = VoxelMode::kConservative;
-  std::vector<std::uint64_t> keys;  ///< sorted ascending, unique
+  /// Sorted ascending, unique. (Sized without zeroing: it is filled in parallel right after.)
+  DefaultInitVector<std::uint64_t> keys;
   /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
   /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
   /// voxel² (its coverage). All in binary16, as .vfrag stores them: ~3 significant digits are

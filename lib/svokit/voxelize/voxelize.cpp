@@ -155,7 +155,7 @@ class TriangleCache {
 
 // The voxels of some consecutive bricks, in key order, with their attributes.
 struct VoxelRun {
-  std::vector<std::uint64_t> keys;
+  DefaultInitVector<std::uint64_t> keys;
   std::vector<HalfRgba> colors;
   std::vector<HalfVec3> normals;
   std::vector<Half> coverage;
@@ -325,8 +325,8 @@ class BrickPass {
     acc.Finish(brick, out);
   }
 
-  template <class T>
-  static void Append(const std::vector<T>& from, std::vector<T>& to) {
+  template <class Vector>
+  static void Append(const Vector& from, Vector& to) {
     to.insert(to.end(), from.begin(), from.end());
   }
   void Append(const VoxelRun& run, VoxelSet& set) const {
