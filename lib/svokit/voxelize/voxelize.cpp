@@ -49,6 +49,13 @@ class MeshVoxelizer {
     return TriangleVoxelizer(vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]], mode_, box_);
   }
 
+  /// The snapped corners in voxel coordinates (exact in doubles).
+  std::array<Vec3d, 3> Corners(std::size_t t) const {
+    const svokit::Triangle& tri = mesh_.triangles[t];
+    return {FixedToVoxel(vertices_[tri[0]]), FixedToVoxel(vertices_[tri[1]]),
+            FixedToVoxel(vertices_[tri[2]])};
+  }
+
   // Projected dominant-axis area in voxel², in doubles: only a scheduling decision.
   double ProjectedArea(std::size_t t) const {
     const svokit::Triangle& tri = mesh_.triangles[t];
@@ -76,55 +83,62 @@ struct BrickTriangle {
   bool operator==(const BrickTriangle&) const = default;
 };
 
-// Records the bricks one triangle's voxels fall in. A triangle whose candidate box spans at most
-// 2×2×2 bricks is binned by that box (walking the columns of a brick it misses later costs less
-// than walking the whole triangle now: armadillo 1024³ runs 0.31 s binning up to two bricks by
-// box, 0.25 s up to eight); larger ones record the brick of every run (consecutive runs mostly
-// share one).
-class BrickRecorder {
- public:
-  static constexpr std::int64_t kMaxBoxBricks = 8;
-
-  /// Bins `triangle` by its candidate box when that is small enough; false: record its runs.
-  bool BinByBox(const TriangleVoxelizer& tv, std::uint32_t triangle,
-                std::vector<BrickTriangle>& out) {
-    std::int64_t lo[3], hi[3], bricks = 1;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = tv.lo(a) >> 4;
-      hi[a] = (tv.hi(a) - 1) >> 4;
-      bricks *= hi[a] - lo[a] + 1;
-    }
-    if (bricks > kMaxBoxBricks) return false;
-    for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
-        for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
-          out.push_back({MortonEncode(Coord(x), Coord(y), Coord(z)), triangle});
+// Appends (brick, triangle) for the 16³ bricks the triangle may have voxels in: a superset,
+// which is all the brick pass needs (a brick the triangle misses costs a walk of its columns
+// there). Per 16 × 16 window of dominant-axis columns its candidate box spans: none when the
+// projected triangle stays over a voxel away from the window, else the bricks along w between
+// the plane's lowest and highest point over the window's part of the box, widened by the voxels
+// a closed box can touch and one more for rounding. Doubles are exact on the snapped vertices'
+// differences, and rounding elsewhere is far below those one-voxel margins.
+void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std::uint32_t triangle,
+                 std::vector<BrickTriangle>& out) {
+  if (tv.empty()) return;
+  const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
+  double pu[3], pv[3];
+  for (int k = 0; k < 3; ++k) pu[k] = p[k][u], pv[k] = p[k][v];
+  const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const Vec3d normal = Cross(e1, e2);
+  // (u, v, w) is a cyclic permutation of (x, y, z): normal[w] is the projection's doubled area.
+  const double nu = normal[u], nv = normal[v], nw = normal[w];
+  // A (nearly) degenerate triangle, whose rounded normal may point anywhere: its whole box.
+  const bool plane = std::abs(nw) > 1e-9 * Length(e1) * Length(e2);
+  const std::int64_t lo_u = tv.lo(u), hi_u = tv.hi(u), lo_v = tv.lo(v), hi_v = tv.hi(v);
+  for (std::int64_t bv = lo_v >> 4; bv <= (hi_v - 1) >> 4; ++bv) {
+    for (std::int64_t bu = lo_u >> 4; bu <= (hi_u - 1) >> 4; ++bu) {
+      const double u0 = static_cast<double>(std::max(bu * 16, lo_u));
+      const double u1 = static_cast<double>(std::min(bu * 16 + 16, hi_u));
+      const double v0 = static_cast<double>(std::max(bv * 16, lo_v));
+      const double v1 = static_cast<double>(std::min(bv * 16 + 16, hi_v));
+      std::int64_t w_lo = tv.lo(w), w_hi = tv.hi(w) - 1;
+      if (plane) {
+        bool apart = false;  // an edge separates the triangle from the window grown by a voxel
+        for (int k = 0; k < 3; ++k) {
+          const int j = (k + 1) % 3;
+          const double sign = nw > 0 ? 1.0 : -1.0;  // inward normal of edge k→j
+          const double eu = -(pv[j] - pv[k]) * sign, ev = (pu[j] - pu[k]) * sign;
+          const double x = eu > 0 ? u1 + 1 : u0 - 1, y = ev > 0 ? v1 + 1 : v0 - 1;
+          apart |= eu * (x - pu[k]) + ev * (y - pv[k]) < 0;
         }
+        if (apart) continue;
+        double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
+        for (const double x : {u0, u1}) {
+          for (const double y : {v0, v1}) {
+            const double h = p[0][w] - (nu * (x - pu[0]) + nv * (y - pv[0])) / nw;
+            h_lo = std::min(h_lo, h);
+            h_hi = std::max(h_hi, h);
+          }
+        }
+        w_lo = std::max(w_lo, static_cast<std::int64_t>(std::floor(h_lo)) - 2);
+        w_hi = std::min(w_hi, static_cast<std::int64_t>(std::floor(h_hi)) + 1);
+      }
+      for (std::int64_t bw = w_lo >> 4; bw <= w_hi >> 4 && w_lo <= w_hi; ++bw) {
+        std::uint32_t c[3];
+        c[u] = Coord(bu), c[v] = Coord(bv), c[w] = Coord(bw);
+        out.push_back({MortonEncode(c[0], c[1], c[2]), triangle});
       }
     }
-    return true;
   }
-  void Run(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis, std::uint32_t n) {
-    VoxelBitSet::ForEachBrickOfRun(
-        x, y, z, axis, n,
-        [&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint32_t, std::uint32_t) {
-          const std::uint64_t packed = bx | std::uint64_t{by} << 21 | std::uint64_t{bz} << 42;
-          if (packed != last_) bricks_.push_back(MortonEncode(bx, by, bz)), last_ = packed;
-        });
-  }
-  void EndTriangle(std::uint32_t triangle, std::vector<BrickTriangle>& out) {
-    std::sort(bricks_.begin(), bricks_.end());
-    bricks_.erase(std::unique(bricks_.begin(), bricks_.end()), bricks_.end());
-    for (std::uint64_t b : bricks_) out.push_back({b, triangle});
-    bricks_.clear();
-    last_ = kNone;
-  }
-
- private:
-  static constexpr std::uint64_t kNone = ~std::uint64_t{0};
-  std::vector<std::uint64_t> bricks_;
-  std::uint64_t last_ = kNone;
-};
+}
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
 // triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 44 % of the
@@ -375,6 +389,34 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         estimate, kMaxVoxels);
   }
 
+  VoxelSet set;
+  set.grid = grid;
+  set.mode = options.mode;
+  if (options.colors || options.normals) {
+    // Voxels and attributes come out of one walk per brick (BrickPass), whatever the method:
+    // first the bricks each triangle may touch.
+    tbb::enumerable_thread_specific<std::vector<BrickTriangle>> bins;
+    {
+      Progress::Stage stage(progress, "voxelize", n);
+      ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+        std::vector<BrickTriangle>& out = bins.local();
+        for (std::size_t t = begin; t < end; ++t) {
+          BinToBricks(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
+                      out);
+        }
+        stage.Advance(end - begin);
+      });
+    }
+    const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
+    set.warnings = sampler.warnings();
+    const std::optional<Rgba> shared_color = sampler.SharedColor();
+    if (shared_color) set.colors.assign(1, *shared_color);
+    BrickPass pass(voxelizer, sampler, options.colors && !shared_color, options.normals);
+    // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
+    pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, set, progress);
+    return set;
+  }
+
   // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
   if (options.method == VoxelMethod::kHybrid) {
@@ -389,34 +431,17 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     if (is_large[t]) large.push_back(static_cast<std::uint32_t>(t));
   }
 
-  // Geometry only, the stage ends with the voxel set; with attributes, once the triangles are
-  // binned to bricks (the brick pass reports as a stage of its own).
   std::optional<Progress::Stage> stage(std::in_place, progress, "voxelize", n);
   // One bit set per worker thread; their union is the result, whatever the split or thread count.
   tbb::enumerable_thread_specific<VoxelBitSet> parts;
-  const bool attributes = options.colors || options.normals;
-  tbb::enumerable_thread_specific<std::vector<BrickTriangle>> bins;
-  tbb::enumerable_thread_specific<BrickRecorder> recorders;
-  // Geometry only: walks columns [u0,u1)×[v0,v1) of triangle t into this thread's bit set. With
-  // attributes: records the bricks the triangle's voxels fall in (walking only triangles too
-  // large to bin by their box); the brick pass below then finds the voxels and their attributes.
-  auto walk = [&](std::size_t t, const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1,
-                  std::int64_t v0, std::int64_t v1) {
+  // Walks columns [u0,u1)×[v0,v1) of triangle t into this thread's bit set.
+  auto walk = [&](const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                  std::int64_t v1) {
     const int axis = tv.dominant_axis();
-    if (!attributes) {
-      VoxelBitSet& keys = parts.local();
-      tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
-        keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
-      });
-      return;
-    }
-    BrickRecorder& recorder = recorders.local();
-    const auto triangle = static_cast<std::uint32_t>(t);
-    if (recorder.BinByBox(tv, triangle, bins.local())) return;
+    VoxelBitSet& keys = parts.local();
     tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
-      recorder.Run(Coord(x), Coord(y), Coord(z), axis, Coord(k));
+      keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
     });
-    recorder.EndTriangle(triangle, bins.local());
   };
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task, in Morton order
@@ -447,7 +472,7 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         const std::size_t t = order[i].triangle;
         if (is_large[t]) continue;
         const TriangleVoxelizer tv = voxelizer.Triangle(t);
-        walk(t, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
+        walk(tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
       }
       stage->Advance(end - begin);
     });
@@ -469,28 +494,14 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
       for (std::size_t i = begin; i < end; ++i) {
         const Tile& tile = tiles[i];
         const TriangleVoxelizer tv = voxelizer.Triangle(tile.triangle);
-        walk(tile.triangle, tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
+        walk(tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
       }
     });
     stage->Advance(large.size());
   }
 
-  VoxelSet set;
-  set.grid = grid;
-  set.mode = options.mode;
-  if (!attributes) {
-    set.keys = VoxelBitSet::UnionKeys(parts);
-    stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
-    return set;
-  }
-  stage.reset();  // the voxels are found with their attributes, below
-  const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
-  set.warnings = sampler.warnings();
-  const std::optional<Rgba> shared_color = sampler.SharedColor();
-  if (shared_color) set.colors.assign(1, *shared_color);
-  BrickPass pass(voxelizer, sampler, options.colors && !shared_color, options.normals);
-  // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-  pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, set, progress);
+  set.keys = VoxelBitSet::UnionKeys(parts);
+  stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
   return set;
 }
 
