@@ -141,8 +141,8 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
 }
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
-// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 44 % of the
-// 152 k (brick, triangle) pairs hit at 1024³, 76 % of 497 k at 4096³; 64 entries: 33 %, 70 %).
+// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 42 % of the
+// 144 k (brick, triangle) pairs hit at 1024³, 79 % of 607 k at 4096³; 64 entries: 31 %, 74 %).
 // Both are functions of the triangle alone, so hits change only the time.
 class TriangleCache {
  public:
