@@ -45,13 +45,15 @@ int main(int argc, char** argv) {
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
 
     for (const std::string& w : voxels->warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
+    const std::size_t voxel_count = voxels->size();  // the .vfrag writer consumes the set
     Status written;
     {
       Progress::Stage stage(progress, "write", 1);
       const std::string ext = LowerExtension(output);
       if (ext == "vfrag") {
         // Methods and thread counts give the same file, byte for byte: they are not recorded.
-        written = WriteVfrag(*voxels, {input.filename().string(), voxelize.Recorded()}, output);
+        written = WriteVfrag(std::move(*voxels), {input.filename().string(), voxelize.Recorded()},
+                             output);
       } else if (ext == "xyz") {
         written = WriteVoxelsXyz(*voxels, output);
       } else {
@@ -64,7 +66,7 @@ int main(int argc, char** argv) {
     const auto& d = grid->dims();
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}\n", d[0], d[1], d[2], grid->voxel_size());
-    fmt::print("voxels      {} ({})\n", voxels->size(),
+    fmt::print("voxels      {} ({})\n", voxel_count,
                voxelize.options.mode == VoxelMode::kThin ? "thin" : "conservative");
     fmt::print("output      {}\n", output.string());
     return 0;

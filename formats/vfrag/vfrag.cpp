@@ -12,6 +12,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/release_pages.hpp"
 
 namespace svokit {
 
@@ -185,10 +186,11 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
 namespace {
 
 // A per-voxel section encoded while it is written, a batch of chunks at a time, the chunks of a
-// batch in parallel: encode(begin, end, out) appends voxels [begin, end)'s bytes to out.
-template <class Encode>
-container::Writer::Producer Chunked(std::size_t voxels, Encode encode) {
-  return [voxels, encode](const container::Writer::Emit& emit) -> Status {
+// batch in parallel: encode(begin, end, out) appends voxels [begin, end)'s bytes to out;
+// done(begin, end) is told when voxels [begin, end) have been written.
+template <class Encode, class Done>
+container::Writer::Producer Chunked(std::size_t voxels, Encode encode, Done done) {
+  return [voxels, encode, done](const container::Writer::Emit& emit) -> Status {
     constexpr std::size_t kChunk = 1 << 15, kBatch = 16;
     std::vector<std::vector<std::uint8_t>> pieces(kBatch);
     for (std::size_t first = 0; first < voxels; first += kChunk * kBatch) {
@@ -201,15 +203,19 @@ container::Writer::Producer Chunked(std::size_t voxels, Encode encode) {
         }
       });
       for (std::size_t c = 0; c < chunks; ++c) SVOKIT_RETURN_IF_ERROR(emit(pieces[c]));
+      done(first, std::min(voxels, first + kChunk * kBatch));
     }
     return Status::Ok();
   };
 }
 
-container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys) {
+// `release`: the keys' pages are given back as they are written (all but the last key of each
+// batch, which the next one starts from).
+container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys, bool release) {
   const std::uint64_t count = keys.size();
   auto varints = Chunked(
-      keys.size(), [keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
+      keys.size(),
+      [keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
         std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
         for (std::size_t i = begin; i < end; ++i) {
           std::uint64_t gap = keys[i] - prev - 1;
@@ -220,6 +226,9 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys) {
           }
           out.push_back(static_cast<std::uint8_t>(gap));
         }
+      },
+      [keys, release](std::size_t begin, std::size_t end) {
+        if (release) ReleasePages(keys.data() + begin, keys.data() + end - 1);
       });
   return [count, varints](const container::Writer::Emit& emit) -> Status {
     std::uint8_t head[sizeof(count)];
@@ -230,9 +239,10 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys) {
 }
 
 // A per-voxel array's section: the array, or its one value when every voxel has the same (an
-// untextured mesh without vertex colours: one colour for millions of voxels).
+// untextured mesh without vertex colours: one colour for millions of voxels). `release`: the
+// array's pages are given back as they are written.
 template <class T>
-std::span<const std::uint8_t> PerVoxelBytes(const std::vector<T>& values) {
+container::Writer::Producer PerVoxelProducer(const std::vector<T>& values, bool release) {
   std::atomic<bool> uniform = values.size() > 1;
   ParallelChunks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
     if (uniform.load(std::memory_order_relaxed) &&
@@ -242,17 +252,31 @@ std::span<const std::uint8_t> PerVoxelBytes(const std::vector<T>& values) {
     }
   });
   const std::span<const std::uint8_t> all = Bytes(values);
-  return uniform ? all.first(sizeof(T)) : all;
+  const std::span<const std::uint8_t> bytes = uniform ? all.first(sizeof(T)) : all;
+  return [bytes, all, release](const container::Writer::Emit& emit) -> Status {
+    constexpr std::size_t kPiece = std::size_t{4} << 20;
+    for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+      const std::span<const std::uint8_t> piece =
+          bytes.subspan(at, std::min(kPiece, bytes.size() - at));
+      SVOKIT_RETURN_IF_ERROR(emit(piece));
+      if (release) ReleasePages(piece.data(), piece.data() + piece.size());
+    }
+    if (release) ReleasePages(all.data(), all.data() + all.size());
+    return Status::Ok();
+  };
 }
 
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
-container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
+// `release`: each array's pages are given back once written (the set is consumed).
+container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta, bool release) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
-  file.AddSectionProduced(kKeys, KeysProducer(set.keys));
-  if (set.has_colors()) file.AddSectionView(kColors, PerVoxelBytes(set.colors));
-  if (set.has_normals()) file.AddSectionView(kNormals, PerVoxelBytes(set.normals));
-  if (!set.coverage.empty()) file.AddSectionView(kCoverage, PerVoxelBytes(set.coverage));
+  file.AddSectionProduced(kKeys, KeysProducer(set.keys, release));
+  if (set.has_colors()) file.AddSectionProduced(kColors, PerVoxelProducer(set.colors, release));
+  if (set.has_normals()) file.AddSectionProduced(kNormals, PerVoxelProducer(set.normals, release));
+  if (!set.coverage.empty()) {
+    file.AddSectionProduced(kCoverage, PerVoxelProducer(set.coverage, release));
+  }
   const nlohmann::json j = {
       {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
   const std::string text = j.dump();
@@ -263,12 +287,18 @@ container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta) {
 }  // namespace
 
 std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
-  return MakeWriter(set, meta).Serialize();
+  return MakeWriter(set, meta, false).Serialize();
 }
 
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
                   const std::filesystem::path& path) {
-  return MakeWriter(set, meta).WriteFile(path);
+  return MakeWriter(set, meta, false).WriteFile(path);
+}
+
+Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path) {
+  const Status status = MakeWriter(set, meta, true).WriteFile(path);
+  set = VoxelSet{};  // its pages are gone
+  return status;
 }
 
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,

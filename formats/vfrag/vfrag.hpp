@@ -26,6 +26,9 @@ struct VfragMetadata {
 std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta);
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
                   const std::filesystem::path& path);
+/// The same file from a set that is consumed: its arrays' memory goes back to the kernel as it is
+/// written, for the file's page cache to reuse (fresh pages are slow on VMs); `set` is left empty.
+Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path);
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
                                VfragMetadata* meta = nullptr);

@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <sstream>
 
 #include "formats/container/grid_section.hpp"
+#include "svokit/core/file_io.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -67,6 +69,41 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
   bad = DecodeVfrag(EncodeVfrag(s, {}), "nan.vfrag");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("non-finite"), std::string::npos);
+}
+
+// Writing a set it consumes (its pages released as they are written) gives the file of the set
+// written as it is: several batches of keys (each encoded from the one before), attribute
+// sections of several pieces, and a colour every voxel shares; the set is left empty.
+TEST(Vfrag, AConsumedSetWritesTheSameFile) {
+  const test::TempDir dir;
+  VoxelSet s;
+  s.grid = GridTransform({0, 0, 0}, 1, {1 << 12, 1 << 12, 1 << 12});
+  std::mt19937_64 rng(7);
+  std::uint64_t key = 0;
+  for (std::size_t i = 0; i < 1'500'000; ++i) {  // 12 MB of keys, 9 MB of normals
+    key += 1 + rng() % 300;
+    s.keys.push_back(key);
+    const float f = static_cast<float>(rng() % 1000) / 1000;
+    s.normals.push_back({f, 1 - f, 0.5f});
+    s.coverage.push_back(f);
+  }
+  s.colors.assign(1, Rgba{0.25f, 0.5f, 0.75f, 1});
+  for (const bool shared_normal : {false, true}) {
+    if (shared_normal) s.normals.assign(s.size(), HalfVec3{0, 0, 1});
+    const std::vector<std::uint8_t> expected = EncodeVfrag(s, {"m.obj", "--resolution 4096"});
+    VoxelSet consumed = s;
+    ASSERT_TRUE(
+        WriteVfrag(std::move(consumed), {"m.obj", "--resolution 4096"}, dir / "c.vfrag").ok());
+    EXPECT_EQ(consumed.size(), 0u);
+    EXPECT_TRUE(consumed.normals.empty());
+    const auto written = ReadFileBytes(dir / "c.vfrag");
+    ASSERT_TRUE(written.ok());
+    EXPECT_TRUE(*written == expected) << "shared normal " << shared_normal;
+    auto back = DecodeVfrag(*written, "c.vfrag");
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    EXPECT_EQ(back->keys, s.keys);
+    EXPECT_EQ(back->normals, s.normals);
+  }
 }
 
 template <class T, class A>

@@ -346,7 +346,21 @@ void AttributeSampler::ColumnSampler::Sample(std::int64_t x, std::int64_t y, std
                                              int axis, int n, bool interior, AttributeSample* out) {
   const Prepared& p = p_;
   if (!p.uniform || axis != p.axis) return sampler_.SampleRun(p, x, y, z, axis, n, out);
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  ForEachArea(x, y, z, n, interior, [&](int i, double area) {
+    out[i] = {area, p.color, p.unit_normal};
+  });
+}
+
+void AttributeSampler::ColumnSampler::Areas(std::int64_t x, std::int64_t y, std::int64_t z, int n,
+                                            bool interior, double* area) {
+  ForEachArea(x, y, z, n, interior, [&](int i, double a) { area[i] = a; });
+}
+
+template <class Out>
+void AttributeSampler::ColumnSampler::ForEachArea(std::int64_t x, std::int64_t y, std::int64_t z,
+                                                  int n, bool interior, const Out& out) {
+  const Prepared& p = p_;
+  const int axis = p.axis, u = (axis + 1) % 3, v = (axis + 2) % 3;
   const std::int64_t corner[3] = {x, y, z};
   constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
   // The first vertex relative to the run's first voxel corner: exact fixed-point differences.
@@ -373,7 +387,7 @@ void AttributeSampler::ColumnSampler::Sample(std::int64_t x, std::int64_t y, std
         area = std::max(below - below_prev, 0.0);
         below_prev = below;
       }
-      out[i] = {area * p.secant, p.color, p.unit_normal};
+      out(i, area * p.secant);
     }
     return;
   }
@@ -427,7 +441,7 @@ void AttributeSampler::ColumnSampler::Sample(std::int64_t x, std::int64_t y, std
       area = std::max(next - below_prev, 0.0);
       below_prev = next;
     }
-    out[i] = {area * p.secant, p.color, p.unit_normal};
+    out(i, area * p.secant);
   }
 }
 

@@ -104,8 +104,15 @@ class AttributeSampler {
     /// exact test).
     void Sample(std::int64_t x, std::int64_t y, std::int64_t z, int axis, int n, bool interior,
                 AttributeSample* out);
+    /// Sample()'s areas alone, for a uniform triangle's run along its dominant axis (the colour
+    /// and normal of every sample are the triangle's): voxel i's into area[i].
+    void Areas(std::int64_t x, std::int64_t y, std::int64_t z, int n, bool interior, double* area);
 
    private:
+    // Calls out(i, area) for voxel i of the run (uniform triangle, dominant axis).
+    template <class Out>
+    void ForEachArea(std::int64_t x, std::int64_t y, std::int64_t z, int n, bool interior,
+                     const Out& out);
     // Makes row_ the part of the projected triangle in the row's strip v ≤ t ≤ v + 1, in
     // coordinates relative to column (u, v), and above_ the part above it; the next row splits
     // above_ (walks go up row by row). The part left of column u is dropped on use.

@@ -170,14 +170,15 @@ class TriangleCache {
 // The voxels of some consecutive bricks, in key order, with their attributes.
 struct VoxelRun {
   DefaultInitVector<std::uint64_t> keys;
-  std::vector<HalfRgba> colors;
-  std::vector<HalfVec3> normals;
-  std::vector<Half> coverage;
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<HalfVec3> normals;
+  DefaultInitVector<Half> coverage;
   void clear() { keys.clear(), colors.clear(), normals.clear(), coverage.clear(); }
 };
 
 // One brick's voxels (a 16³ bit set) and their area-weighted sums, indexed by local Morton code.
-// Colours are summed only when they differ between voxels (else the set holds the shared one).
+// Colours are summed only when they differ between voxels (else the set holds the shared one),
+// in an array of their own that is otherwise never touched.
 class BrickAccumulator {
  public:
   BrickAccumulator(bool colors, bool normals) : colors_(colors), normals_(normals) {}
@@ -186,53 +187,72 @@ class BrickAccumulator {
   // only that way still averages its contacts.
   static constexpr double kMinWeight = 1.0 / (1 << 20);
 
-  void Add(std::uint32_t local, const AttributeSample& s) {
+  void Add(std::uint32_t local, double area, const Rgba& color, const Vec3f& normal) {
     bits_[local >> 6] |= std::uint64_t{1} << (local & 63);
     Sum& sum = sums_[local];
-    const double w = s.area + kMinWeight;
+    const double w = area + kMinWeight;
     sum.weight += w;
-    sum.area += s.area;
+    sum.area += area;
     if (colors_) {
-      sum.r += s.color.r * w, sum.g += s.color.g * w, sum.b += s.color.b * w;
-      sum.a += s.color.a * w;
+      ColorSum& c = color_sums_[local];
+      c.r += color.r * w, c.g += color.g * w, c.b += color.b * w, c.a += color.a * w;
     }
-    sum.nx += s.normal.x * w, sum.ny += s.normal.y * w, sum.nz += s.normal.z * w;
+    sum.nx += normal.x * w, sum.ny += normal.y * w, sum.nz += normal.z * w;
   }
   // Appends the brick's voxels (bits set in local Morton order = key order) to `out`, and
   // clears the brick.
   void Finish(std::uint64_t brick, VoxelRun& out) {
-    const std::uint64_t base = brick << VoxelBitSet::kBrickBits;
+    std::uint16_t locals[kVoxels];
+    std::size_t n = 0;
     for (std::size_t word = 0; word < bits_.size(); ++word) {
       for (std::uint64_t bits = bits_[word]; bits != 0; bits &= bits - 1) {
-        const std::size_t local = word * 64 + static_cast<std::size_t>(std::countr_zero(bits));
-        Sum& sum = sums_[local];
-        out.keys.push_back(base | local);
-        out.coverage.push_back(static_cast<float>(sum.area));
-        if (colors_) {
-          const double inv = 1.0 / sum.weight;  // ≥ kMinWeight
-          out.colors.push_back(
-              Rgba{static_cast<float>(sum.r * inv), static_cast<float>(sum.g * inv),
-                   static_cast<float>(sum.b * inv), static_cast<float>(sum.a * inv)});
-        }
-        if (normals_) {
-          const double len = std::sqrt(sum.nx * sum.nx + sum.ny * sum.ny + sum.nz * sum.nz);
-          const double scale = len > 0 ? 1.0 / len : 0.0;
-          out.normals.push_back(Vec3f{static_cast<float>(sum.nx * scale),
-                                      static_cast<float>(sum.ny * scale),
-                                      static_cast<float>(sum.nz * scale)});
-        }
-        sum = {};
+        locals[n++] = static_cast<std::uint16_t>(word * 64 + std::countr_zero(bits));
       }
       bits_[word] = 0;
     }
+    const std::size_t at = out.keys.size();
+    const std::uint64_t base = brick << VoxelBitSet::kBrickBits;
+    out.keys.resize(at + n);
+    out.coverage.resize(at + n);
+    for (std::size_t i = 0; i < n; ++i) {
+      Sum& sum = sums_[locals[i]];
+      out.keys[at + i] = base | locals[i];
+      out.coverage[at + i] = static_cast<float>(sum.area);
+    }
+    if (colors_) {
+      out.colors.resize(at + n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const double inv = 1.0 / sums_[locals[i]].weight;  // ≥ kMinWeight
+        ColorSum& c = color_sums_[locals[i]];
+        out.colors[at + i] = Rgba{static_cast<float>(c.r * inv), static_cast<float>(c.g * inv),
+                                  static_cast<float>(c.b * inv), static_cast<float>(c.a * inv)};
+        c = {};
+      }
+    }
+    if (normals_) {
+      out.normals.resize(at + n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Sum& sum = sums_[locals[i]];
+        const double len = std::sqrt(sum.nx * sum.nx + sum.ny * sum.ny + sum.nz * sum.nz);
+        const double scale = len > 0 ? 1.0 / len : 0.0;
+        out.normals[at + i] =
+            Vec3f{static_cast<float>(sum.nx * scale), static_cast<float>(sum.ny * scale),
+                  static_cast<float>(sum.nz * scale)};
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) sums_[locals[i]] = {};
   }
 
  private:
   struct Sum {
-    double weight = 0, area = 0, r = 0, g = 0, b = 0, a = 0, nx = 0, ny = 0, nz = 0;
+    double weight = 0, area = 0, nx = 0, ny = 0, nz = 0;
+  };
+  struct ColorSum {
+    double r = 0, g = 0, b = 0, a = 0;
   };
   VoxelBitSet::Brick bits_{};
   std::array<Sum, kVoxels> sums_{};
+  std::array<ColorSum, kVoxels> color_sums_{};
   bool colors_, normals_;
 };
 
@@ -314,11 +334,15 @@ class BrickPass {
     const std::int64_t lo[3] = {std::int64_t{bc.x} << 4, std::int64_t{bc.y} << 4,
                                 std::int64_t{bc.z} << 4};
     AttributeSample samples[16];  // one run's samples (built once: a run is often one voxel)
+    double areas[16];
     for (std::size_t i = first; i < last; ++i) {
       const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
       const TriangleVoxelizer& tv = *entry.tv;
+      const AttributeSampler::Prepared& p = entry.prepared;
       const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
-      AttributeSampler::ColumnSampler columns(sampler_, entry.prepared);
+      // A uniform triangle's samples differ only in area (most meshes: scans, CAD, STL).
+      const bool uniform = p.uniform && p.axis == w;
+      AttributeSampler::ColumnSampler columns(sampler_, p);
       tv.RunsWithInterior(
           lo[u], lo[u] + 16, lo[v], lo[v] + 16,
           [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k, bool interior) {
@@ -329,18 +353,25 @@ class BrickPass {
             if (begin >= end) return;
             c[w] = begin;
             const int count = static_cast<int>(end - begin);
-            columns.Sample(c[0], c[1], c[2], w, count, interior, samples);
             std::uint32_t local = VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
-            for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
-              acc.Add(local, samples[s]);
+            if (uniform) {
+              columns.Areas(c[0], c[1], c[2], count, interior, areas);
+              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+                acc.Add(local, areas[s], p.color, p.unit_normal);
+              }
+            } else {
+              columns.Sample(c[0], c[1], c[2], w, count, interior, samples);
+              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+                acc.Add(local, samples[s].area, samples[s].color, samples[s].normal);
+              }
             }
           });
     }
     acc.Finish(brick, out);
   }
 
-  template <class Vector>
-  static void Append(const Vector& from, Vector& to) {
+  template <class From, class To>
+  static void Append(const From& from, To& to) {
     to.insert(to.end(), from.begin(), from.end());
   }
   void Append(const VoxelRun& run, VoxelSet& set) const {

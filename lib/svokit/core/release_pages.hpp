@@ -1,0 +1,24 @@
+#pragma once
+// Giving memory back as it is consumed. On VMs a fresh page costs far more on first touch than a
+// page just freed: the host backs the first lazily, the second is still backed. Arrays released
+// piece by piece while they are written out let the file's page cache take their pages (armadillo
+// 4096³ with attributes: writing the 376 MB .vfrag took 0.8–1.0 s, now 0.4–0.55 s).
+
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdint>
+
+namespace svokit {
+
+/// Returns the whole pages inside [begin, end) to the kernel (their contents read as zero
+/// afterwards): for memory that is no longer read. Partial pages at either end are kept, so the
+/// allocator's own bookkeeping next to the range is never touched.
+inline void ReleasePages(const void* begin, const void* end) {
+  static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page;
+  const std::uintptr_t hi = reinterpret_cast<std::uintptr_t>(end) / page * page;
+  if (lo < hi) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
+}
+
+}  // namespace svokit

@@ -1,0 +1,42 @@
+#include "svokit/core/release_pages.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstring>
+
+namespace svokit {
+namespace {
+
+// Whole pages inside the range read as zero afterwards; the partial pages at its ends, and
+// everything outside it, keep their bytes.
+TEST(ReleasePages, ZeroesTheWholePagesInsideTheRangeOnly) {
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  constexpr std::size_t kPages = 8;
+  void* map =
+      ::mmap(nullptr, kPages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(map, MAP_FAILED);
+  auto* bytes = static_cast<std::uint8_t*>(map);
+  std::memset(bytes, 0xab, kPages * page);
+
+  ReleasePages(bytes + 100, bytes + 5 * page + 10);  // whole pages 1–4
+  for (std::size_t i = 0; i < kPages * page; ++i) {
+    const bool released = i >= page && i < 5 * page;
+    ASSERT_EQ(bytes[i], released ? 0 : 0xab) << "byte " << i;
+  }
+  std::memset(bytes, 0xab, kPages * page);
+  ReleasePages(bytes + page + 1, bytes + 2 * page + page - 1);  // no whole page inside
+  ReleasePages(bytes + 3 * page, bytes + 3 * page);             // empty
+  for (std::size_t i = 0; i < kPages * page; ++i) ASSERT_EQ(bytes[i], 0xab) << "byte " << i;
+  ReleasePages(bytes + 6 * page, bytes + 7 * page);  // exactly page 6
+  for (std::size_t i = 5 * page; i < kPages * page; ++i) {
+    ASSERT_EQ(bytes[i], i / page == 6 ? 0 : 0xab) << "byte " << i;
+  }
+  ::munmap(map, kPages * page);
+}
+
+}  // namespace
+}  // namespace svokit
