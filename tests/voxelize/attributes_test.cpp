@@ -143,10 +143,33 @@ TEST(AttributeClip, EdgeAndPointContactHaveZeroAreaAndContactColour) {
   ExpectRgbaNear(p.color, {0.25f, 0.5f, 0.75f, 0.5f}, 1e-6);
   EXPECT_EQ(p.normal, (Vec3f{0, 0, 0}));  // not wanted
 
-  // A voxel the triangle does not touch at all: area 0, the centroid's colour.
-  const AttributeSample none = ps.Sample(0, 5, 5, 5);
-  EXPECT_EQ(none.area, 0.0);
-  ExpectRgbaNear(none.color, {0.25f / 3, 0.5f / 3 + 1 / 3.f, 0.75f / 3 + 1 / 3.f, 2.5f / 3}, 1e-6);
+  // Voxels the triangle does not touch at all: area 0, the colour at the triangle's point nearest
+  // the voxel's centre, found here by a search over a fine barycentric grid.
+  const Vec3d corners[3] = {{1, 1, 1}, {2, 1.5, 1.25}, {1.5, 2, 1.75}};
+  for (const auto& [x, y, z] : {std::array<int, 3>{5, 5, 5},
+                                {1, -3, 1},
+                                {-2, 1, 4},
+                                {1, 1, 3},
+                                std::array<int, 3>{3, 0, 1}}) {
+    const Vec3d centre{x + 0.5, y + 0.5, z + 0.5};
+    double best = 1e300, best1 = 0, best2 = 0;
+    constexpr int kSteps = 400;
+    for (int i = 0; i <= kSteps; ++i) {
+      for (int j = 0; i + j <= kSteps; ++j) {
+        const double b1 = double(i) / kSteps, b2 = double(j) / kSteps;
+        const Vec3d q = corners[0] * (1 - b1 - b2) + corners[1] * b1 + corners[2] * b2;
+        const double d = Dot(q - centre, q - centre);
+        if (d < best) best = d, best1 = b1, best2 = b2;
+      }
+    }
+    const AttributeSample none = ps.Sample(0, x, y, z);
+    EXPECT_EQ(none.area, 0.0);
+    const Rgba& c0 = point.mesh.colors[0];
+    const float b0 = static_cast<float>(1 - best1 - best2);
+    const float b1 = static_cast<float>(best1), b2 = static_cast<float>(best2);
+    ExpectRgbaNear(none.color, {c0.r * b0, c0.g * b0 + b1, c0.b * b0 + b2, c0.a * b0 + b1 + b2},
+                   0.01f);
+  }
 }
 
 TEST(AttributeClip, AreasOverAllVoxelsSumToTheTriangleAndMatchTheExactOverlapTest) {

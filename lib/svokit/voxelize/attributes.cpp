@@ -143,6 +143,34 @@ int ClipToColumn(const Frame& f, ClipVertex*& poly, ClipVertex*& spare) {
   return n;
 }
 
+// The point of the triangle nearest the voxel's centre, as barycentrics (Ericson, Real-Time
+// Collision Detection §5.1.5: by the Voronoi region of the centre). For a voxel the exact test
+// says is touched but whose contact (an edge or a corner of the box) rounding clipped away, it
+// lies within √3/2 of the centre; the centroid for a degenerate triangle.
+ClipVertex NearestPoint(const Frame& f) {
+  const double c[3] = {0.5 - f.a[0], 0.5 - f.a[1], 0.5 - f.a[2]};  // centre − vertex 0
+  auto dot = [](const double* x, const double* y) {
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  };
+  const double d1 = dot(f.e1, c), d2 = dot(f.e2, c);
+  if (d1 <= 0 && d2 <= 0) return {0, 0};
+  const double e11 = dot(f.e1, f.e1), e12 = dot(f.e1, f.e2), e22 = dot(f.e2, f.e2);
+  const double d3 = d1 - e11, d4 = d2 - e12;  // centre − vertex 1
+  if (d3 >= 0 && d4 <= d3) return {1, 0};
+  const double d5 = d1 - e12, d6 = d2 - e22;  // centre − vertex 2
+  if (d6 >= 0 && d5 <= d6) return {0, 1};
+  const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0 && d1 > d3) return {d1 / (d1 - d3), 0};
+  if (vb <= 0 && d2 >= 0 && d6 <= 0 && d2 > d6) return {0, d2 / (d2 - d6)};
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0 && (d4 - d3) + (d5 - d6) > 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {1 - w, w};
+  }
+  const double sum = va + vb + vc;
+  if (!(sum > 0)) return {1.0 / 3, 1.0 / 3};
+  return {vb / sum, vc / sum};
+}
+
 // Twice the polygon's area (shoelace formula), whichever its orientation.
 double TwiceArea(const Point2* q, int n) {
   double twice = 0;
@@ -478,6 +506,10 @@ void AttributeSampler::SampleRunAlong(const Prepared& p, std::int64_t x, std::in
       std::copy(column, column + m, poly);
     }
     if (m > 0) m = ClipAxis<kW>(f, poly, spare, m);
+    if (m == 0) {  // no contact, or one rounding clipped away: the nearest point stands for it
+      poly[0] = NearestPoint(f);
+      m = 1;
+    }
     out[i] = Finish(p, poly, m);
   }
 }
@@ -512,7 +544,7 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
     out.area = 0.5 * normal_length * total;
     b1 = poly[0].b1 + cb1 / (3 * centroid_total);
     b2 = poly[0].b2 + cb2 / (3 * centroid_total);
-  } else if (n > 0) {
+  } else {
     // Contact only (a segment or a point), or a degenerate triangle: the midpoint of the two
     // farthest vertices (an affine map keeps which pair of collinear points is farthest).
     int ia = 0, ib = 0;
@@ -525,8 +557,6 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
     }
     b1 = 0.5 * (poly[ia].b1 + poly[ib].b1);
     b2 = 0.5 * (poly[ia].b2 + poly[ib].b2);
-  } else {
-    b1 = b2 = 1.0 / 3.0;  // no contact at all: the triangle's centroid
   }
   const double bary[3] = {1.0 - b1 - b2, b1, b2};
   const std::size_t corner = 3 * triangle;

@@ -48,7 +48,9 @@ struct AttributeSample {
   double area = 0;
   /// Mean over the clipped polygon of material base colour × texture × vertex colour (linear light,
   /// straight alpha; each factor's mean, multiplied). With zero area: the value at the contact
-  /// (midpoint of the contact segment or the contact point). Opaque white unless want_color.
+  /// (midpoint of the contact segment or the contact point); where the triangle misses the box,
+  /// or rounding clipped a contact away, at its point nearest the voxel's centre. Opaque white
+  /// unless want_color.
   Rgba color;
   /// Mean shading normal over the clipped polygon (per-corner normals interpolated; unnormalized),
   /// or the unit geometric normal (voxel space, counter-clockwise winding = front) when the mesh
@@ -146,7 +148,7 @@ class AttributeSampler {
   template <int kU, int kV, int kW>
   void SampleRunAlong(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis,
                       int n, AttributeSample* out) const;
-  // Area, colour and normal of the triangle clipped to a voxel: the polygon poly[0..n).
+  // Area, colour and normal of the triangle clipped to a voxel: the polygon poly[0..n), n ≥ 1.
   AttributeSample Finish(const Prepared& p, const attributes_detail::ClipVertex* poly, int n) const;
 
   struct MaterialInfo {
