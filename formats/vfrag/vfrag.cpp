@@ -26,8 +26,8 @@ constexpr container::Tag kNormals = MakeTag("NORM");
 constexpr container::Tag kCoverage = MakeTag("COVR");
 constexpr container::Tag kMetadata = MakeTag("META");
 
-template <class T>
-std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
+template <class T, class A>
+std::span<const std::uint8_t> Bytes(const std::vector<T, A>& v) {
   return {reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)};
 }
 
@@ -35,14 +35,14 @@ std::span<const std::uint8_t> Bytes(const std::vector<T>& v) {
 // every voxel shares (`shared`: refused, given to every voxel, or kept once as VoxelSet::colors
 // does).
 enum class Shared { kRefused, kExpanded, kKept };
-template <class T>
+template <class T, class A>
 Status ReadPerVoxel(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                    std::vector<T>& out, Shared shared = Shared::kRefused) {
+                    std::vector<T, A>& out, Shared shared = Shared::kRefused) {
   const auto section = file.Find(tag);
   if (!section) return Status::Ok();
   ByteReader r(*section, file.name());
   if (shared != Shared::kRefused && section->size() == sizeof(T)) {
-    T value;
+    T value{};
     SVOKIT_RETURN_IF_ERROR(r.Get(value));
     out.assign(shared == Shared::kKept ? 1 : voxels, value);
     return Status::Ok();
@@ -95,9 +95,9 @@ Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
 }
 
 // Versions 1 and 2 stored COLR / NORM as f32: read, then held in binary16 like version 3's.
-template <class Float, class Half16>
+template <class Float, class Half16, class A>
 Status ReadFloatsAsHalves(const container::Reader& file, container::Tag tag, std::size_t voxels,
-                          std::vector<Half16>& out) {
+                          std::vector<Half16, A>& out) {
   std::vector<Float> floats;
   SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, tag, voxels, floats));
   out.assign(floats.begin(), floats.end());
@@ -241,8 +241,8 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys, bo
 // A per-voxel array's section: the array, or its one value when every voxel has the same (an
 // untextured mesh without vertex colours: one colour for millions of voxels). `release`: the
 // array's pages are given back as they are written.
-template <class T>
-container::Writer::Producer PerVoxelProducer(const std::vector<T>& values, bool release) {
+template <class T, class A>
+container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bool release) {
   std::atomic<bool> uniform = values.size() > 1;
   ParallelChunks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
     if (uniform.load(std::memory_order_relaxed) &&

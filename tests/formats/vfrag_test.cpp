@@ -167,7 +167,7 @@ TEST(Vfrag, Version2RawKeysAndFloatAttributesAreRead) {
     EXPECT_EQ(Rgba(back->colors[i]), (Rgba{RoundToHalf(f), RoundToHalf(f / 3), 0.25f, 1})) << i;
     EXPECT_EQ(Vec3f(back->normals[i]), (Vec3f{RoundToHalf(f), 0, 1})) << i;
   }
-  EXPECT_EQ(back->coverage, coverage);
+  EXPECT_EQ(std::vector<Half>(back->coverage.begin(), back->coverage.end()), coverage);
 }
 
 // Version 4: per voxel 8 B colour, 6 B normal, 2 B coverage, and keys as varint gaps (spelled out

@@ -173,6 +173,55 @@ TEST(VoxelizeAttributes, AttributesFindTheSameVoxelsAsGeometryOnly) {
   }
 }
 
+// A 45° square through voxel edges fills three voxels a column (the closed boxes above and below
+// touch it too): more than the brick pass sizes its arrays for (2 per voxel² of projected area),
+// so many groups are appended after the parallel copies. They come out in key order with their
+// own attributes: the geometry pass's keys, the plane's normal, each voxel's colour (red = x / L)
+// from its own part of the square, or its contact with it.
+TEST(VoxelizeAttributes, MoreVoxelsThanEstimatedAreAppendedInOrder) {
+  constexpr double kSide = 120;
+  Mesh square;
+  square.positions = {{0, 0, 0}, {kSide, 0, kSide}, {kSide, kSide, kSide}, {0, kSide, 0}};
+  square.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const GridTransform grid({-2, -2, -2}, 1, {124, 124, 124});
+  for (const bool vertex_colors : {false, true}) {
+    square.colors.clear();
+    if (vertex_colors) {
+      for (const Triangle& t : square.triangles) {
+        for (std::uint32_t v : t) {
+          square.colors.push_back(
+              {static_cast<float>(square.positions[v].x / kSide), 0.5f, 0.25f, 1});
+        }
+      }
+    }
+    VoxelizeOptions options;
+    auto geometry = Voxelize(square, grid, options);
+    options.colors = options.normals = true;
+    auto attributed = Voxelize(square, grid, options);
+    ASSERT_TRUE(geometry.ok() && attributed.ok());
+    const std::size_t voxels = geometry->size();
+    EXPECT_GT(voxels, 2 * kSide * kSide + 2 + 10000);
+    EXPECT_EQ(attributed->keys, geometry->keys);
+    ASSERT_EQ(attributed->normals.size(), voxels);
+    ASSERT_EQ(attributed->coverage.size(), voxels);
+    ASSERT_EQ(attributed->colors.size(), vertex_colors ? voxels : 1);
+    const Vec3f normal(
+        HalfVec3(Vec3f{-std::numbers::sqrt2_v<float> / 2, 0, std::numbers::sqrt2_v<float> / 2}));
+    for (std::size_t i = 0; i < voxels; ++i) {
+      ASSERT_EQ(Vec3f(attributed->normals[i]), normal) << i;
+      if (!vertex_colors) continue;
+      const MortonCoord c = MortonDecode(attributed->keys[i]);
+      const double x = static_cast<double>(c.x) - 2;  // the voxel's low x in world units
+      // Voxels touched only at an edge or a corner, whose contact rounding may clip away, take
+      // the colour at the point nearest their centre: within √3/2 of it, 0.37 past the box.
+      constexpr double kReach = 0.37 + 0.05;
+      const double red = Rgba(attributed->color(i)).r * kSide;
+      ASSERT_GE(red, std::max(0.0, x) - kReach) << i;
+      ASSERT_LE(red, std::min(kSide, x + 1) + kReach) << i;
+    }
+  }
+}
+
 // A colour every point of the surface has is every voxel's colour: held once. Materials sharing
 // one base colour count as one; two base colours, a texture or vertex colours make it per voxel,
 // and voxels whose surface has one material get that colour exactly (binary16-exact colours).

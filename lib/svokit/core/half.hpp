@@ -51,7 +51,7 @@ inline float RoundToHalf(float value) {
 
 /// A binary16 value that converts to and from float implicitly.
 struct Half {
-  std::uint16_t bits = 0;
+  std::uint16_t bits;  // trivially default-constructed (like float): Half{} is zero
   Half() = default;
   Half(float value) : bits(FloatToHalfBits(value)) {}  // NOLINT: implicit by design
   operator float() const { return HalfBitsToFloat(bits); }

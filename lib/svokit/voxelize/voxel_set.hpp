@@ -30,10 +30,11 @@ struct VoxelSet {
   /// all a filtered colour, a normal or a weight needs, and the 16 bytes a voxel saved over floats
   /// are fresh memory the voxelizer would otherwise have to touch. Empty when not requested.
   /// A colour every voxel has (an untextured mesh without vertex colours, one material colour)
-  /// is held once: `colors` then has one entry; read colours through color(i).
-  std::vector<HalfRgba> colors;
-  std::vector<HalfVec3> normals;
-  std::vector<Half> coverage;
+  /// is held once: `colors` then has one entry; read colours through color(i). Like the keys,
+  /// sized without zeroing: the voxelizer's threads fill (and first touch) them in parallel.
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<HalfVec3> normals;
+  DefaultInitVector<Half> coverage;
   /// Non-fatal findings of the voxelization (e.g. a texture that could not be decoded, so its
   /// materials used their base colour). Not stored in files.
   std::vector<std::string> warnings;

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 
+#include <tbb/concurrent_queue.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/parallel_sort.h>
@@ -282,45 +285,77 @@ class BrickPass {
     starts.push_back(pairs.size());
     const std::size_t bricks = starts.size() - 1;
 
-    set.keys.reserve(reserve);  // address space: pages are touched as groups are appended
-    set.coverage.reserve(reserve);
-    if (colors_) set.colors.reserve(reserve);
-    if (normals_) set.normals.reserve(reserve);
+    // Room for `reserve` voxels, sized without a write: pages are first touched by the copies.
+    set.keys.resize(reserve);
+    set.coverage.resize(reserve);
+    if (colors_) set.colors.resize(reserve);
+    if (normals_) set.normals.resize(reserve);
     Progress::Stage stage(progress, "attributes", bricks);
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
         [&] { return std::make_unique<BrickAccumulator>(colors_, normals_); });
     tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
         [] { return std::make_unique<TriangleCache>(); });
-    // Groups of kGroupBricks bricks: numbered in order, filled in parallel, appended in order.
-    // At most `tokens` groups are in flight, consecutive ones (the last stage runs in order), so
-    // group g can use buffer g % tokens.
+    // Groups of kGroupBricks bricks: numbered in order, filled in parallel into a free buffer,
+    // placed in order (an offset in the set's arrays) and copied there in parallel, so both
+    // threads first-touch the arrays' fresh pages. Groups past the room (an estimate) are kept
+    // aside, in order, and appended after.
     const std::size_t groups = (bricks + kGroupBricks - 1) / kGroupBricks;
     const std::size_t tokens =
         4 * std::max<std::size_t>(1, tbb::this_task_arena::max_concurrency());
     std::vector<VoxelRun> buffers(tokens);
-    std::size_t next = 0;
+    tbb::concurrent_queue<std::size_t> free_buffers;  // at most `tokens` groups are in flight
+    for (std::size_t b = 0; b < tokens; ++b) free_buffers.push(b);
+    struct Group {
+      std::size_t index, buffer, offset;
+    };
+    constexpr std::size_t kAside = std::numeric_limits<std::size_t>::max();
+    std::size_t next = 0, placed = 0;
+    std::vector<VoxelRun> aside;
     auto number = [&](tbb::flow_control& fc) -> std::size_t {
       if (next == groups) fc.stop();
       return next++;
     };
     auto fill = [&](std::size_t g) {
+      Group group{g, 0, 0};
+      [[maybe_unused]] const bool popped = free_buffers.try_pop(group.buffer);
+      assert(popped);
       const std::size_t end = std::min(bricks, (g + 1) * kGroupBricks);
       for (std::size_t b = g * kGroupBricks; b < end; ++b) {
         FillBrick(pairs, starts[b], starts[b + 1], *accumulators.local(), *caches.local(),
-                  buffers[g % tokens]);
+                  buffers[group.buffer]);
       }
-      return g;
+      return group;
     };
-    auto append = [&](std::size_t g) {
-      VoxelRun& run = buffers[g % tokens];
-      Append(run, set);
+    auto place = [&](Group group) {
+      VoxelRun& run = buffers[group.buffer];
+      const std::size_t n = run.keys.size();
+      if (aside.empty() && placed + n <= reserve) {
+        group.offset = placed;
+        placed += n;
+      } else {
+        aside.push_back(std::move(run));
+        run = VoxelRun{};
+        group.offset = kAside;
+      }
+      stage.Advance(std::min(kGroupBricks, bricks - group.index * kGroupBricks));
+      return group;
+    };
+    auto copy = [&](const Group& group) {
+      VoxelRun& run = buffers[group.buffer];
+      if (group.offset != kAside) CopyTo(run, group.offset, set);
       run.clear();
-      stage.Advance(std::min(kGroupBricks, bricks - g * kGroupBricks));
+      free_buffers.push(group.buffer);
     };
     tbb::parallel_pipeline(
         tokens, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, number) &
-                    tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel, fill) &
-                    tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, append));
+                    tbb::make_filter<std::size_t, Group>(tbb::filter_mode::parallel, fill) &
+                    tbb::make_filter<Group, Group>(tbb::filter_mode::serial_in_order, place) &
+                    tbb::make_filter<Group, void>(tbb::filter_mode::parallel, copy));
+    set.keys.resize(placed);
+    set.coverage.resize(placed);
+    if (colors_) set.colors.resize(placed);
+    if (normals_) set.normals.resize(placed);
+    for (const VoxelRun& run : aside) Append(run, set);
     stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
   }
 
@@ -370,15 +405,17 @@ class BrickPass {
     acc.Finish(brick, out);
   }
 
-  template <class From, class To>
-  static void Append(const From& from, To& to) {
-    to.insert(to.end(), from.begin(), from.end());
+  void CopyTo(const VoxelRun& run, std::size_t offset, VoxelSet& set) const {
+    std::copy(run.keys.begin(), run.keys.end(), set.keys.begin() + offset);
+    std::copy(run.coverage.begin(), run.coverage.end(), set.coverage.begin() + offset);
+    if (colors_) std::copy(run.colors.begin(), run.colors.end(), set.colors.begin() + offset);
+    if (normals_) std::copy(run.normals.begin(), run.normals.end(), set.normals.begin() + offset);
   }
   void Append(const VoxelRun& run, VoxelSet& set) const {
-    Append(run.keys, set.keys);
-    Append(run.coverage, set.coverage);
-    if (colors_) Append(run.colors, set.colors);
-    if (normals_) Append(run.normals, set.normals);
+    set.keys.insert(set.keys.end(), run.keys.begin(), run.keys.end());
+    set.coverage.insert(set.coverage.end(), run.coverage.begin(), run.coverage.end());
+    if (colors_) set.colors.insert(set.colors.end(), run.colors.begin(), run.colors.end());
+    if (normals_) set.normals.insert(set.normals.end(), run.normals.begin(), run.normals.end());
   }
 
   const MeshVoxelizer& voxelizer_;
