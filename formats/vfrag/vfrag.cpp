@@ -94,13 +94,31 @@ Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
   return Status::Ok();
 }
 
-// Versions 1 and 2 stored COLR / NORM as f32: read, then held in binary16 like version 3's.
+// Versions 1 and 2 stored COLR as f32: read, then held in binary16 like version 3's.
 template <class Float, class Half16, class A>
 Status ReadFloatsAsHalves(const container::Reader& file, container::Tag tag, std::size_t voxels,
                           std::vector<Half16, A>& out) {
   std::vector<Float> floats;
   SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, tag, voxels, floats));
   out.assign(floats.begin(), floats.end());
+  return Status::Ok();
+}
+
+// NORM before version 5: x, y, z (f32 in versions 1 and 2, binary16 in 3 and 4), each finite;
+// held octahedral, like version 5's.
+template <class Stored>
+Status ReadNormalsAsOctahedral(const container::Reader& file, std::size_t voxels, Shared shared,
+                               DefaultInitVector<OctNormal>& out) {
+  std::vector<Stored> stored;
+  SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(file, kNormals, voxels, stored, shared));
+  out.resize(stored.size());
+  for (std::size_t i = 0; i < stored.size(); ++i) {
+    const Vec3f n = stored[i];
+    if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) {
+      return Status::BadInput("{}: non-finite voxel normal", file.name());
+    }
+    out[i] = n;
+  }
   return Status::Ok();
 }
 
@@ -145,11 +163,17 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
   if (file->version() >= 3) {
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kColors, set.keys.size(), set.colors,
                                         v4 ? Shared::kKept : Shared::kRefused));
-    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals, expanded));
   } else {
     SVOKIT_RETURN_IF_ERROR(ReadFloatsAsHalves<Rgba>(*file, kColors, set.keys.size(), set.colors));
+  }
+  if (file->version() >= 5) {
+    SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kNormals, set.keys.size(), set.normals, expanded));
+  } else if (file->version() >= 3) {
     SVOKIT_RETURN_IF_ERROR(
-        ReadFloatsAsHalves<Vec3f>(*file, kNormals, set.keys.size(), set.normals));
+        ReadNormalsAsOctahedral<HalfVec3>(*file, set.keys.size(), expanded, set.normals));
+  } else {
+    SVOKIT_RETURN_IF_ERROR(
+        ReadNormalsAsOctahedral<Vec3f>(*file, set.keys.size(), Shared::kRefused, set.normals));
   }
   if (file->version() >= 2) {
     SVOKIT_RETURN_IF_ERROR(ReadPerVoxel(*file, kCoverage, set.keys.size(), set.coverage, expanded));
@@ -161,11 +185,6 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
   for (const HalfRgba& c : set.colors) {
     if (!IsFiniteHalf(c.r) || !IsFiniteHalf(c.g) || !IsFiniteHalf(c.b) || !IsFiniteHalf(c.a)) {
       return Status::BadInput("{}: non-finite voxel colour", name);
-    }
-  }
-  for (const HalfVec3& n : set.normals) {
-    if (!IsFiniteHalf(n.x) || !IsFiniteHalf(n.y) || !IsFiniteHalf(n.z)) {
-      return Status::BadInput("{}: non-finite voxel normal", name);
     }
   }
   if (meta != nullptr) {

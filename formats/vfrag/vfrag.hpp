@@ -15,7 +15,7 @@
 namespace svokit {
 
 inline constexpr container::FormatId kVfragFormat{
-    {'\x89', 'V', 'F', 'R', '\r', '\n', '\x1a', '\n'}, 4, "svokit voxel fragment list (.vfrag)"};
+    {'\x89', 'V', 'F', 'R', '\r', '\n', '\x1a', '\n'}, 5, "svokit voxel fragment list (.vfrag)"};
 
 /// Provenance stored with the voxels (the `META` section).
 struct VfragMetadata {

@@ -33,7 +33,7 @@ Svo HandSvo(std::uint32_t side = 3) {
   std::sort(set.keys.begin(), set.keys.end());
   for (std::size_t i = 0; i < set.keys.size(); ++i) {
     set.colors.push_back({0.1f * static_cast<float>(i), 0.5f, 0.9f, 1});
-    set.normals.push_back({0, 1, 0});
+    set.normals.push_back(Vec3f{0, 1, 0});
     set.coverage.push_back(1);
   }
   BuildOptions options;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -41,10 +42,10 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const float f = static_cast<float>(i) / static_cast<float>(s.size());
     s.colors.push_back({f, 1 - f, 0.5f, 1});
-    s.normals.push_back({0, f, 1});
+    s.normals.push_back(Vec3f{0, f, 1});
     s.coverage.push_back(f * 2);
   }
-  // Colours and normals are stored as binary16: each component comes back as its nearest one.
+  // Colours and coverage are stored as binary16, normals as 16-bit octahedral codes.
   auto back = DecodeVfrag(EncodeVfrag(s, {}), "attr.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
   ASSERT_EQ(back->colors.size(), s.size());
@@ -52,14 +53,17 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
   EXPECT_EQ(back->colors, s.colors);
   EXPECT_EQ(back->normals, s.normals);
   EXPECT_EQ(back->coverage, s.coverage);
-  // A voxel set holds each component as the binary16 nearest the float it was given.
+  // A voxel set holds each colour component as the binary16 nearest the float it was given, and
+  // a normal as the unit vector of the octahedral code nearest its direction: within 7·10⁻⁵ rad.
   for (std::size_t i = 0; i < s.size(); ++i) {
     const float f = static_cast<float>(i) / static_cast<float>(s.size());
     const Rgba c = back->colors[i];
     const Vec3f n = back->normals[i];
     EXPECT_EQ(c, (Rgba{RoundToHalf(f), RoundToHalf(1 - f), 0.5f, 1}));
-    EXPECT_EQ(n, (Vec3f{0, RoundToHalf(f), 1}));
     EXPECT_NEAR(c.g, 1 - f, (1 - f) / 2048);
+    const Vec3d exact = Vec3d{0, f, 1} / std::sqrt(1.0 + double{f} * f);
+    EXPECT_NEAR(std::sqrt(Dot(Vec3d(n.x, n.y, n.z), Vec3d(n.x, n.y, n.z))), 1.0, 1e-6);
+    EXPECT_LT(Length(Cross(Vec3d(n.x, n.y, n.z), exact)), 7e-5) << i;
   }
   s.colors.pop_back();
   auto bad = DecodeVfrag(EncodeVfrag(s, {}), "short.vfrag");
@@ -84,12 +88,12 @@ TEST(Vfrag, AConsumedSetWritesTheSameFile) {
     key += 1 + rng() % 300;
     s.keys.push_back(key);
     const float f = static_cast<float>(rng() % 1000) / 1000;
-    s.normals.push_back({f, 1 - f, 0.5f});
+    s.normals.push_back(Vec3f{f, 1 - f, 0.5f});
     s.coverage.push_back(f);
   }
   s.colors.assign(1, Rgba{0.25f, 0.5f, 0.75f, 1});
   for (const bool shared_normal : {false, true}) {
-    if (shared_normal) s.normals.assign(s.size(), HalfVec3{0, 0, 1});
+    if (shared_normal) s.normals.assign(s.size(), Vec3f{0, 0, 1});
     const std::vector<std::uint8_t> expected = EncodeVfrag(s, {"m.obj", "--resolution 4096"});
     VoxelSet consumed = s;
     ASSERT_TRUE(
@@ -161,31 +165,32 @@ TEST(Vfrag, Version2RawKeysAndFloatAttributesAreRead) {
   EXPECT_EQ(back->keys, s.keys);
   ASSERT_EQ(back->colors.size(), s.size());
   ASSERT_EQ(back->normals.size(), s.size());
-  // Held in binary16 like every voxel set: each float comes back as its nearest binary16.
+  // Held like every voxel set: each colour float comes back as its nearest binary16, each normal
+  // as the octahedral code nearest its direction.
   for (std::size_t i = 0; i < s.size(); ++i) {
     const float f = 0.1f + static_cast<float>(i) / 7.f;
     EXPECT_EQ(Rgba(back->colors[i]), (Rgba{RoundToHalf(f), RoundToHalf(f / 3), 0.25f, 1})) << i;
-    EXPECT_EQ(Vec3f(back->normals[i]), (Vec3f{RoundToHalf(f), 0, 1})) << i;
+    EXPECT_EQ(back->normals[i], OctNormal(Vec3f{f, 0, 1})) << i;
   }
   EXPECT_EQ(std::vector<Half>(back->coverage.begin(), back->coverage.end()), coverage);
 }
 
-// Version 4: per voxel 8 B colour, 6 B normal, 2 B coverage, and keys as varint gaps (spelled out
+// Version 5: per voxel 8 B colour, 4 B normal, 2 B coverage, and keys as varint gaps (spelled out
 // byte by byte here).
-TEST(Vfrag, Version4StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
+TEST(Vfrag, Version5StoresKeyGapsAsVarintsAttributesAsBinary16AndOctahedralNormals) {
   VoxelSet s;
   s.grid = GridTransform({0, 0, 0}, 1, {(1u << 21) - 1, 1u << 20, 1u << 20});
   s.keys = {5, 6, 6 + 1 + 200, (std::uint64_t{1} << 60) + 3};
   for (int i = 0; i < 4; ++i) {
     const float f = 0.25f * static_cast<float>(i);
     s.colors.push_back({f, 0.25f, 1, 1});
-    s.normals.push_back({0, f, 1});
+    s.normals.push_back(Vec3f{0, f, 1});
     s.coverage.push_back(f);
   }
   const std::vector<std::uint8_t> bytes = EncodeVfrag(s, {});
-  auto frame = container::Frame::FromBytes(bytes, "v4.vfrag", kVfragFormat);
+  auto frame = container::Frame::FromBytes(bytes, "v5.vfrag", kVfragFormat);
   ASSERT_TRUE(frame.ok()) << frame.status().message();
-  EXPECT_EQ(frame->version(), 4u);
+  EXPECT_EQ(frame->version(), 5u);
   const auto* keys = frame->Find(container::MakeTag("KEYS"));
   ASSERT_NE(keys, nullptr);
   // count 4; gaps 5, 0, 200 = 0xC8 0x01, 2^60 + 3 − 207 − 1 = 2^60 − 205.
@@ -196,13 +201,20 @@ TEST(Vfrag, Version4StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
   expected.push_back(static_cast<std::uint8_t>(((std::uint64_t{1} << 60) - 205) >> 56));
   EXPECT_EQ(std::vector<std::uint8_t>(keys->bytes.begin(), keys->bytes.end()), expected);
   EXPECT_EQ(frame->Find(container::MakeTag("COLR"))->size, 8 * s.size());
-  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 6 * s.size());
+  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 4 * s.size());
   EXPECT_EQ(frame->Find(container::MakeTag("COVR"))->size, 2 * s.size());
   // COLR holds binary16 r, g, b, a per voxel: voxel 1 is (0.25, 0.25, 1, 1).
   const std::uint8_t* colr = frame->Find(container::MakeTag("COLR"))->bytes.data();
   const std::vector<std::uint8_t> voxel1(colr + 8, colr + 16);
   EXPECT_EQ(voxel1, (std::vector<std::uint8_t>{0x00, 0x34, 0x00, 0x34, 0x00, 0x3c, 0x00, 0x3c}));
-  auto back = DecodeVfrag(bytes, "v4.vfrag");
+  // NORM holds two u16 octahedral codes, x first: +z is the octahedron's centre, code 2^15 each;
+  // voxel 2's (0, 0.5, 1) is (0, 1/3) on it, 2^15 + round(32767 / 3) = 0xAAAA for y.
+  const std::uint8_t* norm = frame->Find(container::MakeTag("NORM"))->bytes.data();
+  EXPECT_EQ(std::vector<std::uint8_t>(norm, norm + 4),
+            (std::vector<std::uint8_t>{0x00, 0x80, 0x00, 0x80}));
+  EXPECT_EQ(std::vector<std::uint8_t>(norm + 8, norm + 12),
+            (std::vector<std::uint8_t>{0x00, 0x80, 0xAA, 0xAA}));
+  auto back = DecodeVfrag(bytes, "v5.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->keys, s.keys);
   EXPECT_EQ(back->colors, s.colors);
@@ -210,10 +222,12 @@ TEST(Vfrag, Version4StoresKeyGapsAsVarintsAndAttributesAsBinary16) {
   EXPECT_EQ(back->coverage, s.coverage);
 }
 
-// An attribute every voxel shares (an untextured mesh's colour) is stored once; earlier versions
-// must hold one per voxel, and a section of any other size is refused. A shared colour is read
-// back as VoxelSet holds one (once); normals and coverage are given to every voxel.
-TEST(Vfrag, Version4StoresAnAttributeEveryVoxelSharesOnce) {
+// An attribute every voxel shares (an untextured mesh's colour) is stored once (since version 4);
+// earlier versions must hold one per voxel, and a section of any other size is refused. A shared
+// colour is read back as VoxelSet holds one (once); normals and coverage are given to every voxel.
+// Version 4's binary16 normals are read as the octahedral codes nearest them; non-finite ones are
+// refused.
+TEST(Vfrag, AnAttributeEveryVoxelSharesIsStoredOnce) {
   VoxelSet s = Sample();
   ASSERT_GT(s.size(), 2u);
   s.colors.assign(s.size(), Rgba{0.5f, 0.25f, 1, 1});
@@ -225,7 +239,7 @@ TEST(Vfrag, Version4StoresAnAttributeEveryVoxelSharesOnce) {
   auto frame = container::Frame::FromBytes(bytes, "uniform.vfrag", kVfragFormat);
   ASSERT_TRUE(frame.ok()) << frame.status().message();
   EXPECT_EQ(frame->Find(container::MakeTag("COLR"))->size, 8u);
-  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 6 * s.size());
+  EXPECT_EQ(frame->Find(container::MakeTag("NORM"))->size, 4 * s.size());
   EXPECT_EQ(frame->Find(container::MakeTag("COVR"))->size, 2u);
   auto back = DecodeVfrag(bytes, "uniform.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
@@ -238,7 +252,8 @@ TEST(Vfrag, Version4StoresAnAttributeEveryVoxelSharesOnce) {
   once.colors.resize(1);
   EXPECT_EQ(EncodeVfrag(once, {}), bytes);
   // The same sections in a version 3 file are refused.
-  auto with_version = [&](std::uint32_t version, std::size_t colors) {
+  auto with_version = [&](std::uint32_t version, std::size_t colors,
+                          std::vector<HalfVec3> normals = {}) {
     container::FormatId format = kVfragFormat;
     format.version = version;
     container::Writer w(format, 0);
@@ -247,9 +262,22 @@ TEST(Vfrag, Version4StoresAnAttributeEveryVoxelSharesOnce) {
     w.AddSection(container::MakeTag("KEYS"), std::vector<std::uint8_t>(keys.begin(), keys.end()));
     std::vector<HalfRgba> c(colors, HalfRgba(Rgba{0.5f, 0.25f, 1, 1}));
     w.AddSection(container::MakeTag("COLR"), RawBytes(c));
+    if (!normals.empty()) w.AddSection(container::MakeTag("NORM"), RawBytes(normals));
     return DecodeVfrag(w.Serialize(), "versioned.vfrag");
   };
   EXPECT_TRUE(with_version(4, 1).ok());
+  std::vector<HalfVec3> halves;
+  for (std::size_t i = 0; i < s.size(); ++i) halves.push_back(Vec3f{0.5f, -1, float(i) / 3});
+  auto v4 = with_version(4, 1, halves);
+  ASSERT_TRUE(v4.ok()) << v4.status().message();
+  ASSERT_EQ(v4->normals.size(), s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(v4->normals[i], OctNormal(Vec3f(halves[i]))) << i;
+  }
+  halves[1].y = Half(std::numeric_limits<float>::infinity());
+  auto inf = with_version(4, 1, halves);
+  ASSERT_FALSE(inf.ok());
+  EXPECT_NE(inf.status().message().find("non-finite voxel normal"), std::string::npos);
   auto v3 = with_version(3, 1);
   ASSERT_FALSE(v3.ok());
   EXPECT_NE(v3.status().message().find("section 'COLR' holds 8 bytes"), std::string::npos);

@@ -29,7 +29,7 @@ Svo TinyOctree() {
   std::sort(set.keys.begin(), set.keys.end());
   for (std::size_t i = 0; i < set.keys.size(); ++i) {
     set.colors.push_back({0.25f * float(i + 1), 0.5f, 0.0f, 1});
-    set.normals.push_back({0, 0, 1});
+    set.normals.push_back(Vec3f{0, 0, 1});
     set.coverage.push_back(1);
   }
   BuildOptions options;

@@ -38,7 +38,7 @@ VoxelSet MakeSet(const GridTransform& grid, std::vector<Ijk> voxels, bool attrib
     for (std::size_t i = 0; i < set.keys.size(); ++i) {
       const float f = static_cast<float>(i + 1) / static_cast<float>(set.keys.size());
       set.colors.push_back({f, 1 - f, 0.5f, 1});
-      set.normals.push_back({0, 0, 1});
+      set.normals.push_back(Vec3f{0, 0, 1});
       set.coverage.push_back(1);
     }
   }

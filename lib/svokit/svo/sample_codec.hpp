@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "svokit/core/octahedral.hpp"
 #include "svokit/core/vec.hpp"
 
 namespace svokit {
@@ -21,30 +22,6 @@ inline float DecodeUnorm8(std::uint8_t v) {
 }
 
 namespace codec_detail {
-
-// [−1, 1] → [1, 255]: code 0 stays free for "no normal".
-inline std::uint32_t EncodeSnorm8(float v) {
-  return static_cast<std::uint32_t>(std::clamp(v, -1.f, 1.f) * 127.f +
-                                    128.5f);  // > 0: truncation rounds
-}
-inline float DecodeSnorm8(std::uint32_t b) {
-  return static_cast<float>(static_cast<int>(b) - 128) / 127.f;
-}
-
-// Octahedral mapping (Meyer et al. 2010): |x|+|y|+|z| = 1, the lower half folded over.
-inline Vec3f OctahedralDecode(std::uint16_t oct) {
-  if (oct == 0) return {0, 0, 0};
-  float x = DecodeSnorm8(oct & 0xffu), y = DecodeSnorm8(oct >> 8u);
-  const float z = 1.f - std::abs(x) - std::abs(y);
-  if (z < 0) {
-    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
-    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
-    x = fx;
-    y = fy;
-  }
-  const float len = std::sqrt(x * x + y * y + z * z);
-  return {x / len, y / len, z / len};
-}
 
 struct Tables {
   static constexpr int kBins = 4096;
@@ -68,7 +45,7 @@ struct Tables {
           srgb_midpoints.begin());
     }
     for (std::uint32_t i = 0; i < normals.size(); ++i) {
-      normals[i] = OctahedralDecode(static_cast<std::uint16_t>(i));
+      normals[i] = OctahedralDecode<8>(static_cast<std::uint32_t>(i));
     }
   }
 };
@@ -103,17 +80,7 @@ inline Rgba DecodeColor(std::uint32_t v) {
 
 /// Octahedral, 8 bits per axis (x low byte); a zero normal encodes as 0.
 inline std::uint16_t EncodeNormal(const Vec3f& n) {
-  using codec_detail::EncodeSnorm8;
-  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-  if (!(l1 > 1e-20f)) return 0;
-  float x = n.x / l1, y = n.y / l1;
-  if (n.z < 0) {
-    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
-    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
-    x = fx;
-    y = fy;
-  }
-  return static_cast<std::uint16_t>(EncodeSnorm8(x) | EncodeSnorm8(y) << 8);
+  return static_cast<std::uint16_t>(OctahedralEncode<8>(n));
 }
 inline Vec3f DecodeNormal(std::uint16_t oct) {
   return codec_detail::GetTables().normals[oct];

@@ -10,6 +10,7 @@
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/core/octahedral.hpp"
 #include "svokit/core/vec.hpp"
 
 namespace svokit {
@@ -26,14 +27,15 @@ struct VoxelSet {
   DefaultInitVector<std::uint64_t> keys;
   /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
   /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
-  /// voxel² (its coverage). All in binary16, as .vfrag stores them: ~3 significant digits are
-  /// all a filtered colour, a normal or a weight needs, and the 16 bytes a voxel saved over floats
-  /// are fresh memory the voxelizer would otherwise have to touch. Empty when not requested.
+  /// voxel² (its coverage). Colour and coverage in binary16, the normal as 16-bit octahedral
+  /// codes (4 bytes, ≤ 7·10⁻⁵ rad), as .vfrag stores them: ~3 significant digits are all a
+  /// filtered colour or a weight needs, and the bytes a voxel saves (22 over floats) are fresh
+  /// memory the voxelizer would otherwise have to touch. Empty when not requested.
   /// A colour every voxel has (an untextured mesh without vertex colours, one material colour)
   /// is held once: `colors` then has one entry; read colours through color(i). Like the keys,
   /// sized without zeroing: the voxelizer's threads fill (and first touch) them in parallel.
   DefaultInitVector<HalfRgba> colors;
-  DefaultInitVector<HalfVec3> normals;
+  DefaultInitVector<OctNormal> normals;
   DefaultInitVector<Half> coverage;
   /// Non-fatal findings of the voxelization (e.g. a texture that could not be decoded, so its
   /// materials used their base colour). Not stored in files.

@@ -174,7 +174,7 @@ class TriangleCache {
 struct VoxelRun {
   DefaultInitVector<std::uint64_t> keys;
   DefaultInitVector<HalfRgba> colors;
-  DefaultInitVector<HalfVec3> normals;
+  DefaultInitVector<OctNormal> normals;
   DefaultInitVector<Half> coverage;
   void clear() { keys.clear(), colors.clear(), normals.clear(), coverage.clear(); }
 };
@@ -233,11 +233,13 @@ class BrickAccumulator {
       }
     }
     if (normals_) {
+      // Octahedral codes keep the direction only; scaled to |x|+|y|+|z| = 1 in double first, so
+      // sums that nearly cancel (two sides of a thin sheet) keep theirs in float.
       out.normals.resize(at + n);
       for (std::size_t i = 0; i < n; ++i) {
         const Sum& sum = sums_[locals[i]];
-        const double len = std::sqrt(sum.nx * sum.nx + sum.ny * sum.ny + sum.nz * sum.nz);
-        const double scale = len > 0 ? 1.0 / len : 0.0;
+        const double l1 = std::abs(sum.nx) + std::abs(sum.ny) + std::abs(sum.nz);
+        const double scale = l1 > 0 ? 1.0 / l1 : 0.0;
         out.normals[at + i] =
             Vec3f{static_cast<float>(sum.nx * scale), static_cast<float>(sum.ny * scale),
                   static_cast<float>(sum.nz * scale)};

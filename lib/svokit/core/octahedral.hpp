@@ -1,0 +1,70 @@
+#pragma once
+// Unit vectors in octahedral mapping (Meyer et al. 2010): the direction's point on the octahedron
+// |x|+|y|+|z| = 1, the lower half folded over the upper, as two signed codes of kBits bits each.
+// Code 0 on both axes is kept for the zero vector ("no normal"). Two 16-bit codes hold a
+// direction to ≤ 7·10⁻⁵ rad in 4 bytes (binary16 x, y, z: 4·10⁻⁴ rad, in 6); two 8-bit codes are
+// the bricks' normals.
+
+#include <cmath>
+#include <cstdint>
+
+#include "svokit/core/vec.hpp"
+
+namespace svokit {
+
+/// [−1, 1] → [1, 2^kBits − 1], to nearest: code 0 stays free.
+template <int kBits>
+std::uint32_t EncodeOctSnorm(float v) {
+  constexpr float kHalf = static_cast<float>(1u << (kBits - 1));
+  const float clamped = v < -1.f ? -1.f : (v > 1.f ? 1.f : v);
+  return static_cast<std::uint32_t>(clamped * (kHalf - 1) + (kHalf + 0.5f));  // > 0: truncation
+}
+template <int kBits>
+float DecodeOctSnorm(std::uint32_t code) {
+  constexpr int kHalf = 1 << (kBits - 1);
+  return static_cast<float>(static_cast<int>(code) - kHalf) / static_cast<float>(kHalf - 1);
+}
+
+/// The direction of `n` (any length; 0 for a zero or non-finite vector), x code in the low kBits.
+template <int kBits>
+std::uint32_t OctahedralEncode(const Vec3f& n) {
+  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+  if (!(l1 > 1e-20f) || !std::isfinite(l1)) return 0;
+  float x = n.x / l1, y = n.y / l1;
+  if (n.z < 0) {
+    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
+    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
+    x = fx;
+    y = fy;
+  }
+  return EncodeOctSnorm<kBits>(x) | EncodeOctSnorm<kBits>(y) << kBits;
+}
+
+/// The unit vector of `code` (the zero vector for 0).
+template <int kBits>
+Vec3f OctahedralDecode(std::uint32_t code) {
+  if (code == 0) return {0, 0, 0};
+  constexpr std::uint32_t kMask = (std::uint32_t{1} << kBits) - 1;
+  float x = DecodeOctSnorm<kBits>(code & kMask), y = DecodeOctSnorm<kBits>(code >> kBits & kMask);
+  const float z = 1.f - std::abs(x) - std::abs(y);
+  if (z < 0) {
+    const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
+    const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
+    x = fx;
+    y = fy;
+  }
+  const float len = std::sqrt(x * x + y * y + z * z);
+  return {x / len, y / len, z / len};
+}
+
+/// A unit normal in 4 bytes (16-bit octahedral codes, x low), as voxel sets hold and .vfrag
+/// stores them: converts from any vector (keeping its direction only) and to a unit Vec3f.
+struct OctNormal {
+  std::uint32_t bits;  // trivially default-constructed (like float): OctNormal{} is "no normal"
+  OctNormal() = default;
+  OctNormal(const Vec3f& n) : bits(OctahedralEncode<16>(n)) {}  // NOLINT: implicit by design
+  operator Vec3f() const { return OctahedralDecode<16>(bits); }
+  bool operator==(const OctNormal&) const = default;
+};
+
+}  // namespace svokit
