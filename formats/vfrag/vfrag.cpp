@@ -11,6 +11,7 @@
 #include "formats/container/grid_section.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
 
@@ -211,7 +212,7 @@ template <class Encode, class Done>
 container::Writer::Producer Chunked(std::size_t voxels, Encode encode, Done done) {
   return [voxels, encode, done](const container::Writer::Emit& emit) -> Status {
     constexpr std::size_t kChunk = 1 << 15, kBatch = 16;
-    std::vector<std::vector<std::uint8_t>> pieces(kBatch);
+    std::vector<DefaultInitVector<std::uint8_t>> pieces(kBatch);
     for (std::size_t first = 0; first < voxels; first += kChunk * kBatch) {
       const std::size_t chunks = std::min(kBatch, (voxels - first + kChunk - 1) / kChunk);
       ParallelChunks(chunks, 1, [&](std::size_t c0, std::size_t c1) {
@@ -234,17 +235,9 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys, bo
   const std::uint64_t count = keys.size();
   auto varints = Chunked(
       keys.size(),
-      [keys](std::size_t begin, std::size_t end, std::vector<std::uint8_t>& out) {
-        std::uint64_t prev = begin == 0 ? ~std::uint64_t{0} : keys[begin - 1];
-        for (std::size_t i = begin; i < end; ++i) {
-          std::uint64_t gap = keys[i] - prev - 1;
-          prev = keys[i];
-          while (gap >= 0x80u) {
-            out.push_back(static_cast<std::uint8_t>(gap | 0x80u));
-            gap >>= 7;
-          }
-          out.push_back(static_cast<std::uint8_t>(gap));
-        }
+      [keys](std::size_t begin, std::size_t end, DefaultInitVector<std::uint8_t>& out) {
+        AppendKeyGaps(keys.subspan(begin, end - begin),
+                      begin == 0 ? kNoPreviousKey : keys[begin - 1], out);
       },
       [keys, release](std::size_t begin, std::size_t end) {
         if (release) ReleasePages(keys.data() + begin, keys.data() + end - 1);
@@ -256,6 +249,9 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys, bo
     return varints(emit);
   };
 }
+
+container::Writer::Producer BytesProducer(std::span<const std::uint8_t> bytes,
+                                          std::span<const std::uint8_t> all, bool release);
 
 // A per-voxel array's section: the array, or its one value when every voxel has the same (an
 // untextured mesh without vertex colours: one colour for millions of voxels). `release`: the
@@ -271,7 +267,12 @@ container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bo
     }
   });
   const std::span<const std::uint8_t> all = Bytes(values);
-  const std::span<const std::uint8_t> bytes = uniform ? all.first(sizeof(T)) : all;
+  return BytesProducer(uniform ? all.first(sizeof(T)) : all, all, release);
+}
+
+// `bytes` in pieces of a few MB; `release`: `all`'s pages are given back as they are written.
+container::Writer::Producer BytesProducer(std::span<const std::uint8_t> bytes,
+                                          std::span<const std::uint8_t> all, bool release) {
   return [bytes, all, release](const container::Writer::Emit& emit) -> Status {
     constexpr std::size_t kPiece = std::size_t{4} << 20;
     for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
@@ -285,12 +286,24 @@ container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bo
   };
 }
 
+// KEYS from keys already packed: the count, then the bytes.
+container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set, bool release) {
+  return [&set, release](const container::Writer::Emit& emit) -> Status {
+    std::uint8_t head[sizeof(set.count)];
+    std::memcpy(head, &set.count, sizeof(set.count));
+    SVOKIT_RETURN_IF_ERROR(emit(head));
+    const std::span<const std::uint8_t> gaps = Bytes(set.key_gaps);
+    return BytesProducer(gaps, gaps, release)(emit);
+  };
+}
+
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 // `release`: each array's pages are given back once written (the set is consumed).
-container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta, bool release) {
+container::Writer MakeWriter(const VoxelAttributes& set, container::Writer::Producer keys,
+                             const VfragMetadata& meta, bool release) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
-  file.AddSectionProduced(kKeys, KeysProducer(set.keys, release));
+  file.AddSectionProduced(kKeys, std::move(keys));
   if (set.has_colors()) file.AddSectionProduced(kColors, PerVoxelProducer(set.colors, release));
   if (set.has_normals()) file.AddSectionProduced(kNormals, PerVoxelProducer(set.normals, release));
   if (!set.coverage.empty()) {
@@ -306,17 +319,28 @@ container::Writer MakeWriter(const VoxelSet& set, const VfragMetadata& meta, boo
 }  // namespace
 
 std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
-  return MakeWriter(set, meta, false).Serialize();
+  return MakeWriter(set, KeysProducer(set.keys, false), meta, false).Serialize();
+}
+
+std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta) {
+  return MakeWriter(set, PackedKeysProducer(set, false), meta, false).Serialize();
 }
 
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
                   const std::filesystem::path& path) {
-  return MakeWriter(set, meta, false).WriteFile(path);
+  return MakeWriter(set, KeysProducer(set.keys, false), meta, false).WriteFile(path);
 }
 
 Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path) {
-  const Status status = MakeWriter(set, meta, true).WriteFile(path);
+  const Status status = MakeWriter(set, KeysProducer(set.keys, true), meta, true).WriteFile(path);
   set = VoxelSet{};  // its pages are gone
+  return status;
+}
+
+Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
+                  const std::filesystem::path& path) {
+  const Status status = MakeWriter(set, PackedKeysProducer(set, true), meta, true).WriteFile(path);
+  set = PackedVoxelSet{};  // its pages are gone
   return status;
 }
 

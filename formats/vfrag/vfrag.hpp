@@ -29,6 +29,10 @@ Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
 /// The same file from a set that is consumed: its arrays' memory goes back to the kernel as it is
 /// written, for the file's page cache to reuse (fresh pages are slow on VMs); `set` is left empty.
 Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path);
+/// The same file from voxels whose keys are packed already (VoxelizePacked), consumed likewise.
+std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta);
+Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
+                  const std::filesystem::path& path);
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
                                VfragMetadata* meta = nullptr);

@@ -107,7 +107,33 @@ TEST(Vfrag, AConsumedSetWritesTheSameFile) {
     ASSERT_TRUE(back.ok()) << back.status().message();
     EXPECT_EQ(back->keys, s.keys);
     EXPECT_EQ(back->normals, s.normals);
+    // Packed keys (23 chunks of 2^16 packed in parallel) give the same bytes, consumed or not;
+    // gaps of up to 300 take one or two bytes.
+    VoxelSet copy = s;
+    PackedVoxelSet packed = PackVoxelSet(std::move(copy));
+    EXPECT_TRUE(copy.keys.empty());
+    EXPECT_EQ(packed.size(), s.size());
+    EXPECT_GT(packed.key_gaps.size(), s.size());
+    EXPECT_LT(packed.key_gaps.size(), 2 * s.size());
+    EXPECT_TRUE(EncodeVfrag(packed, {"m.obj", "--resolution 4096"}) == expected);
+    ASSERT_TRUE(
+        WriteVfrag(std::move(packed), {"m.obj", "--resolution 4096"}, dir / "p.vfrag").ok());
+    EXPECT_EQ(packed.size(), 0u);
+    const auto packed_file = ReadFileBytes(dir / "p.vfrag");
+    ASSERT_TRUE(packed_file.ok());
+    EXPECT_TRUE(*packed_file == expected) << "shared normal " << shared_normal;
   }
+  // Keys whose gaps are all the same byte are still stored one per voxel (only attributes every
+  // voxel shares are stored once).
+  VoxelSet run;
+  run.grid = s.grid;
+  for (std::uint64_t k = 100; k < 200; ++k) run.keys.push_back(k);
+  const std::vector<std::uint8_t> run_bytes = EncodeVfrag(run, {});
+  VoxelSet run_copy = run;
+  EXPECT_TRUE(EncodeVfrag(PackVoxelSet(std::move(run_copy)), {}) == run_bytes);
+  auto run_back = DecodeVfrag(run_bytes, "run.vfrag");
+  ASSERT_TRUE(run_back.ok()) << run_back.status().message();
+  EXPECT_EQ(run_back->keys, run.keys);
 }
 
 template <class T, class A>

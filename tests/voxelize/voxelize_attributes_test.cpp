@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "formats/vfrag/vfrag.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/mesh/import.hpp"
@@ -143,6 +144,42 @@ TEST(VoxelizeAttributes, DeterministicAcrossMethodsAndThreads) {
   EXPECT_GT(coverage, 0);
 }
 
+// VoxelizePacked: the voxels and attributes of Voxelize(), keys packed as they are found (with
+// attributes) or after (without): the same .vfrag bytes for every method, thread count and mode.
+TEST(VoxelizeAttributes, PackedKeysGiveTheSameFileForEveryMethodAndThreadCount) {
+  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(mesh.ok());
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), 160);
+  for (const VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
+    for (const bool attributes : {true, false}) {
+      VoxelizeOptions options;
+      options.mode = mode;
+      options.colors = options.normals = attributes;
+      auto reference = Voxelize(*mesh, *grid, options);
+      ASSERT_TRUE(reference.ok());
+      ASSERT_GT(reference->size(), 10000u);
+      const std::vector<std::uint8_t> expected = EncodeVfrag(*reference, {});
+      for (VoxelMethod method :
+           {VoxelMethod::kTriangle, VoxelMethod::kFragment, VoxelMethod::kHybrid}) {
+        for (std::size_t threads : {1u, 2u}) {
+          ThreadLimit limit(threads);
+          options.method = method;
+          options.hybrid_cutoff = 4;
+          auto packed = VoxelizePacked(*mesh, *grid, options);
+          ASSERT_TRUE(packed.ok());
+          EXPECT_EQ(packed->size(), reference->size());
+          EXPECT_EQ(packed->coverage, reference->coverage);
+          EXPECT_TRUE(EncodeVfrag(*packed, {}) == expected)
+              << "mode " << static_cast<int>(mode) << " attributes " << attributes << " method "
+              << static_cast<int>(method) << " threads " << threads;
+        }
+      }
+    }
+  }
+  Mesh empty;
+  EXPECT_FALSE(VoxelizePacked(empty, *grid, {}).ok());
+}
+
 // With attributes the voxels are found brick by brick (triangles binned to bricks by their box
 // or by walking them); without, by the method's own split: the same voxels either way, for
 // small triangles (box-binned), huge ones (walked, and cut into tiles by the fragment path) and
@@ -199,6 +236,10 @@ TEST(VoxelizeAttributes, MoreVoxelsThanEstimatedAreAppendedInOrder) {
     options.colors = options.normals = true;
     auto attributed = Voxelize(square, grid, options);
     ASSERT_TRUE(geometry.ok() && attributed.ok());
+    // Packed keys go past their estimated room the same way: the same file.
+    auto packed = VoxelizePacked(square, grid, options);
+    ASSERT_TRUE(packed.ok());
+    EXPECT_TRUE(EncodeVfrag(*packed, {}) == EncodeVfrag(*attributed, {}));
     const std::size_t voxels = geometry->size();
     EXPECT_GT(voxels, 2 * kSide * kSide + 2 + 10000);
     EXPECT_EQ(attributed->keys, geometry->keys);

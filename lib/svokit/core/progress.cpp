@@ -70,7 +70,7 @@ void Progress::Stage::Draw(bool final) {
     case Style::kAuto:
       return;
     case Style::kLines:
-      if (final) fmt::print(out, "{:<12} done in {:.2f} s{}\n", name_, seconds(), tail);
+      if (final) fmt::print(out, "{:<12} done in {:.3f} s{}\n", name_, seconds(), tail);
       break;
     case Style::kBar: {
       constexpr int kWidth = 30;

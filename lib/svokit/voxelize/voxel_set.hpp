@@ -20,20 +20,20 @@ enum class VoxelMode : std::uint32_t {
   kThin = 1,          ///< Schwarz & Seidel 2010's 6-separating subset
 };
 
-struct VoxelSet {
+/// What a voxelization holds besides its keys: the grid, the mode and the per-voxel attributes
+/// (VoxelSet, PackedVoxelSet).
+struct VoxelAttributes {
   GridTransform grid;
   VoxelMode mode = VoxelMode::kConservative;
-  /// Sorted ascending, unique. (Sized without zeroing: it is filled in parallel right after.)
-  DefaultInitVector<std::uint64_t> keys;
-  /// Per voxel (parallel to keys), when requested: the area-weighted mean colour (linear RGBA,
-  /// straight alpha) and unit normal of the surface inside the voxel, and that surface's area in
-  /// voxel² (its coverage). Colour and coverage in binary16, the normal as 16-bit octahedral
+  /// Per voxel (parallel to the keys), when requested: the area-weighted mean colour (linear
+  /// RGBA, straight alpha) and unit normal of the surface inside the voxel, and that surface's area
+  /// in voxel² (its coverage). Colour and coverage in binary16, the normal as 16-bit octahedral
   /// codes (4 bytes, ≤ 7·10⁻⁵ rad), as .vfrag stores them: ~3 significant digits are all a
   /// filtered colour or a weight needs, and the bytes a voxel saves (22 over floats) are fresh
   /// memory the voxelizer would otherwise have to touch. Empty when not requested.
   /// A colour every voxel has (an untextured mesh without vertex colours, one material colour)
-  /// is held once: `colors` then has one entry; read colours through color(i). Like the keys,
-  /// sized without zeroing: the voxelizer's threads fill (and first touch) them in parallel.
+  /// is held once: `colors` then has one entry; read colours through color(i). Sized without
+  /// zeroing: the voxelizer's threads fill (and first touch) them in parallel.
   DefaultInitVector<HalfRgba> colors;
   DefaultInitVector<OctNormal> normals;
   DefaultInitVector<Half> coverage;
@@ -41,11 +41,30 @@ struct VoxelSet {
   /// materials used their base colour). Not stored in files.
   std::vector<std::string> warnings;
 
-  std::size_t size() const { return keys.size(); }
   bool has_colors() const { return !colors.empty(); }
   /// Voxel i's colour (has_colors()), whether held per voxel or once for all.
   HalfRgba color(std::size_t i) const { return colors[colors.size() == 1 ? 0 : i]; }
   bool has_normals() const { return !normals.empty(); }
 };
+
+struct VoxelSet : VoxelAttributes {
+  /// Sorted ascending, unique. (Sized without zeroing: it is filled in parallel right after.)
+  DefaultInitVector<std::uint64_t> keys;
+
+  std::size_t size() const { return keys.size(); }
+};
+
+/// A VoxelSet whose keys are packed as .vfrag stores them (varint gaps, core/key_gaps.hpp): ~1
+/// byte a voxel instead of 8. What svo-voxelize writes a file from: at 4096³ the keys are most of
+/// a VoxelSet's fresh memory, and fresh memory is what these machines pay for.
+struct PackedVoxelSet : VoxelAttributes {
+  std::uint64_t count = 0;
+  DefaultInitVector<std::uint8_t> key_gaps;
+
+  std::size_t size() const { return static_cast<std::size_t>(count); }
+};
+
+/// The same voxels with packed keys (encoded in parallel; the keys' memory is freed).
+PackedVoxelSet PackVoxelSet(VoxelSet&& set);
 
 }  // namespace svokit

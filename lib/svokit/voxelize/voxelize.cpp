@@ -4,6 +4,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/parallel_sort.h>
 
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/voxelize/attributes.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
@@ -173,10 +175,130 @@ class TriangleCache {
 // The voxels of some consecutive bricks, in key order, with their attributes.
 struct VoxelRun {
   DefaultInitVector<std::uint64_t> keys;
+  DefaultInitVector<std::uint8_t> gaps;  // packed output: keys[1..]'s varint gaps
   DefaultInitVector<HalfRgba> colors;
   DefaultInitVector<OctNormal> normals;
   DefaultInitVector<Half> coverage;
-  void clear() { keys.clear(), colors.clear(), normals.clear(), coverage.clear(); }
+  void clear() { keys.clear(), gaps.clear(), colors.clear(), normals.clear(), coverage.clear(); }
+};
+
+// Where the brick pass puts its runs: a VoxelSet's arrays, or a PackedVoxelSet's (keys as varint
+// gaps). Arrays are sized for an estimate without a write; runs are placed in key order (serial)
+// and copied in parallel, so both threads first-touch the fresh pages; runs past the room are
+// appended after, in order.
+class BrickOutput {
+ public:
+  // `colors`, `normals`: the per-voxel arrays to fill (a colour held once is not).
+  BrickOutput(VoxelAttributes& attributes, DefaultInitVector<std::uint64_t>* keys,
+              PackedVoxelSet* packed, bool colors, bool normals)
+      : attributes_(attributes), keys_(keys), packed_(packed), colors_(colors), normals_(normals) {}
+  bool packed() const { return packed_ != nullptr; }
+
+  struct Slot {
+    std::size_t voxel = 0, byte = 0;
+    std::uint8_t head[kMaxVarintBytes];  // packed: the run's first key's varint
+    std::uint8_t head_size = 0;
+  };
+
+  void Reserve(std::size_t voxels, std::size_t bricks) {
+    room_voxels_ = voxels;
+    if (packed_) {
+      // Gaps inside a brick take a byte; a brick's first key's may take up to ten.
+      room_bytes_ = voxels + kMaxVarintBytes * bricks;
+      packed_->key_gaps.resize(room_bytes_);
+    } else {
+      keys_->resize(voxels);
+    }
+    ForEachAttribute([&](auto& array) { array.resize(voxels); });
+  }
+  // Serial, in key order: `slot` is where `run` goes; false when past the room (then Append it
+  // after, in order).
+  bool Place(const VoxelRun& run, Slot& slot) {
+    const std::size_t n = run.keys.size();
+    if (n == 0) return true;
+    if (aside_) return false;
+    std::size_t bytes = 0;
+    if (packed_) {
+      slot.head_size = static_cast<std::uint8_t>(PutVarint(run.keys[0] - last_ - 1, slot.head));
+      bytes = slot.head_size + run.gaps.size();
+    }
+    if (placed_voxels_ + n > room_voxels_ || placed_bytes_ + bytes > room_bytes_) {
+      aside_ = true;
+      return false;
+    }
+    slot.voxel = placed_voxels_, slot.byte = placed_bytes_;
+    placed_voxels_ += n, placed_bytes_ += bytes;
+    last_ = run.keys.back();
+    return true;
+  }
+  // Parallel.
+  void Copy(const VoxelRun& run, const Slot& slot) {
+    const std::size_t n = run.keys.size();
+    if (n == 0) return;
+    if (packed_) {
+      std::uint8_t* out = packed_->key_gaps.data() + slot.byte;
+      std::memcpy(out, slot.head, slot.head_size);
+      std::memcpy(out + slot.head_size, run.gaps.data(), run.gaps.size());
+    } else {
+      std::copy(run.keys.begin(), run.keys.end(), keys_->begin() + slot.voxel);
+    }
+    CopyAttributes(run, [&](auto& array, const auto& values) {
+      std::copy(values.begin(), values.end(), array.begin() + slot.voxel);
+    });
+  }
+  // After the pass: trims the arrays to what was placed, then appends `aside` in order.
+  void Finish(const std::vector<VoxelRun>& aside) {
+    ForEachAttribute([&](auto& array) { array.resize(placed_voxels_); });
+    if (packed_) {
+      packed_->key_gaps.resize(placed_bytes_);
+    } else {
+      keys_->resize(placed_voxels_);
+    }
+    std::size_t count = placed_voxels_;
+    for (const VoxelRun& run : aside) {
+      if (run.keys.empty()) continue;
+      count += run.keys.size();
+      if (packed_) {
+        std::uint8_t head[kMaxVarintBytes];
+        const std::size_t h = PutVarint(run.keys[0] - last_ - 1, head);
+        packed_->key_gaps.insert(packed_->key_gaps.end(), head, head + h);
+        packed_->key_gaps.insert(packed_->key_gaps.end(), run.gaps.begin(), run.gaps.end());
+        last_ = run.keys.back();
+      } else {
+        keys_->insert(keys_->end(), run.keys.begin(), run.keys.end());
+      }
+      CopyAttributes(run, [](auto& array, const auto& values) {
+        array.insert(array.end(), values.begin(), values.end());
+      });
+    }
+    count_ = count;
+    if (packed_) packed_->count = count;
+  }
+  std::size_t count() const { return count_; }
+
+ private:
+  // f(array) for each per-voxel attribute array the output fills (colours only when per voxel).
+  template <class F>
+  void ForEachAttribute(const F& f) {
+    f(attributes_.coverage);
+    if (colors_) f(attributes_.colors);
+    if (normals_) f(attributes_.normals);
+  }
+  // f(array, run's values) for each attribute the run carries.
+  template <class F>
+  void CopyAttributes(const VoxelRun& run, const F& f) {
+    f(attributes_.coverage, run.coverage);
+    if (colors_) f(attributes_.colors, run.colors);
+    if (normals_) f(attributes_.normals, run.normals);
+  }
+
+  VoxelAttributes& attributes_;
+  DefaultInitVector<std::uint64_t>* keys_;
+  PackedVoxelSet* packed_;
+  bool colors_, normals_;
+  std::size_t room_voxels_ = 0, room_bytes_ = 0, placed_voxels_ = 0, placed_bytes_ = 0, count_ = 0;
+  std::uint64_t last_ = kNoPreviousKey;
+  bool aside_ = false;
 };
 
 // One brick's voxels (a 16³ bit set) and their area-weighted sums, indexed by local Morton code.
@@ -274,7 +396,7 @@ class BrickPass {
   /// `bins`: the (brick, triangle) pairs the geometry pass recorded; `reserve`: room for the
   /// voxels to reserve up front (more only costs a reallocation).
   template <class Bins>
-  void Run(Bins& bins, std::size_t reserve, VoxelSet& set, Progress& progress) {
+  void Run(Bins& bins, std::size_t reserve, BrickOutput& output, Progress& progress) {
     std::vector<BrickTriangle> pairs;
     for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
     bins.clear();
@@ -287,20 +409,14 @@ class BrickPass {
     starts.push_back(pairs.size());
     const std::size_t bricks = starts.size() - 1;
 
-    // Room for `reserve` voxels, sized without a write: pages are first touched by the copies.
-    set.keys.resize(reserve);
-    set.coverage.resize(reserve);
-    if (colors_) set.colors.resize(reserve);
-    if (normals_) set.normals.resize(reserve);
+    output.Reserve(reserve, bricks);
     Progress::Stage stage(progress, "attributes", bricks);
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
         [&] { return std::make_unique<BrickAccumulator>(colors_, normals_); });
     tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
         [] { return std::make_unique<TriangleCache>(); });
     // Groups of kGroupBricks bricks: numbered in order, filled in parallel into a free buffer,
-    // placed in order (an offset in the set's arrays) and copied there in parallel, so both
-    // threads first-touch the arrays' fresh pages. Groups past the room (an estimate) are kept
-    // aside, in order, and appended after.
+    // placed in order and copied into the output in parallel.
     const std::size_t groups = (bricks + kGroupBricks - 1) / kGroupBricks;
     const std::size_t tokens =
         4 * std::max<std::size_t>(1, tbb::this_task_arena::max_concurrency());
@@ -308,43 +424,43 @@ class BrickPass {
     tbb::concurrent_queue<std::size_t> free_buffers;  // at most `tokens` groups are in flight
     for (std::size_t b = 0; b < tokens; ++b) free_buffers.push(b);
     struct Group {
-      std::size_t index, buffer, offset;
+      std::size_t index, buffer;
+      bool placed;
+      BrickOutput::Slot slot;
     };
-    constexpr std::size_t kAside = std::numeric_limits<std::size_t>::max();
-    std::size_t next = 0, placed = 0;
+    std::size_t next = 0;
     std::vector<VoxelRun> aside;
     auto number = [&](tbb::flow_control& fc) -> std::size_t {
       if (next == groups) fc.stop();
       return next++;
     };
     auto fill = [&](std::size_t g) {
-      Group group{g, 0, 0};
+      Group group{g, 0, false, {}};
       [[maybe_unused]] const bool popped = free_buffers.try_pop(group.buffer);
       assert(popped);
+      VoxelRun& run = buffers[group.buffer];
       const std::size_t end = std::min(bricks, (g + 1) * kGroupBricks);
       for (std::size_t b = g * kGroupBricks; b < end; ++b) {
-        FillBrick(pairs, starts[b], starts[b + 1], *accumulators.local(), *caches.local(),
-                  buffers[group.buffer]);
+        FillBrick(pairs, starts[b], starts[b + 1], *accumulators.local(), *caches.local(), run);
+      }
+      if (output.packed() && !run.keys.empty()) {
+        AppendKeyGaps(std::span<const std::uint64_t>(run.keys).subspan(1), run.keys[0], run.gaps);
       }
       return group;
     };
     auto place = [&](Group group) {
       VoxelRun& run = buffers[group.buffer];
-      const std::size_t n = run.keys.size();
-      if (aside.empty() && placed + n <= reserve) {
-        group.offset = placed;
-        placed += n;
-      } else {
+      group.placed = output.Place(run, group.slot);
+      if (!group.placed) {
         aside.push_back(std::move(run));
         run = VoxelRun{};
-        group.offset = kAside;
       }
       stage.Advance(std::min(kGroupBricks, bricks - group.index * kGroupBricks));
       return group;
     };
     auto copy = [&](const Group& group) {
       VoxelRun& run = buffers[group.buffer];
-      if (group.offset != kAside) CopyTo(run, group.offset, set);
+      if (group.placed) output.Copy(run, group.slot);
       run.clear();
       free_buffers.push(group.buffer);
     };
@@ -353,12 +469,8 @@ class BrickPass {
                     tbb::make_filter<std::size_t, Group>(tbb::filter_mode::parallel, fill) &
                     tbb::make_filter<Group, Group>(tbb::filter_mode::serial_in_order, place) &
                     tbb::make_filter<Group, void>(tbb::filter_mode::parallel, copy));
-    set.keys.resize(placed);
-    set.coverage.resize(placed);
-    if (colors_) set.colors.resize(placed);
-    if (normals_) set.normals.resize(placed);
-    for (const VoxelRun& run : aside) Append(run, set);
-    stage.SetSummary(fmt::format("{} voxels", set.keys.size()));
+    output.Finish(aside);
+    stage.SetSummary(fmt::format("{} voxels", output.count()));
   }
 
  private:
@@ -407,19 +519,6 @@ class BrickPass {
     acc.Finish(brick, out);
   }
 
-  void CopyTo(const VoxelRun& run, std::size_t offset, VoxelSet& set) const {
-    std::copy(run.keys.begin(), run.keys.end(), set.keys.begin() + offset);
-    std::copy(run.coverage.begin(), run.coverage.end(), set.coverage.begin() + offset);
-    if (colors_) std::copy(run.colors.begin(), run.colors.end(), set.colors.begin() + offset);
-    if (normals_) std::copy(run.normals.begin(), run.normals.end(), set.normals.begin() + offset);
-  }
-  void Append(const VoxelRun& run, VoxelSet& set) const {
-    set.keys.insert(set.keys.end(), run.keys.begin(), run.keys.end());
-    set.coverage.insert(set.coverage.end(), run.coverage.begin(), run.coverage.end());
-    if (colors_) set.colors.insert(set.colors.end(), run.colors.begin(), run.colors.end());
-    if (normals_) set.normals.insert(set.normals.end(), run.normals.begin(), run.normals.end());
-  }
-
   const MeshVoxelizer& voxelizer_;
   const AttributeSampler& sampler_;
   bool colors_, normals_;
@@ -427,8 +526,13 @@ class BrickPass {
 
 }  // namespace
 
-StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
-                            const VoxelizeOptions& options, Progress& progress) {
+namespace {
+
+// Voxelize() and VoxelizePacked(): grid, mode and attributes into `out`; the keys into `keys`, or
+// packed into `packed` (attributes only; `out` is then *packed).
+Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
+                    Progress& progress, VoxelAttributes& out,
+                    DefaultInitVector<std::uint64_t>* keys, PackedVoxelSet* packed) {
   if (mesh.triangles.empty()) return Status::BadInput("the mesh has no triangles to voxelize");
   const std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
   for (const FixedPoint3& v : vertices) {
@@ -459,9 +563,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
         estimate, kMaxVoxels);
   }
 
-  VoxelSet set;
-  set.grid = grid;
-  set.mode = options.mode;
+  out.grid = grid;
+  out.mode = options.mode;
   if (options.colors || options.normals) {
     // Voxels and attributes come out of one walk per brick (BrickPass), whatever the method:
     // first the bricks each triangle may touch.
@@ -469,23 +572,26 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     {
       Progress::Stage stage(progress, "voxelize", n);
       ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-        std::vector<BrickTriangle>& out = bins.local();
+        std::vector<BrickTriangle>& pairs = bins.local();
         for (std::size_t t = begin; t < end; ++t) {
           BinToBricks(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
-                      out);
+                      pairs);
         }
         stage.Advance(end - begin);
       });
     }
     const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
-    set.warnings = sampler.warnings();
+    out.warnings = sampler.warnings();
     const std::optional<Rgba> shared_color = sampler.SharedColor();
-    if (shared_color) set.colors.assign(1, *shared_color);
-    BrickPass pass(voxelizer, sampler, options.colors && !shared_color, options.normals);
+    if (shared_color) out.colors.assign(1, *shared_color);
+    const bool colors = options.colors && !shared_color;
+    BrickPass pass(voxelizer, sampler, colors, options.normals);
+    BrickOutput output(out, keys, packed, colors, options.normals);
     // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-    pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, set, progress);
-    return set;
+    pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, output, progress);
+    return Status::Ok();
   }
+  assert(keys != nullptr);
 
   // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
@@ -508,9 +614,9 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
   auto walk = [&](const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1, std::int64_t v0,
                   std::int64_t v1) {
     const int axis = tv.dominant_axis();
-    VoxelBitSet& keys = parts.local();
+    VoxelBitSet& bits = parts.local();
     tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
-      keys.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
+      bits.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
     });
   };
 
@@ -570,9 +676,31 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
     stage->Advance(large.size());
   }
 
-  set.keys = VoxelBitSet::UnionKeys(parts);
-  stage->SetSummary(fmt::format("{} voxels", set.keys.size()));
+  *keys = VoxelBitSet::UnionKeys(parts);
+  stage->SetSummary(fmt::format("{} voxels", keys->size()));
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
+                            const VoxelizeOptions& options, Progress& progress) {
+  VoxelSet set;
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, set, &set.keys, nullptr));
   return set;
+}
+
+StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
+                                        const VoxelizeOptions& options, Progress& progress) {
+  if (!options.colors && !options.normals) {
+    // The geometry walk's union yields keys; packing them costs what encoding them to a file does.
+    StatusOr<VoxelSet> set = Voxelize(mesh, grid, options, progress);
+    if (!set.ok()) return set.status();
+    return PackVoxelSet(std::move(*set));
+  }
+  PackedVoxelSet packed;
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, packed, nullptr, &packed));
+  return packed;
 }
 
 }  // namespace svokit
