@@ -54,10 +54,9 @@ int main(int argc, char** argv) {
     };
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
-    if (ext == "vfrag" && (voxelize.options.colors || voxelize.options.normals)) {
-      // With attributes, from keys packed as they are found: 7 bytes a voxel less fresh memory
-      // (the geometry walk's union yields plain keys, which the writer encodes as it goes).
-      // Methods and thread counts give the same file, byte for byte: they are not recorded.
+    if (ext == "vfrag") {
+      // From keys packed as they are found: 7 bytes a voxel less fresh memory. Methods and thread
+      // counts give the same file, byte for byte: they are not recorded.
       StatusOr<PackedVoxelSet> voxels = VoxelizePacked(*mesh, *grid, voxelize.options, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
       written = write_stage(*voxels, voxels->size(),
@@ -66,7 +65,6 @@ int main(int argc, char** argv) {
       StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.options, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
       written = write_stage(*voxels, voxels->size(), [&] {
-        if (ext == "vfrag") return WriteVfrag(std::move(*voxels), meta, output);
         return ext == "xyz" ? WriteVoxelsXyz(*voxels, output) : WriteVoxelsPly(*voxels, output);
       });
     }

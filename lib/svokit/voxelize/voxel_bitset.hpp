@@ -15,6 +15,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "svokit/core/default_init.hpp"
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
 
 namespace svokit {
@@ -74,6 +75,10 @@ class VoxelBitSet {
   /// The union of `sets` as sorted unique Morton keys (thread-count independent).
   template <class Sets>
   static DefaultInitVector<std::uint64_t> UnionKeys(const Sets& sets);
+  /// The same keys packed as varint gaps (core/key_gaps.hpp), with their count.
+  template <class Sets>
+  static void UnionPacked(const Sets& sets, std::uint64_t& count,
+                          DefaultInitVector<std::uint8_t>& gaps);
 
  private:
   // The bits of brick (bx, by, bz), created empty on first use.
@@ -98,6 +103,8 @@ class VoxelBitSet {
     return bricks_[it->second];
   }
 
+  class MergedBricks;
+
   std::unordered_map<std::uint64_t, std::size_t> index_;
   std::vector<std::uint64_t> keys_;
   std::deque<Brick> bricks_;  // stable addresses: cached pointers survive growth
@@ -109,57 +116,122 @@ class VoxelBitSet {
   std::array<CacheEntry, kCacheSize> cache_{};
 };
 
-// Union of bit sets: group bricks by key, OR each group, and write every brick's keys at its
-// prefix-sum offset. The result does not depend on how voxels were spread over the sets.
-template <class Sets>
-DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
-  // Every (brick key, bitmap) of every set, grouped by key; pointers only, no copies.
+// The bricks of several bit sets grouped by key (pointers, no copies), in key order; Merge(b)
+// ORs group b. A union does not depend on how voxels were spread over the sets.
+class VoxelBitSet::MergedBricks {
+ public:
+  template <class Sets>
+  explicit MergedBricks(const Sets& sets) {
+    for (const VoxelBitSet& s : sets) {
+      for (std::size_t i = 0; i < s.brick_count(); ++i)
+        refs_.push_back({s.keys_[i], &s.bricks_[i]});
+    }
+    tbb::parallel_sort(refs_.begin(), refs_.end(),
+                       [](const Ref& a, const Ref& b) { return a.key < b.key; });
+    for (std::size_t i = 0; i < refs_.size(); ++i) {
+      if (i == 0 || refs_[i].key != refs_[i - 1].key) starts_.push_back(i);
+    }
+    bricks_ = starts_.size();
+    starts_.push_back(refs_.size());
+  }
+  std::size_t size() const { return bricks_; }
+  std::uint64_t key(std::size_t b) const { return refs_[starts_[b]].key; }
+  Brick Merge(std::size_t b) const {
+    Brick m = *refs_[starts_[b]].bits;
+    for (std::size_t r = starts_[b] + 1; r < starts_[b + 1]; ++r) {
+      for (std::size_t w = 0; w < m.size(); ++w) m[w] |= (*refs_[r].bits)[w];
+    }
+    return m;
+  }
+  // f(local code) for each voxel of `m`, in order.
+  template <class F>
+  static void ForEachVoxel(const Brick& m, const F& f) {
+    for (std::size_t w = 0; w < m.size(); ++w) {
+      for (std::uint64_t word = m[w]; word != 0; word &= word - 1) {
+        f(static_cast<std::uint32_t>(w * 64 + static_cast<std::uint64_t>(std::countr_zero(word))));
+      }
+    }
+  }
+
+ private:
   struct Ref {
     std::uint64_t key;
     const Brick* bits;
   };
-  std::vector<Ref> refs;
-  for (const VoxelBitSet& s : sets) {
-    for (std::size_t i = 0; i < s.brick_count(); ++i) refs.push_back({s.keys_[i], &s.bricks_[i]});
-  }
-  tbb::parallel_sort(refs.begin(), refs.end(),
-                     [](const Ref& a, const Ref& b) { return a.key < b.key; });
-  std::vector<std::size_t> starts;  // first ref of each distinct brick
-  for (std::size_t i = 0; i < refs.size(); ++i) {
-    if (i == 0 || refs[i].key != refs[i - 1].key) starts.push_back(i);
-  }
-  const std::size_t bricks = starts.size();
-  starts.push_back(refs.size());
+  std::vector<Ref> refs_;
+  std::vector<std::size_t> starts_;  // first ref of each distinct brick, and the end
+  std::size_t bricks_ = 0;
+};
 
-  // OR each group and count its voxels, then OR again to write every brick's keys at its
-  // prefix-sum offset (cheaper than keeping a merged copy of every brick).
-  auto merge = [&](std::size_t b) {
-    Brick m = *refs[starts[b]].bits;
-    for (std::size_t r = starts[b] + 1; r < starts[b + 1]; ++r) {
-      for (std::size_t w = 0; w < m.size(); ++w) m[w] |= (*refs[r].bits)[w];
-    }
-    return m;
-  };
+// Each group is merged twice, to count and then to write at its prefix-sum offset: cheaper than
+// keeping a merged copy of every brick.
+template <class Sets>
+DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
+  const MergedBricks merged(sets);
+  const std::size_t bricks = merged.size();
   std::vector<std::uint64_t> offset(bricks + 1, 0);
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    const Brick m = merge(b);
     std::uint64_t count = 0;
-    for (std::uint64_t word : m) count += static_cast<std::uint64_t>(std::popcount(word));
+    for (std::uint64_t word : merged.Merge(b)) count += std::popcount(word);
     offset[b + 1] = count;
   });
   for (std::size_t b = 0; b < bricks; ++b) offset[b + 1] += offset[b];
   DefaultInitVector<std::uint64_t> keys(offset[bricks]);  // first touched by the writes below
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    const Brick m = merge(b);
     std::uint64_t* out = keys.data() + offset[b];
-    const std::uint64_t base = refs[starts[b]].key << kBrickBits;
-    for (std::size_t w = 0; w < m.size(); ++w) {
-      for (std::uint64_t word = m[w]; word != 0; word &= word - 1) {
-        *out++ = base | (w * 64 + static_cast<std::uint64_t>(std::countr_zero(word)));
-      }
-    }
+    const std::uint64_t base = merged.key(b) << kBrickBits;
+    MergedBricks::ForEachVoxel(merged.Merge(b),
+                               [&](std::uint32_t local) { *out++ = base | local; });
   });
   return keys;
+}
+
+// As UnionKeys(), the keys packed (key_gaps.hpp): a brick's gaps after its first voxel are
+// counted and written in parallel; its first voxel's gap, from the previous brick's last voxel,
+// is placed in order between the two passes.
+template <class Sets>
+void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
+                              DefaultInitVector<std::uint8_t>& gaps) {
+  const MergedBricks merged(sets);
+  const std::size_t bricks = merged.size();
+  struct Span {
+    std::uint64_t voxels = 0, bytes = 0;  // bytes: the gaps after the first voxel
+    std::uint32_t first = 0, last = 0;    // local codes
+  };
+  std::vector<Span> spans(bricks);
+  tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
+    Span& s = spans[b];
+    MergedBricks::ForEachVoxel(merged.Merge(b), [&](std::uint32_t local) {
+      if (s.voxels++ == 0) {
+        s.first = local;
+      } else {
+        s.bytes += local - s.last - 1 < 0x80u ? 1 : 2;  // gaps inside a brick are < 2^12
+      }
+      s.last = local;
+    });
+  });
+  std::vector<std::uint64_t> offset(bricks + 1, 0);
+  std::vector<std::uint64_t> previous(bricks);  // the key before each brick's first
+  std::uint64_t last = kNoPreviousKey;
+  count = 0;
+  for (std::size_t b = 0; b < bricks; ++b) {
+    std::uint8_t head[kMaxVarintBytes];
+    const std::uint64_t first = merged.key(b) << kBrickBits | spans[b].first;
+    previous[b] = last;
+    offset[b + 1] = offset[b] + PutVarint(first - last - 1, head) + spans[b].bytes;
+    last = merged.key(b) << kBrickBits | spans[b].last;
+    count += spans[b].voxels;
+  }
+  gaps.resize(offset[bricks]);  // first touched by the writes below
+  tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
+    std::uint8_t* out = gaps.data() + offset[b];
+    const std::uint64_t base = merged.key(b) << kBrickBits;
+    std::uint64_t prev = previous[b];
+    MergedBricks::ForEachVoxel(merged.Merge(b), [&](std::uint32_t local) {
+      out += PutVarint((base | local) - prev - 1, out);
+      prev = base | local;
+    });
+  });
 }
 
 }  // namespace svokit

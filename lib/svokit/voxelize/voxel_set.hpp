@@ -64,7 +64,4 @@ struct PackedVoxelSet : VoxelAttributes {
   std::size_t size() const { return static_cast<std::size_t>(count); }
 };
 
-/// The same voxels with packed keys (encoded in parallel; the keys' memory is freed).
-PackedVoxelSet PackVoxelSet(VoxelSet&& set);
-
 }  // namespace svokit

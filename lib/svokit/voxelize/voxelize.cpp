@@ -529,7 +529,7 @@ class BrickPass {
 namespace {
 
 // Voxelize() and VoxelizePacked(): grid, mode and attributes into `out`; the keys into `keys`, or
-// packed into `packed` (attributes only; `out` is then *packed).
+// packed into `packed` (`out` is then *packed).
 Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
                     Progress& progress, VoxelAttributes& out,
                     DefaultInitVector<std::uint64_t>* keys, PackedVoxelSet* packed) {
@@ -591,7 +591,6 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
     pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, output, progress);
     return Status::Ok();
   }
-  assert(keys != nullptr);
 
   // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
@@ -676,8 +675,15 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
     stage->Advance(large.size());
   }
 
-  *keys = VoxelBitSet::UnionKeys(parts);
-  stage->SetSummary(fmt::format("{} voxels", keys->size()));
+  std::uint64_t count = 0;
+  if (packed != nullptr) {
+    VoxelBitSet::UnionPacked(parts, packed->count, packed->key_gaps);
+    count = packed->count;
+  } else {
+    *keys = VoxelBitSet::UnionKeys(parts);
+    count = keys->size();
+  }
+  stage->SetSummary(fmt::format("{} voxels", count));
   return Status::Ok();
 }
 
@@ -692,12 +698,6 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
 
 StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
                                         const VoxelizeOptions& options, Progress& progress) {
-  if (!options.colors && !options.normals) {
-    // The geometry walk's union yields keys; packing them costs what encoding them to a file does.
-    StatusOr<VoxelSet> set = Voxelize(mesh, grid, options, progress);
-    if (!set.ok()) return set.status();
-    return PackVoxelSet(std::move(*set));
-  }
   PackedVoxelSet packed;
   SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, packed, nullptr, &packed));
   return packed;

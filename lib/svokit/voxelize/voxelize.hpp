@@ -32,8 +32,8 @@ StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                             Progress& progress = Progress::Silent());
 
 /// Voxelize() with the keys packed as .vfrag stores them, for writing a file: the same voxels and
-/// attributes in ~7 bytes a voxel less memory (with attributes, the keys are packed brick group by
-/// brick group as they are found; without, the walk's keys are packed after).
+/// attributes in ~7 bytes a voxel less memory (the keys are packed brick by brick as they are
+/// found, never held as 64-bit keys).
 StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
                                         const VoxelizeOptions& options,
                                         Progress& progress = Progress::Silent());
