@@ -25,19 +25,24 @@ float DecodeOctSnorm(std::uint32_t code) {
   return static_cast<float>(static_cast<int>(code) - kHalf) / static_cast<float>(kHalf - 1);
 }
 
-/// The direction of `n` (any length; 0 for a zero or non-finite vector), x code in the low kBits.
+/// The code of a point (x, y, z) on the octahedron, |x|+|y|+|z| = 1 (only z's sign is read).
 template <int kBits>
-std::uint32_t OctahedralEncode(const Vec3f& n) {
-  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-  if (!(l1 > 1e-20f) || !std::isfinite(l1)) return 0;
-  float x = n.x / l1, y = n.y / l1;
-  if (n.z < 0) {
+std::uint32_t OctahedralEncodePoint(float x, float y, float z) {
+  if (z < 0) {
     const float fx = (1.f - std::abs(y)) * (x < 0 ? -1.f : 1.f);
     const float fy = (1.f - std::abs(x)) * (y < 0 ? -1.f : 1.f);
     x = fx;
     y = fy;
   }
   return EncodeOctSnorm<kBits>(x) | EncodeOctSnorm<kBits>(y) << kBits;
+}
+
+/// The direction of `n` (any length; 0 for a zero or non-finite vector), x code in the low kBits.
+template <int kBits>
+std::uint32_t OctahedralEncode(const Vec3f& n) {
+  const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+  if (!(l1 > 1e-20f) || !std::isfinite(l1)) return 0;
+  return OctahedralEncodePoint<kBits>(n.x / l1, n.y / l1, n.z);
 }
 
 /// The unit vector of `code` (the zero vector for 0).
@@ -63,6 +68,12 @@ struct OctNormal {
   std::uint32_t bits;  // trivially default-constructed (like float): OctNormal{} is "no normal"
   OctNormal() = default;
   OctNormal(const Vec3f& n) : bits(OctahedralEncode<16>(n)) {}  // NOLINT: implicit by design
+  /// From a code (OctahedralEncode<16>, OctahedralEncodePoint<16>).
+  static OctNormal FromCode(std::uint32_t code) {
+    OctNormal n;
+    n.bits = code;
+    return n;
+  }
   operator Vec3f() const { return OctahedralDecode<16>(bits); }
   bool operator==(const OctNormal&) const = default;
 };

@@ -355,16 +355,18 @@ class BrickAccumulator {
       }
     }
     if (normals_) {
-      // Octahedral codes keep the direction only; scaled to |x|+|y|+|z| = 1 in double first, so
-      // sums that nearly cancel (two sides of a thin sheet) keep theirs in float.
+      // Octahedral codes keep the direction only: the sum's point on the octahedron, scaled in
+      // double (sums that nearly cancel, two sides of a thin sheet, keep their direction).
       out.normals.resize(at + n);
       for (std::size_t i = 0; i < n; ++i) {
         const Sum& sum = sums_[locals[i]];
         const double l1 = std::abs(sum.nx) + std::abs(sum.ny) + std::abs(sum.nz);
-        const double scale = l1 > 0 ? 1.0 / l1 : 0.0;
-        out.normals[at + i] =
-            Vec3f{static_cast<float>(sum.nx * scale), static_cast<float>(sum.ny * scale),
-                  static_cast<float>(sum.nz * scale)};
+        const double scale = 1.0 / l1;
+        out.normals[at + i] = OctNormal::FromCode(
+            l1 > 0 ? OctahedralEncodePoint<16>(static_cast<float>(sum.nx * scale),
+                                               static_cast<float>(sum.ny * scale),
+                                               static_cast<float>(sum.nz))
+                   : 0);
       }
     }
     for (std::size_t i = 0; i < n; ++i) sums_[locals[i]] = {};
