@@ -356,7 +356,7 @@ class BrickAccumulator {
     }
     if (normals_) {
       // Octahedral codes keep the direction only: the sum's point on the octahedron, scaled in
-      // double (sums that nearly cancel, two sides of a thin sheet, keep their direction).
+      // double whatever the sum's size (one division a voxel; a zero sum is "no normal").
       out.normals.resize(at + n);
       for (std::size_t i = 0; i < n; ++i) {
         const Sum& sum = sums_[locals[i]];
