@@ -152,7 +152,8 @@ void TriangleVoxelizer::Localize() {
     if (Abs(*a) + Abs(d.b) * extent[u_] + Abs(d.c) * extent[v_] >= kLimit) fits_int64_ = false;
   }
   if (d.den >= kLimit) fits_int64_ = false;
-  for (auto [step, delta] : {std::pair{&d.step_u, -d.b}, {&d.step_v, -d.c}}) {
+  for (auto [step, delta] :
+       {std::pair{&d.step_u, -d.b}, {&d.step_v, -d.c}, {&d.span, d.a_hi - d.a_lo}}) {
     step->dq = voxelize_detail::FloorDiv(delta, d.den);
     step->dr = delta - step->dq * d.den;
   }
@@ -163,7 +164,8 @@ void TriangleVoxelizer::Localize() {
                    narrow(d.b),
                    narrow(d.c),
                    {narrow(d.step_u.dq), narrow(d.step_u.dr)},
-                   {narrow(d.step_v.dq), narrow(d.step_v.dr)}};
+                   {narrow(d.step_v.dq), narrow(d.step_v.dr)},
+                   {narrow(d.span.dq), narrow(d.span.dr)}};
 }
 
 bool TriangleVoxelizer::ColumnInside(std::int64_t pu, std::int64_t pv) const {
@@ -183,7 +185,7 @@ bool TriangleVoxelizer::Overlaps(std::int64_t x, std::int64_t y, std::int64_t z)
   if (!ColumnInside(p[u_], p[v_])) return false;
   const std::int64_t lu = p[u_] - origin_[u_], lv = p[v_] - origin_[v_], lw = p[w_] - origin_[w_];
   std::int64_t w0, w1;
-  ClipDepth(StartDepth(wide_.depth, lu, lv), w0, w1);
+  ClipDepth(MakeFrame(), wide_.depth, StartDepth(wide_.depth, lu, lv), w0, w1);
   return lw >= w0 && lw <= w1 && StartSideRun(wide_.edges, lu, lv, lw).Inside();
 }
 

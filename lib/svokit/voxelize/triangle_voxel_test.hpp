@@ -51,6 +51,12 @@ class TriangleVoxelizer {
   template <class EmitRun>
   void RunsWithInterior(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
                         const EmitRun& emit) const;
+  /// RunsWithInterior() with the dominant axis as a compile-time constant:
+  /// emit(std::integral_constant<int, W>, x, y, z, n, interior), so that the emitter's
+  /// per-run code is compiled once per axis (the voxelizer's innermost loop).
+  template <class EmitRun>
+  void RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
+                     const EmitRun& emit) const;
   /// The same voxels one by one: emit(x, y, z).
   template <class Emit>
   void Columns(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
@@ -76,8 +82,7 @@ class TriangleVoxelizer {
     Int value[6];
     Int step[6];
     bool Inside() const {
-      return value[0] >= 0 && value[1] >= 0 && value[2] >= 0 && value[3] >= 0 && value[4] >= 0 &&
-             value[5] >= 0;
+      return (value[0] | value[1] | value[2] | value[3] | value[4] | value[5]) >= 0;
     }
     void Step() {
       for (int k = 0; k < 6; ++k) value[k] += step[k];
@@ -93,16 +98,13 @@ class TriangleVoxelizer {
   struct FloorStep {
     Int dq = 0, dr = 0;
   };
-  // The plane's run along w at a column (local indices): plane_lo = lo.q, plane_hi = hi.q.
-  template <class Int>
-  struct DepthCursor {
-    FloorCursor<Int> lo, hi;
-  };
   // Depth-range constants in local coordinates: plane_lo/hi = floor((a_lo/hi − b·lu − c·lv) / den).
+  // The two numerators differ by a constant (span), so one cursor on plane_lo's gives both.
   template <class Int>
   struct Depth {
     Int den = 1, a_lo = 0, a_hi = 0, b = 0, c = 0;
     FloorStep<Int> step_u, step_v;  // one column along u, one row along v
+    FloorStep<Int> span;            // a_hi − a_lo
   };
   // Everything the column walk evaluates, in one integer width.
   template <class Int>
@@ -110,36 +112,50 @@ class TriangleVoxelizer {
     EdgeSet<Int> edges{};
     Depth<Int> depth;
   };
+  // What the column walk reads of the voxelizer, copied into the walk's frame: the emitter's
+  // stores could alias the members, which would reload them at every column.
+  struct Frame {
+    std::int64_t origin[3];
+    std::int64_t w_last;  // the candidate range along w is [0, w_last] locally (origin_ = lo_)
+    bool has_plane, conservative;
+  };
+  Frame MakeFrame() const {
+    return {{origin_[0], origin_[1], origin_[2]},
+            hi_[w_] - 1 - lo_[w_],
+            has_plane_,
+            mode_ == VoxelMode::kConservative};
+  }
 
   template <class Int>
   SideRun<Int> StartSideRun(const EdgeSet<Int>& edges, std::int64_t lu, std::int64_t lv,
                             std::int64_t lw) const;
-  template <class Int, class EmitRun>
+  template <int W, class Int, class EmitRun>
   void RunsWith(const Setup<Int>& setup, std::int64_t u0, std::int64_t u1, std::int64_t v0,
                 std::int64_t v1, const EmitRun& emit) const;
+  // The plane_lo cursor at column (lu, lv); zero without a plane.
   template <class Int>
-  DepthCursor<Int> StartDepth(const Depth<Int>& depth, std::int64_t lu, std::int64_t lv) const;
-  // Without a plane the cursor stays at zero (den = 1, zero steps).
+  FloorCursor<Int> StartDepth(const Depth<Int>& depth, std::int64_t lu, std::int64_t lv) const;
+  // Adds a constant step to the cursor (branch-free: the carry is a coin toss per column).
   template <class Int>
-  static void Step(Int den, DepthCursor<Int>& c, const FloorStep<Int>& s) {
-    c.lo.q += s.dq, c.lo.r += s.dr;
-    c.hi.q += s.dq, c.hi.r += s.dr;
-    if (c.lo.r >= den) c.lo.r -= den, ++c.lo.q;
-    if (c.hi.r >= den) c.hi.r -= den, ++c.hi.q;
+  static void Step(Int den, FloorCursor<Int>& c, const FloorStep<Int>& s) {
+    c.q += s.dq, c.r += s.dr;
+    const Int carry = c.r >= den;
+    c.q += carry, c.r -= den & -carry;
   }
   // The column's local voxel run [w0, w1] (empty if w0 > w1) within the candidate range; true
   // when the plane alone meets exactly one voxel of the column (conservative mode), which makes
   // the side tests unnecessary: every triangle point in the column then lies in that voxel.
   // Without a plane (degenerate triangle) every w of the candidate range passes.
   template <class Int>
-  bool ClipDepth(const DepthCursor<Int>& c, std::int64_t& w0, std::int64_t& w1) const {
-    w0 = lo_[w_] - origin_[w_];
-    w1 = hi_[w_] - 1 - origin_[w_];
-    if (!has_plane_) return false;
-    const bool single = mode_ == VoxelMode::kConservative && c.lo.q == c.hi.q;
-    if (c.lo.q > w0) w0 = static_cast<std::int64_t>(c.lo.q);
-    if (c.hi.q < w1) w1 = static_cast<std::int64_t>(c.hi.q);
-    return single;
+  static bool ClipDepth(const Frame& f, const Depth<Int>& d, const FloorCursor<Int>& c,
+                        std::int64_t& w0, std::int64_t& w1) {
+    w0 = 0;
+    w1 = f.w_last;
+    if (!f.has_plane) return false;
+    const Int lo = c.q, hi = c.q + d.span.dq + (c.r >= d.den - d.span.dr);
+    if (lo > w0) w0 = static_cast<std::int64_t>(lo);
+    if (hi < w1) w1 = static_cast<std::int64_t>(hi);
+    return f.conservative && lo == hi;
   }
   void Localize();
   bool ColumnInside(std::int64_t pu, std::int64_t pv) const;

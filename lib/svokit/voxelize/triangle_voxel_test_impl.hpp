@@ -29,11 +29,29 @@ void TriangleVoxelizer::Runs(std::int64_t u0, std::int64_t u1, std::int64_t v0, 
 template <class EmitRun>
 void TriangleVoxelizer::RunsWithInterior(std::int64_t u0, std::int64_t u1, std::int64_t v0,
                                          std::int64_t v1, const EmitRun& emit) const {
+  RunsAlongAxis(u0, u1, v0, v1,
+                [&](auto, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t n,
+                    bool interior) { emit(x, y, z, n, interior); });
+}
+
+template <class EmitRun>
+void TriangleVoxelizer::RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                                      std::int64_t v1, const EmitRun& emit) const {
   if (empty_) return;
+  auto along = [&](const auto& setup) {
+    switch (w_) {
+      case 0:
+        return RunsWith<0>(setup, u0, u1, v0, v1, emit);
+      case 1:
+        return RunsWith<1>(setup, u0, u1, v0, v1, emit);
+      default:
+        return RunsWith<2>(setup, u0, u1, v0, v1, emit);
+    }
+  };
   if (fits_int64_) {
-    RunsWith(narrow_, u0, u1, v0, v1, emit);
+    along(narrow_);
   } else {
-    RunsWith(wide_, u0, u1, v0, v1, emit);
+    along(wide_);
   }
 }
 
@@ -65,80 +83,78 @@ TriangleVoxelizer::SideRun<Int> TriangleVoxelizer::StartSideRun(const EdgeSet<In
 }
 
 template <class Int>
-TriangleVoxelizer::DepthCursor<Int> TriangleVoxelizer::StartDepth(const Depth<Int>& depth,
+TriangleVoxelizer::FloorCursor<Int> TriangleVoxelizer::StartDepth(const Depth<Int>& depth,
                                                                   std::int64_t lu,
                                                                   std::int64_t lv) const {
-  DepthCursor<Int> c;
+  FloorCursor<Int> c;
   if (!has_plane_) return c;
-  for (FloorCursor<Int>* f : {&c.lo, &c.hi}) {
-    const Int num = (f == &c.lo ? depth.a_lo : depth.a_hi) - depth.b * lu - depth.c * lv;
-    f->q = voxelize_detail::FloorDiv(num, depth.den);
-    f->r = num - f->q * depth.den;
-  }
+  const Int num = depth.a_lo - depth.b * lu - depth.c * lv;
+  c.q = voxelize_detail::FloorDiv(num, depth.den);
+  c.r = num - c.q * depth.den;
   return c;
 }
 
-template <class Int, class EmitRun>
+template <int W, class Int, class EmitRun>
 void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::int64_t u1,
                                  std::int64_t v0, std::int64_t v1, const EmitRun& emit) const {
-  u0 = std::max(u0, lo_[u_]), u1 = std::min(u1, hi_[u_]);
-  v0 = std::max(v0, lo_[v_]), v1 = std::min(v1, hi_[v_]);
+  constexpr int U = (W + 1) % 3, V = (W + 2) % 3;
+  const std::integral_constant<int, W> axis;
+  const Frame f = MakeFrame();
+  u0 = std::max(u0, lo_[U]), u1 = std::min(u1, hi_[U]);
+  v0 = std::max(v0, lo_[V]), v1 = std::min(v1, hi_[V]);
   if (u0 >= u1) return;
-  const auto& foot = setup.edges[0];
-  const std::int64_t lu0 = u0 - origin_[u_], lu1 = u1 - origin_[u_];
-  std::int64_t xyz[3];
-  DepthCursor<Int> row = StartDepth(setup.depth, lu0, v0 - origin_[v_]);
+  const std::int64_t lu0 = u0 - f.origin[U], lu1 = u1 - f.origin[U];
+  const Depth<Int> depth = setup.depth;
+  FloorCursor<Int> row = StartDepth(depth, lu0, v0 - f.origin[V]);
   // Conservative mode, with a plane: a column whose whole square lies inside the projected
   // triangle meets the triangle exactly where it meets the plane, so its plane run needs no side
   // tests. An edge function's minimum over the square is its value (at the most interior corner)
   // minus |a| + |b|.
-  const bool shortcut = has_plane_ && mode_ == VoxelMode::kConservative;
+  const bool shortcut = f.has_plane && f.conservative;
+  const EdgeT<Int> foot[3] = {setup.edges[0][0], setup.edges[0][1], setup.edges[0][2]};
   Int inner[3];
   for (int i = 0; i < 3; ++i)
     inner[i] = (foot[i].a < 0 ? -foot[i].a : foot[i].a) + (foot[i].b < 0 ? -foot[i].b : foot[i].b);
-  const Int den = setup.depth.den;
-  const FloorStep<Int> step_u = setup.depth.step_u;
-  for (std::int64_t pv = v0; pv < v1; ++pv, Step(den, row, setup.depth.step_v)) {
+  std::int64_t xyz[3];
+  for (std::int64_t pv = v0; pv < v1; ++pv, Step(depth.den, row, depth.step_v)) {
     // Footprint edge functions, stepped incrementally along u (exact integer adds). The row's
     // columns inside all three edges form one interval: the walk ends at its first column after.
-    const std::int64_t lv = pv - origin_[v_];
+    const std::int64_t lv = pv - f.origin[V];
     Int e0 = foot[0].a * lu0 + foot[0].b * lv + foot[0].c;
     Int e1 = foot[1].a * lu0 + foot[1].b * lv + foot[1].c;
     Int e2 = foot[2].a * lu0 + foot[2].b * lv + foot[2].c;
-    DepthCursor<Int> depth = row;
-    xyz[v_] = pv;
+    FloorCursor<Int> cursor = row;
+    xyz[V] = pv;
     bool entered = false;
-    for (std::int64_t lu = lu0; lu < lu1;
-         ++lu, e0 += foot[0].a, e1 += foot[1].a, e2 += foot[2].a, Step(den, depth, step_u)) {
+    for (std::int64_t lu = lu0; lu < lu1; ++lu, e0 += foot[0].a, e1 += foot[1].a, e2 += foot[2].a,
+                      Step(depth.den, cursor, depth.step_u)) {
       if ((e0 | e1 | e2) < 0) {  // some edge function negative
         if (entered) break;
         continue;
       }
       entered = true;
       std::int64_t w0, w1;
-      const bool single = ClipDepth(depth, w0, w1);
+      const bool single = ClipDepth(f, depth, cursor, w0, w1);
       if (w0 > w1) continue;
-      xyz[u_] = lu + origin_[u_];
+      xyz[U] = lu + f.origin[U];
       const bool interior = shortcut && ((e0 - inner[0]) | (e1 - inner[1]) | (e2 - inner[2])) >= 0;
       if (single || interior) {
         // A one-voxel plane run needs no side tests either: the triangle's points in this
         // column all lie in that voxel (exact for conservative mode only).
-        xyz[w_] = w0 + origin_[w_];
-        emit(xyz[0], xyz[1], xyz[2], w1 - w0 + 1, interior);
+        xyz[W] = w0 + f.origin[W];
+        emit(axis, xyz[0], xyz[1], xyz[2], w1 - w0 + 1, interior);
         continue;
       }
-      // Maximal runs of voxels passing the six side tests.
+      // The voxels passing the six side tests: each test is linear along the column, so they
+      // form one run.
       SideRun<Int> run = StartSideRun(setup.edges, lu, lv, w0);
-      for (std::int64_t lw = w0; lw <= w1;) {
-        if (!run.Inside()) {
-          ++lw, run.Step();
-          continue;
-        }
-        const std::int64_t start = lw;
-        do ++lw, run.Step();
-        while (lw <= w1 && run.Inside());
-        xyz[w_] = start + origin_[w_];
-        emit(xyz[0], xyz[1], xyz[2], lw - start, false);
+      std::int64_t lw = w0;
+      while (lw <= w1 && !run.Inside()) ++lw, run.Step();
+      const std::int64_t start = lw;
+      while (lw <= w1 && run.Inside()) ++lw, run.Step();
+      if (lw > start) {
+        xyz[W] = start + f.origin[W];
+        emit(axis, xyz[0], xyz[1], xyz[2], lw - start, false);
       }
     }
   }

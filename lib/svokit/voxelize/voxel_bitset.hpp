@@ -43,8 +43,9 @@ class VoxelBitSet {
   /// (x, y, z) on along `axis` pass through, in order: `local` is the Morton code of the first of
   /// its `count` voxels inside the brick.
   template <class F>
-  static void ForEachBrickOfRun(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis,
-                                std::uint32_t n, const F& f) {
+  [[gnu::always_inline]] static void ForEachBrickOfRun(std::uint32_t x, std::uint32_t y,
+                                                       std::uint32_t z, int axis, std::uint32_t n,
+                                                       const F& f) {
     std::uint32_t c[3] = {x, y, z};
     while (n > 0) {
       const std::uint32_t count = std::min(n, 16 - (c[axis] & 15));
@@ -55,8 +56,9 @@ class VoxelBitSet {
   }
 
   /// Inserts the `n` voxels from (x, y, z) on along `axis` (a column run): one brick lookup per
-  /// brick the run passes through, not per voxel.
-  void InsertRun(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis, std::uint32_t n) {
+  /// brick the run passes through, not per voxel. Inlined, so a constant axis folds.
+  [[gnu::always_inline]] void InsertRun(std::uint32_t x, std::uint32_t y, std::uint32_t z, int axis,
+                                        std::uint32_t n) {
     ForEachBrickOfRun(x, y, z, axis, n,
                       [&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint32_t local,
                           std::uint32_t count) {

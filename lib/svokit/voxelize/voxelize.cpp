@@ -614,11 +614,10 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
   // Walks columns [u0,u1)×[v0,v1) of triangle t into this thread's bit set.
   auto walk = [&](const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1, std::int64_t v0,
                   std::int64_t v1) {
-    const int axis = tv.dominant_axis();
     VoxelBitSet& bits = parts.local();
-    tv.Runs(u0, u1, v0, v1, [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k) {
-      bits.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k));
-    });
+    tv.RunsAlongAxis(u0, u1, v0, v1,
+                     [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
+                         bool) { bits.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k)); });
   };
 
   // Triangle path: every triangle not in `large`, a batch of triangles per task, in Morton order
