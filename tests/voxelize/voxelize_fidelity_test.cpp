@@ -548,6 +548,52 @@ TEST(TriangleFidelity, RandomHugeTriangles) {
   }
 }
 
+// Triangles whose corners lie up to 2²³ fixed-point units (128 voxels) from their candidate
+// box's corner take the walk set up in 64-bit integers, larger ones the 128-bit one: random
+// triangles of 126–130 voxels (either side of the limit), of 900–1000 and of 6000–8000 (whose
+// depth numerators exceed 64 bits), some clipped by the grid, compared in 16³ windows around
+// points on them.
+TEST(TriangleFidelity, TrianglesAtThe64BitSetupLimit) {
+  std::mt19937_64 rng(23);
+  const std::int64_t n = 16384;
+  const IBox3 grid = Cube(n);
+  std::uniform_int_distribution<std::int64_t> fraction(0, kOne - 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::size_t voxels = 0;
+  for (const auto& [lo, hi] : {std::pair{126, 130}, {900, 1000}, {6000, 8000}}) {
+    std::uniform_int_distribution<std::int64_t> size(lo * kOne, hi * kOne),
+        base(-40 * kOne, (n - hi + 40) * kOne);
+    for (int i = 0; i < 24; ++i) {
+      const FixedPoint3 origin{base(rng), base(rng), base(rng)};
+      // Corner k on axis k's far side of the box (or on the two other axes' far sides): the
+      // plane then passes far from the box's low corner (the largest plane offsets).
+      std::array<FixedPoint3, 3> t;
+      for (int k = 0; k < 3; ++k) {
+        for (int a = 0; a < 3; ++a) {
+          const bool far = (a == k) != ((i & 1) == 1);
+          t[k][a] = origin[a] + fraction(rng) + (far ? size(rng) : 0);
+        }
+      }
+      for (int k = 0; k < 3; ++k) {
+        double s = unit(rng), r = unit(rng);
+        if (s + r > 1) s = 1 - s, r = 1 - r;
+        IBox3 window;
+        for (int a = 0; a < 3; ++a) {
+          const double on = static_cast<double>(t[0][a]) +
+                            s * static_cast<double>(t[1][a] - t[0][a]) +
+                            r * static_cast<double>(t[2][a] - t[0][a]);
+          window.lo[a] = std::clamp<std::int64_t>(std::llround(on) / kOne - 8, 0, n - 16);
+          window.hi[a] = window.lo[a] + 16;
+        }
+        const TriangleResult res = CheckTriangle(t[0], t[1], t[2], grid, window);
+        voxels += res.voxels[0];
+        ASSERT_TRUE(res.ok()) << Describe(t[0], t[1], t[2]);
+      }
+    }
+  }
+  EXPECT_GT(voxels, 3u * 24 * 3 * 16);
+}
+
 // Huge triangles whose plane passes exactly through voxel corners while its normal has far more
 // than 53 significant bits: axis-aligned at an integer depth with arbitrary fixed-point corners in
 // the plane, and tilted ones through three lattice points. The depth range's divisions are then

@@ -157,21 +157,26 @@ class TriangleVoxelizer {
     if (hi < w1) w1 = static_cast<std::int64_t>(hi);
     return f.conservative && lo == hi;
   }
-  void Localize();
-  bool ColumnInside(std::int64_t pu, std::int64_t pv) const;
+  // Vertices relative to the candidate box's low corner (origin_), in fixed-point units.
+  using LocalVertices = std::array<std::array<std::int64_t, 3>, 3>;
+  // The plane, the axes and the walk's constants of the triangle `p`, computed in Int (the plane
+  // offset, cubic in the coordinates, always in 128 bits).
+  template <class Int>
+  void Build(const LocalVertices& p, Setup<Int>& setup);
+  // Copies wide_ into narrow_ if every value the walk can reach fits in 63 bits.
+  bool NarrowIfFits();
+  template <class Int>
+  bool OverlapsWith(const Setup<Int>& setup, std::int64_t x, std::int64_t y, std::int64_t z) const;
 
   VoxelMode mode_;
-  int w_, u_, v_;
+  int w_ = 2, u_ = 0, v_ = 1;
   bool empty_ = false;
   bool has_plane_ = false;  // false for a degenerate triangle
   double projected_area_ = 0;
   std::array<std::int64_t, 3> lo_{}, hi_{};  // candidate voxel index range per axis (AABB test)
-  // Plane N·x = d in fixed-point units, oriented so N[w] ≥ 0.
-  std::array<Int128, 3> n_{};
-  Int128 d_ = 0;
-  // The walk's constants in 128 bits, relative to origin_ (the candidate box's low corner); and
-  // the same in 64 bits, used when every value over the candidate box fits (footprints up to
-  // some thousand voxels): the column walk then runs on native integers.
+  // The walk's constants relative to origin_ (the candidate box's low corner): in 64 bits when
+  // every value over the candidate box fits (all but huge or far out-of-grid triangles), the
+  // column walk then running on native integers; else in 128 bits.
   Setup<Int128> wide_;
   Setup<std::int64_t> narrow_;
   bool fits_int64_ = false;
