@@ -201,16 +201,24 @@ void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
     std::uint32_t first = 0, last = 0;    // local codes
   };
   std::vector<Span> spans(bricks);
+  // Word by word: only a word's first voxel can be more than 63 codes after the one before (and
+  // less than 2^12 inside a brick: at most 2 bytes); the others take a byte each.
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
+    const Brick m = merged.Merge(b);
     Span& s = spans[b];
-    MergedBricks::ForEachVoxel(merged.Merge(b), [&](std::uint32_t local) {
-      if (s.voxels++ == 0) {
-        s.first = local;
+    for (std::size_t w = 0; w < m.size(); ++w) {
+      if (m[w] == 0) continue;
+      const auto first = static_cast<std::uint32_t>(w * 64 + std::countr_zero(m[w]));
+      const auto voxels = static_cast<std::uint64_t>(std::popcount(m[w]));
+      if (s.voxels == 0) {
+        s.first = first;
+        s.bytes = voxels - 1;
       } else {
-        s.bytes += local - s.last - 1 < 0x80u ? 1 : 2;  // gaps inside a brick are < 2^12
+        s.bytes += voxels + (first - s.last - 1 >= 0x80u ? 1 : 0);
       }
-      s.last = local;
-    });
+      s.voxels += voxels;
+      s.last = static_cast<std::uint32_t>(w * 64 + 63 - std::countl_zero(m[w]));
+    }
   });
   std::vector<std::uint64_t> offset(bricks + 1, 0);
   std::vector<std::uint64_t> previous(bricks);  // the key before each brick's first
@@ -229,10 +237,20 @@ void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
     std::uint8_t* out = gaps.data() + offset[b];
     const std::uint64_t base = merged.key(b) << kBrickBits;
     std::uint64_t prev = previous[b];
-    MergedBricks::ForEachVoxel(merged.Merge(b), [&](std::uint32_t local) {
-      out += PutVarint((base | local) - prev - 1, out);
-      prev = base | local;
-    });
+    const Brick m = merged.Merge(b);
+    for (std::size_t w = 0; w < m.size(); ++w) {
+      std::uint64_t word = m[w];
+      if (word == 0) continue;
+      std::uint64_t key = base | (w * 64 + static_cast<std::uint64_t>(std::countr_zero(word)));
+      out += PutVarint(key - prev - 1, out);
+      for (word &= word - 1; word != 0; word &= word - 1) {
+        const std::uint64_t next =
+            base | (w * 64 + static_cast<std::uint64_t>(std::countr_zero(word)));
+        *out++ = static_cast<std::uint8_t>(next - key - 1);  // < 63
+        key = next;
+      }
+      prev = key;
+    }
   });
 }
 

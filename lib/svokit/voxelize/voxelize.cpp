@@ -16,6 +16,7 @@
 
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/radix_sort.hpp"
 #include "svokit/voxelize/attributes.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
@@ -640,9 +641,11 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
         order[t] = {MortonEncode(c[0], c[1], c[2]), static_cast<std::uint32_t>(t)};
       }
     });
-    tbb::parallel_sort(order.begin(), order.end(), [](const Ordered& a, const Ordered& b) {
-      return a.brick != b.brick ? a.brick < b.brick : a.triangle < b.triangle;
-    });
+    // Stable: triangles of one brick stay in index order. Morton keys of brick coordinates
+    // below 2^b take 3b bits.
+    const std::int64_t last_brick = (std::max({box.hi.x, box.hi.y, box.hi.z}) - 1) >> 4;
+    RadixSortByKey(order, 3 * KeyBits(static_cast<std::uint64_t>(last_brick)),
+                   [](const Ordered& o) { return o.brick; });
     ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::size_t t = order[i].triangle;
