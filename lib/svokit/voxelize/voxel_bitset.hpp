@@ -91,12 +91,14 @@ class VoxelBitSet {
     const std::uint64_t packed = bx | std::uint64_t{by} << 21 | std::uint64_t{bz} << 42;
     CacheEntry& slot = cache_[(bx & 7) | (by & 7) << 3 | (bz & 7) << 6];
     if (slot.bits == nullptr || slot.packed != packed) [[unlikely]] {
-      slot = {packed, &Lookup(MortonEncode(bx, by, bz))};
+      slot = {packed, &Lookup(bx, by, bz)};
     }
     return *slot.bits;
   }
-  // Out of line: keeps the cache-hit path small enough to inline into the column walk.
-  [[gnu::noinline]] Brick& Lookup(std::uint64_t brick) {
+  // Out of line, the Morton key included: keeps the cache-hit path small enough to inline into
+  // the column walk.
+  [[gnu::noinline]] Brick& Lookup(std::uint32_t bx, std::uint32_t by, std::uint32_t bz) {
+    const std::uint64_t brick = MortonEncode(bx, by, bz);
     auto [it, fresh] = index_.try_emplace(brick, bricks_.size());
     if (fresh) {
       keys_.push_back(brick);
