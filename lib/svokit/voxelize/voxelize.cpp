@@ -17,6 +17,7 @@
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/radix_sort.hpp"
+#include "svokit/core/release_pages.hpp"
 #include "svokit/voxelize/attributes.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
@@ -211,6 +212,17 @@ class BrickOutput {
       keys_->resize(voxels);
     }
     ForEachAttribute([&](auto& array) { array.resize(voxels); });
+    // Written once, in order, then read once by the file writer: small pages are cheaper to
+    // fault in than fresh 2 MB ones (armadillo 4096³, whole process: 1.65 → 1.52 s).
+    auto small_pages = [](const auto& array) {
+      PreferSmallPages(array.data(), array.data() + array.size());
+    };
+    ForEachAttribute(small_pages);
+    if (packed_) {
+      small_pages(packed_->key_gaps);
+    } else {
+      small_pages(*keys_);
+    }
   }
   // Serial, in key order: `slot` is where `run` goes; false when past the room (then Append it
   // after, in order).
@@ -495,25 +507,26 @@ class BrickPass {
       // A uniform triangle's samples differ only in area (most meshes: scans, CAD, STL).
       const bool uniform = p.uniform && p.axis == w;
       AttributeSampler::ColumnSampler columns(sampler_, p);
-      tv.RunsWithInterior(
+      tv.RunsAlongAxis(
           lo[u], lo[u] + 16, lo[v], lo[v] + 16,
-          [&](std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k, bool interior) {
+          [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
+              bool interior) {
             // The part of the run inside the brick.
             std::int64_t c[3] = {x, y, z};
-            const std::int64_t begin = std::max(c[w], lo[w]);
-            const std::int64_t end = std::min(c[w] + k, lo[w] + 16);
+            const std::int64_t begin = std::max(c[axis], lo[axis]);
+            const std::int64_t end = std::min(c[axis] + k, lo[axis] + 16);
             if (begin >= end) return;
-            c[w] = begin;
+            c[axis] = begin;
             const int count = static_cast<int>(end - begin);
             std::uint32_t local = VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
             if (uniform) {
               columns.Areas(c[0], c[1], c[2], count, interior, areas);
-              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, axis)) {
                 acc.Add(local, areas[s], p.color, p.unit_normal);
               }
             } else {
-              columns.Sample(c[0], c[1], c[2], w, count, interior, samples);
-              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, w)) {
+              columns.Sample(c[0], c[1], c[2], axis, count, interior, samples);
+              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, axis)) {
                 acc.Add(local, samples[s].area, samples[s].color, samples[s].normal);
               }
             }
