@@ -7,6 +7,9 @@
 
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 namespace svokit {
 namespace {
@@ -35,6 +38,42 @@ TEST(ReleasePages, ZeroesTheWholePagesInsideTheRangeOnly) {
   for (std::size_t i = 5 * page; i < kPages * page; ++i) {
     ASSERT_EQ(bytes[i], i / page == 6 ? 0 : 0xab) << "byte " << i;
   }
+  ::munmap(map, kPages * page);
+}
+
+// The VmFlags of the mapping that starts at `start` in /proc/self/smaps ("" if none does).
+std::string VmFlagsAt(const void* start) {
+  std::ifstream smaps("/proc/self/smaps");
+  std::ostringstream want;
+  want << std::hex << reinterpret_cast<std::uintptr_t>(start) << "-";
+  bool in = false;
+  for (std::string line; std::getline(smaps, line);) {
+    if (line.find('-') != std::string::npos && line.find(' ') > line.find('-') &&
+        line.find(':') > line.find(' ')) {
+      in = line.rfind(want.str(), 0) == 0;
+    } else if (in && line.rfind("VmFlags:", 0) == 0) {
+      return line;
+    }
+  }
+  return "";
+}
+
+// The whole pages inside the range get their own mapping flagged "nh" (no huge pages); partial
+// pages at its ends do not.
+TEST(PreferSmallPages, MarksTheWholePagesInsideTheRange) {
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  constexpr std::size_t kPages = 8;
+  void* map =
+      ::mmap(nullptr, kPages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(map, MAP_FAILED);
+  auto* bytes = static_cast<std::uint8_t*>(map);
+  ASSERT_EQ(VmFlagsAt(bytes).find(" nh"), std::string::npos) << VmFlagsAt(bytes);
+  PreferSmallPages(bytes + 100, bytes + 5 * page + 10);  // whole pages 1–4
+  ASSERT_FALSE(VmFlagsAt(bytes).empty());  // the range's first page is a mapping of its own
+  EXPECT_EQ(VmFlagsAt(bytes).find(" nh"), std::string::npos) << VmFlagsAt(bytes);
+  EXPECT_NE(VmFlagsAt(bytes + page).find(" nh"), std::string::npos) << VmFlagsAt(bytes + page);
+  EXPECT_EQ(VmFlagsAt(bytes + 5 * page).find(" nh"), std::string::npos)
+      << VmFlagsAt(bytes + 5 * page);
   ::munmap(map, kPages * page);
 }
 
