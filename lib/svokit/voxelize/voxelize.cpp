@@ -12,7 +12,6 @@
 #include <tbb/concurrent_queue.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_pipeline.h>
-#include <tbb/parallel_sort.h>
 
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
@@ -84,10 +83,6 @@ class MeshVoxelizer {
 struct BrickTriangle {
   std::uint64_t brick;
   std::uint32_t triangle;
-  bool operator<(const BrickTriangle& o) const {
-    return brick != o.brick ? brick < o.brick : triangle < o.triangle;
-  }
-  bool operator==(const BrickTriangle&) const = default;
 };
 
 // Appends (brick, triangle) for the 16³ bricks the triangle may have voxels in: a superset,
@@ -408,15 +403,20 @@ class BrickPass {
             bool normals)
       : voxelizer_(voxelizer), sampler_(sampler), colors_(colors), normals_(normals) {}
 
-  /// `bins`: the (brick, triangle) pairs the geometry pass recorded; `reserve`: room for the
-  /// voxels to reserve up front (more only costs a reallocation).
-  template <class Bins>
-  void Run(Bins& bins, std::size_t reserve, BrickOutput& output, Progress& progress) {
+  /// `bins`: the (brick, triangle) pairs BinToBricks listed, per chunk of triangles in index
+  /// order (each brick of a triangle once); `reserve`: room for the voxels to reserve up front
+  /// (more only costs a reallocation).
+  void Run(std::vector<std::vector<BrickTriangle>>& bins, std::size_t reserve, BrickOutput& output,
+           Progress& progress) {
     std::vector<BrickTriangle> pairs;
-    for (auto& b : bins) pairs.insert(pairs.end(), b.begin(), b.end());
-    bins.clear();
-    tbb::parallel_sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::uint64_t last_brick = 0;
+    for (auto& b : bins) {
+      pairs.insert(pairs.end(), b.begin(), b.end());
+      for (const BrickTriangle& p : b) last_brick = std::max(last_brick, p.brick);
+      std::vector<BrickTriangle>().swap(b);
+    }
+    // In triangle order already: a stable sort by brick orders them by (brick, triangle).
+    RadixSortByKey(pairs, KeyBits(last_brick), [](const BrickTriangle& p) { return p.brick; });
     std::vector<std::size_t> starts;  // first pair of each brick, and the end
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
@@ -584,11 +584,11 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
   if (options.colors || options.normals) {
     // Voxels and attributes come out of one walk per brick (BrickPass), whatever the method:
     // first the bricks each triangle may touch.
-    tbb::enumerable_thread_specific<std::vector<BrickTriangle>> bins;
+    std::vector<std::vector<BrickTriangle>> bins((n + kTrianglesPerTask - 1) / kTrianglesPerTask);
     {
       Progress::Stage stage(progress, "voxelize", n);
       ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-        std::vector<BrickTriangle>& pairs = bins.local();
+        std::vector<BrickTriangle>& pairs = bins[begin / kTrianglesPerTask];
         for (std::size_t t = begin; t < end; ++t) {
           BinToBricks(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
                       pairs);
