@@ -671,22 +671,35 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
   }
 
   // Fragment path: footprints of the large triangles cut into tiles; tiles spread over threads.
+  // Tiles are listed per chunk of large triangles in parallel, then joined in order.
   if (!large.empty()) {
-    std::vector<Tile> tiles;
-    for (std::uint32_t t : large) {
-      const TriangleVoxelizer tv = voxelizer.Triangle(t);
-      if (tv.empty()) continue;
-      for (std::int64_t v0 = tv.v_lo(); v0 < tv.v_hi(); v0 += kTileColumns) {
-        for (std::int64_t u0 = tv.u_lo(); u0 < tv.u_hi(); u0 += kTileColumns) {
-          tiles.push_back({t, static_cast<std::int32_t>(u0), static_cast<std::int32_t>(v0)});
+    std::vector<std::vector<Tile>> listed((large.size() + kTrianglesPerTask - 1) /
+                                          kTrianglesPerTask);
+    ParallelChunks(large.size(), kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+      std::vector<Tile>& part = listed[begin / kTrianglesPerTask];
+      for (std::size_t i = begin; i < end; ++i) {
+        const TriangleVoxelizer tv = voxelizer.Triangle(large[i]);
+        if (tv.empty()) continue;
+        for (std::int64_t v0 = tv.v_lo(); v0 < tv.v_hi(); v0 += kTileColumns) {
+          for (std::int64_t u0 = tv.u_lo(); u0 < tv.u_hi(); u0 += kTileColumns) {
+            part.push_back(
+                {large[i], static_cast<std::int32_t>(u0), static_cast<std::int32_t>(v0)});
+          }
         }
       }
-    }
+    });
+    std::vector<Tile> tiles;
+    for (const std::vector<Tile>& part : listed)
+      tiles.insert(tiles.end(), part.begin(), part.end());
     ParallelChunks(tiles.size(), kTilesPerTask, [&](std::size_t begin, std::size_t end) {
+      // A large triangle's tiles are neighbours in the list: its set-up serves them all.
+      std::optional<TriangleVoxelizer> tv;
       for (std::size_t i = begin; i < end; ++i) {
         const Tile& tile = tiles[i];
-        const TriangleVoxelizer tv = voxelizer.Triangle(tile.triangle);
-        walk(tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
+        if (i == begin || tile.triangle != tiles[i - 1].triangle) {
+          tv.emplace(voxelizer.Triangle(tile.triangle));
+        }
+        walk(*tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
       }
     });
     stage->Advance(large.size());
