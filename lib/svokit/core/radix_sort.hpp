@@ -3,6 +3,7 @@
 // keys use: linear in the count, where comparison sorts pay log n comparisons an item (tens of
 // thousands of triangles ordered by Morton brick: 0.3 ms instead of 3).
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstddef>
@@ -12,10 +13,12 @@
 
 namespace svokit {
 
-/// Sorts `items` by key(item) (a std::uint64_t below 2^key_bits), keeping the order of equal keys.
+/// Sorts `items` by key(item) (a std::uint64_t below 2^key_bits: only the bytes that spans are
+/// sorted on), keeping the order of equal keys.
 template <class T, class Key>
 void RadixSortByKey(std::vector<T>& items, int key_bits, const Key& key) {
   if (items.size() < 2 || key_bits <= 0) return;
+  key_bits = std::min(key_bits, 64);
   std::vector<T> scratch(items.size());
   for (int shift = 0; shift < key_bits; shift += 8) {
     std::array<std::size_t, 256> start{};

@@ -23,12 +23,13 @@ inline void ReleasePages(const void* begin, const void* end) {
 
 /// Asks for small pages over the whole pages inside [begin, end), not yet touched: on VMs a fresh
 /// 2 MB page is usually one the host has never backed, while small pages come from the ones just
-/// freed.
-inline void PreferSmallPages(const void* begin, const void* end) {
+/// freed. For memory of its own mapping only (the advice stays with the pages). Returns whether
+/// the kernel took it (not without transparent huge pages).
+inline bool PreferSmallPages(const void* begin, const void* end) {
   static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
   const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page;
   const std::uintptr_t hi = reinterpret_cast<std::uintptr_t>(end) / page * page;
-  if (lo < hi) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_NOHUGEPAGE);
+  return lo < hi && ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_NOHUGEPAGE) == 0;
 }
 
 }  // namespace svokit

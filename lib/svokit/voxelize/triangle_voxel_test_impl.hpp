@@ -102,7 +102,7 @@ void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::
   const Frame f = MakeFrame();
   u0 = std::max(u0, lo_[U]), u1 = std::min(u1, hi_[U]);
   v0 = std::max(v0, lo_[V]), v1 = std::min(v1, hi_[V]);
-  if (u0 >= u1) return;
+  if (u0 >= u1 || v0 >= v1) return;
   const std::int64_t lu0 = u0 - f.origin[U], lu1 = u1 - f.origin[U];
   const Depth<Int> depth = setup.depth;
   FloorCursor<Int> row = StartDepth(depth, lu0, v0 - f.origin[V]);

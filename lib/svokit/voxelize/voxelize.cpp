@@ -208,9 +208,13 @@ class BrickOutput {
     }
     ForEachAttribute([&](auto& array) { array.resize(voxels); });
     // Written once, in order, then read once by the file writer: small pages are cheaper to
-    // fault in than fresh 2 MB ones (armadillo 4096³, whole process: 1.65 → 1.52 s).
+    // fault in than fresh 2 MB ones (armadillo 4096³, whole process: 1.65 → 1.52 s). Only arrays
+    // big enough for malloc to map them on their own (≥ 32 MiB, its largest threshold) are
+    // advised: heap pages would keep the advice for whatever reuses them.
     auto small_pages = [](const auto& array) {
-      PreferSmallPages(array.data(), array.data() + array.size());
+      if (array.size() * sizeof(array[0]) >= (std::size_t{32} << 20)) {
+        PreferSmallPages(array.data(), array.data() + array.size());
+      }
     };
     ForEachAttribute(small_pages);
     if (packed_) {
