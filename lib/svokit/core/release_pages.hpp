@@ -8,16 +8,26 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <utility>
 
 namespace svokit {
+
+namespace release_pages_detail {
+
+// The whole pages inside [begin, end), as [lo, hi) (empty when lo >= hi).
+inline std::pair<std::uintptr_t, std::uintptr_t> WholePages(const void* begin, const void* end) {
+  static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  return {(reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page,
+          reinterpret_cast<std::uintptr_t>(end) / page * page};
+}
+
+}  // namespace release_pages_detail
 
 /// Returns the whole pages inside [begin, end) to the kernel (their contents read as zero
 /// afterwards): for memory that is no longer read. Partial pages at either end are kept, so the
 /// allocator's own bookkeeping next to the range is never touched.
 inline void ReleasePages(const void* begin, const void* end) {
-  static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page;
-  const std::uintptr_t hi = reinterpret_cast<std::uintptr_t>(end) / page * page;
+  const auto [lo, hi] = release_pages_detail::WholePages(begin, end);
   if (lo < hi) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
 }
 
@@ -26,9 +36,7 @@ inline void ReleasePages(const void* begin, const void* end) {
 /// freed. For memory of its own mapping only (the advice stays with the pages). Returns whether
 /// the kernel took it (not without transparent huge pages).
 inline bool PreferSmallPages(const void* begin, const void* end) {
-  static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page;
-  const std::uintptr_t hi = reinterpret_cast<std::uintptr_t>(end) / page * page;
+  const auto [lo, hi] = release_pages_detail::WholePages(begin, end);
   return lo < hi && ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_NOHUGEPAGE) == 0;
 }
 
