@@ -44,6 +44,41 @@ TEST(AtomicFileWriter, AbandonedRewriteKeepsOldFile) {
   EXPECT_EQ(test::ReadText(target), "old");
 }
 
+// Commit swaps the new file with an existing one and removes the old: only the new content
+// remains, under the target's name, with no hidden leftovers; a reader holding the old file open
+// keeps reading the old content.
+TEST(AtomicFileWriter, CommitReplacesExistingFile) {
+  TempDir dir;
+  const auto target = dir.Write("out.bin", std::string("old content"));
+  std::FILE* reader = std::fopen(target.c_str(), "rb");
+  ASSERT_NE(reader, nullptr);
+  AtomicFileWriter w(target);
+  ASSERT_TRUE(w.Open().ok());
+  ASSERT_TRUE(w.Write("new", 3).ok());
+  ASSERT_TRUE(w.Commit().ok());
+  EXPECT_EQ(test::ReadText(target), "new");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.bin"});
+  char old[12] = {};
+  EXPECT_EQ(std::fread(old, 1, 11, reader), 11u);
+  EXPECT_STREQ(old, "old content");
+  std::fclose(reader);
+}
+
+// A directory in the target's place is an error, and stays as it was (a swap would have moved it).
+TEST(AtomicFileWriter, CommitOntoDirectoryFailsAndKeepsIt) {
+  TempDir dir;
+  const auto target = dir / "out.bin";
+  std::filesystem::create_directory(target);
+  dir.Write("out.bin/inside", std::string("x"));
+  AtomicFileWriter w(target);
+  ASSERT_TRUE(w.Open().ok());
+  ASSERT_TRUE(w.Write("new", 3).ok());
+  EXPECT_FALSE(w.Commit().ok());
+  EXPECT_TRUE(std::filesystem::is_directory(target));
+  EXPECT_EQ(test::ReadText(target / "inside"), "x");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.bin"});
+}
+
 TEST(AtomicFileWriter, MissingDirectoryIsBadInput) {
   TempDir dir;
   AtomicFileWriter w(dir / "no" / "such" / "out.bin");

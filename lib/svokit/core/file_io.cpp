@@ -1,10 +1,12 @@
 #include "svokit/core/file_io.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 namespace svokit {
@@ -117,6 +119,21 @@ Status AtomicFileWriter::WriteAt(std::uint64_t offset, std::span<const std::uint
   return Status::Ok();
 }
 
+// An existing target is swapped with the temporary (one atomic step, as a rename over it) and
+// then unlinked: ext4 starts writing back a file renamed over another one (auto_da_alloc) inside
+// the rename, ~0.1 s for 300 MB here; the swap does not. Plain rename where there is no target
+// or the file system cannot swap, and for a directory (which a swap would move).
+bool AtomicFileWriter::ReplaceWithTemporary() const {
+  struct stat target {};
+  const bool swappable = ::lstat(path_.c_str(), &target) == 0 && !S_ISDIR(target.st_mode);
+  if (swappable &&
+      ::renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, path_.c_str(), RENAME_EXCHANGE) == 0) {
+    ::unlink(temp_path_.c_str());  // the previous file's data, now under the temporary's name
+    return true;
+  }
+  return std::rename(temp_path_.c_str(), path_.c_str()) == 0;
+}
+
 Status AtomicFileWriter::Commit() {
   if (!file_) return Status::Internal("{}: commit of a writer that is not open", path_.string());
   const bool flushed = std::fflush(file_) == 0;
@@ -127,7 +144,7 @@ Status AtomicFileWriter::Commit() {
     Discard();
     return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
   }
-  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+  if (!ReplaceWithTemporary()) {
     const int err = errno;
     Discard();
     return Status::Internal("{}: cannot rename into place ({})", path_.string(),

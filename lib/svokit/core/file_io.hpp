@@ -44,6 +44,7 @@ class AtomicFileWriter {
 
  private:
   void Discard();
+  bool ReplaceWithTemporary() const;
 
   std::filesystem::path path_;
   std::string temp_path_;
