@@ -78,6 +78,11 @@ inline std::string ReadText(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+inline std::vector<std::uint8_t> ReadBytes(const std::filesystem::path& p) {
+  const std::string text = ReadText(p);
+  return {text.begin(), text.end()};
+}
+
 /// True when missing test data must fail rather than skip (scripts/test sets it, so CI never
 /// passes by skipping).
 inline bool TestDataRequired() {

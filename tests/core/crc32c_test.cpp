@@ -36,6 +36,30 @@ TEST(Crc32c, ChainingEqualsOneShotAtEveryAlignment) {
   }
 }
 
+// Joining two pieces' checksums equals checksumming the whole, for every split (empty pieces
+// included) and for pieces longer than any table of shifts the combination might use.
+TEST(Crc32c, CombineEqualsOneShot) {
+  std::mt19937 rng(7);
+  std::vector<std::uint8_t> data(3000);
+  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
+  const std::uint32_t whole = Crc32c(data.data(), data.size());
+  for (std::size_t split = 0; split <= data.size(); split += 13) {
+    const std::uint32_t a = Crc32c(data.data(), split);
+    const std::uint32_t b = Crc32c(data.data() + split, data.size() - split);
+    EXPECT_EQ(Crc32cCombine(a, b, data.size() - split), whole) << split;
+  }
+  std::vector<std::uint8_t> big((std::size_t{9} << 20) + 12345);  // > two 4 MB pieces
+  for (auto& b : big) b = static_cast<std::uint8_t>(rng());
+  const std::uint32_t big_crc = Crc32c(big.data(), big.size());
+  EXPECT_EQ(Crc32cParallel(big.data(), big.size()), big_crc);
+  const std::size_t split = 5'000'001;
+  EXPECT_EQ(Crc32cCombine(Crc32c(big.data(), split), Crc32c(big.data() + split, big.size() - split),
+                          big.size() - split),
+            big_crc);
+  EXPECT_EQ(Crc32cParallel(big.data(), 0), 0u);
+  EXPECT_EQ(Crc32cParallel(big.data(), 100), Crc32c(big.data(), 100));
+}
+
 TEST(Crc32c, DetectsEverySingleBitFlip) {
   std::vector<std::uint8_t> data(256);
   for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<std::uint8_t>(i * 7);

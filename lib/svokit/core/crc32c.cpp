@@ -1,7 +1,11 @@
 #include "svokit/core/crc32c.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
+#include <vector>
+
+#include "svokit/core/parallel.hpp"
 
 #if defined(__x86_64__)
 #include <nmmintrin.h>
@@ -73,6 +77,58 @@ std::uint32_t Crc32c(const void* data, std::size_t size, std::uint32_t crc) {
   crc = Crc32cPortable(p, size, crc);
 #endif
   return ~crc;
+}
+
+namespace {
+
+// Polynomials mod P in the reflected representation (bit 31 is x^0). a·b mod P.
+std::uint32_t MultiplyModP(std::uint32_t a, std::uint32_t b) {
+  std::uint32_t product = 0;
+  for (std::uint32_t bit = 1u << 31; bit != 0; bit >>= 1) {
+    if (a & bit) product ^= b;
+    b = (b & 1) ? (b >> 1) ^ kPoly : b >> 1;  // b·x
+  }
+  return product;
+}
+
+// x^(8·bytes) mod P, by squaring: kPowers[k] = x^(2^k) mod P.
+std::uint32_t ShiftByBytes(std::uint64_t bytes) {
+  static const auto kPowers = [] {
+    std::array<std::uint32_t, 67> p{};
+    p[0] = 1u << 30;  // x^1
+    for (std::size_t k = 1; k < p.size(); ++k) p[k] = MultiplyModP(p[k - 1], p[k - 1]);
+    return p;
+  }();
+  std::uint32_t result = 1u << 31;  // x^0
+  for (std::size_t k = 3; bytes != 0; bytes >>= 1, ++k) {
+    if (bytes & 1) result = MultiplyModP(kPowers[k], result);
+  }
+  return result;
+}
+
+}  // namespace
+
+std::uint32_t Crc32cCombine(std::uint32_t crc_a, std::uint32_t crc_b, std::uint64_t size_b) {
+  // The register after A, run through size_b zero bytes, XOR B's own: the pre- and
+  // post-inversions cancel (as in zlib's crc32_combine).
+  return MultiplyModP(ShiftByBytes(size_b), crc_a) ^ crc_b;
+}
+
+std::uint32_t Crc32cParallel(const void* data, std::size_t size) {
+  constexpr std::size_t kPiece = std::size_t{4} << 20;
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  const std::size_t pieces = (size + kPiece - 1) / kPiece;
+  std::vector<std::uint32_t> crcs(pieces);
+  ParallelChunks(pieces, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      crcs[i] = Crc32c(bytes + i * kPiece, std::min(kPiece, size - i * kPiece));
+    }
+  });
+  std::uint32_t crc = 0;
+  for (std::size_t i = 0; i < pieces; ++i) {
+    crc = Crc32cCombine(crc, crcs[i], std::min(kPiece, size - i * kPiece));
+  }
+  return crc;
 }
 
 }  // namespace svokit

@@ -41,6 +41,9 @@ class AtomicFileWriter {
   /// The temporary's path, for libraries that write files by name (OpenVDB): they fill it,
   /// Commit() renames it into place.
   const std::string& temp_path() const { return temp_path_; }
+  /// The temporary's descriptor, for writes that bypass Write() (a memory mapping of the file,
+  /// container::MappedWriter); -1 unless open.
+  int descriptor() const { return file_ ? ::fileno(file_) : -1; }
 
  private:
   void Discard();
