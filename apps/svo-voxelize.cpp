@@ -55,12 +55,15 @@ int main(int argc, char** argv) {
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
     if (ext == "vfrag") {
-      // From keys packed as they are found: 7 bytes a voxel less fresh memory. Methods and thread
-      // counts give the same file, byte for byte: they are not recorded.
-      StatusOr<PackedVoxelSet> voxels = VoxelizePacked(*mesh, *grid, voxelize.options, progress);
+      // Keys packed as they are found, everything written in place into the file's mapped
+      // sections. Methods and thread counts give the same file, byte for byte: they are not
+      // recorded.
+      VfragFileWriter file(output, meta);
+      StatusOr<PackedVoxelization> voxels =
+          VoxelizePacked(*mesh, *grid, voxelize.options, file, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
-      written = write_stage(*voxels, voxels->size(),
-                            [&] { return WriteVfrag(std::move(*voxels), meta, output); });
+      written =
+          write_stage(voxels->attributes, voxels->count, [&] { return file.Commit(*voxels); });
     } else {
       StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.options, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));

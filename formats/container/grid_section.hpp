@@ -13,6 +13,8 @@
 
 namespace svokit {
 
+inline constexpr std::size_t kGridSectionSize = 48;
+
 inline std::vector<std::uint8_t> EncodeGridSection(const GridTransform& grid, VoxelMode mode) {
   ByteWriter w;
   w.Put(grid.origin());

@@ -253,11 +253,10 @@ container::Writer::Producer KeysProducer(std::span<const std::uint64_t> keys, bo
 container::Writer::Producer BytesProducer(std::span<const std::uint8_t> bytes,
                                           std::span<const std::uint8_t> all, bool release);
 
-// A per-voxel array's section: the array, or its one value when every voxel has the same (an
-// untextured mesh without vertex colours: one colour for millions of voxels). `release`: the
-// array's pages are given back as they are written.
-template <class T, class A>
-container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bool release) {
+// How many bytes of a per-voxel array its section stores: its one value when every voxel has the
+// same (an untextured mesh without vertex colours: one colour for millions of voxels), else all.
+template <class T>
+std::size_t StoredBytes(std::span<const T> values) {
   std::atomic<bool> uniform = values.size() > 1;
   ParallelChunks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
     if (uniform.load(std::memory_order_relaxed) &&
@@ -266,8 +265,15 @@ container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bo
       uniform.store(false, std::memory_order_relaxed);
     }
   });
+  return uniform ? sizeof(T) : values.size_bytes();
+}
+
+// A per-voxel array's section (StoredBytes() of it). `release`: the array's pages are given back
+// as they are written.
+template <class T, class A>
+container::Writer::Producer PerVoxelProducer(const std::vector<T, A>& values, bool release) {
   const std::span<const std::uint8_t> all = Bytes(values);
-  return BytesProducer(uniform ? all.first(sizeof(T)) : all, all, release);
+  return BytesProducer(all.first(StoredBytes(std::span<const T>(values))), all, release);
 }
 
 // `bytes` in pieces of a few MB; `release`: `all`'s pages are given back as they are written.
@@ -297,6 +303,13 @@ container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set, bool r
   };
 }
 
+std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
+  const nlohmann::json j = {
+      {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
+  const std::string text = j.dump();
+  return {text.begin(), text.end()};
+}
+
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 // `release`: each array's pages are given back once written (the set is consumed).
 container::Writer MakeWriter(const VoxelAttributes& set, container::Writer::Producer keys,
@@ -309,10 +322,7 @@ container::Writer MakeWriter(const VoxelAttributes& set, container::Writer::Prod
   if (!set.coverage.empty()) {
     file.AddSectionProduced(kCoverage, PerVoxelProducer(set.coverage, release));
   }
-  const nlohmann::json j = {
-      {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
-  const std::string text = j.dump();
-  file.AddSection(kMetadata, std::vector<std::uint8_t>(text.begin(), text.end()));
+  file.AddSection(kMetadata, MetadataSection(meta));
   return file;
 }
 
@@ -342,6 +352,95 @@ Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
   const Status status = MakeWriter(set, PackedKeysProducer(set, true), meta, true).WriteFile(path);
   set = PackedVoxelSet{};  // its pages are gone
   return status;
+}
+
+VfragFileWriter::VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta)
+    : path_(std::move(path)),
+      metadata_(MetadataSection(meta)),
+      grid_(kGridSectionSize, 0),          // its value comes with Commit()
+      shared_color_(sizeof(HalfRgba), 0),  // likewise
+      file_(kVfragFormat, 0) {}
+
+std::vector<container::MappedWriter::Section> VfragFileWriter::Sections(
+    const PackedVoxelContents& contents, std::uint64_t voxels, std::uint64_t key_bytes) const {
+  std::vector<container::MappedWriter::Section> sections = {{kGrid, grid_}};
+  int region = 0;
+  sections.push_back({kKeys, {}, region++, sizeof(std::uint64_t) + key_bytes});
+  if (contents.colors) {
+    sections.push_back({kColors, {}, region++, voxels * sizeof(HalfRgba)});
+  } else if (contents.shared_color) {
+    sections.push_back({kColors, shared_color_});
+  }
+  if (contents.normals) sections.push_back({kNormals, {}, region++, voxels * sizeof(OctNormal)});
+  if (contents.coverage) sections.push_back({kCoverage, {}, region++, voxels * sizeof(Half)});
+  sections.push_back({kMetadata, metadata_});
+  return sections;
+}
+
+StatusOr<PackedVoxelArrays> VfragFileWriter::Reserve(const PackedVoxelContents& contents,
+                                                     std::size_t voxels, std::size_t key_bytes) {
+  std::vector<container::MappedWriter::Section> plan = Sections(contents, voxels, key_bytes);
+  if (!open_) {
+    SVOKIT_RETURN_IF_ERROR(file_.Open(path_, plan));
+    open_ = true;
+    contents_ = contents;
+  } else {
+    std::vector<std::uint64_t> rooms;
+    for (const auto& s : plan) {
+      if (s.region >= 0) rooms.push_back(s.size);
+    }
+    SVOKIT_RETURN_IF_ERROR(file_.Resize(rooms));
+  }
+  // Regions in section order: keys (after their count), then the per-voxel arrays.
+  PackedVoxelArrays arrays;
+  std::size_t region = 0;
+  arrays.key_gaps = file_.region(region++).subspan(sizeof(std::uint64_t), key_bytes);
+  auto array = [&](auto& out, bool present) {
+    if (!present) return;
+    using T = typename std::remove_reference_t<decltype(out)>::element_type;
+    static_assert(alignof(T) <= container::kAlignment);
+    out = {reinterpret_cast<T*>(file_.region(region++).data()), voxels};
+  };
+  array(arrays.colors, contents.colors);
+  array(arrays.normals, contents.normals);
+  array(arrays.coverage, contents.coverage);
+  return arrays;
+}
+
+Status VfragFileWriter::Commit(const PackedVoxelization& voxels) {
+  const VoxelAttributes& a = voxels.attributes;
+  const PackedVoxelContents& c = voxels.contents;
+  if (!open_ || c.colors != contents_.colors || c.normals != contents_.normals ||
+      c.coverage != contents_.coverage || c.shared_color != contents_.shared_color ||
+      c.shared_color != (a.colors.size() == 1)) {
+    return Status::Internal("{}: the voxels committed are not those the file was laid out for",
+                            path_.string());
+  }
+  grid_ = EncodeGridSection(a.grid, a.mode);
+  if (grid_.size() != kGridSectionSize)
+    return Status::Internal("GRID section of {} bytes", grid_.size());
+  if (c.shared_color) {
+    const HalfRgba color = a.colors[0];
+    std::memcpy(shared_color_.data(), &color, sizeof(color));
+  }
+  std::vector<container::MappedWriter::Section> sections =
+      Sections(c, voxels.count, voxels.key_bytes);
+  // The key count before the gaps; an attribute every voxel has is stored once (as WriteVfrag).
+  std::size_t region = 0;
+  std::memcpy(file_.region(region++).data(), &voxels.count, sizeof(voxels.count));
+  for (auto& s : sections) {
+    if (s.region <= 0) continue;
+    const std::uint8_t* data = file_.region(static_cast<std::size_t>(s.region)).data();
+    if (s.tag == kColors) {
+      s.size = StoredBytes(std::span(reinterpret_cast<const HalfRgba*>(data), voxels.count));
+    } else if (s.tag == kNormals) {
+      s.size = StoredBytes(std::span(reinterpret_cast<const OctNormal*>(data), voxels.count));
+    } else if (s.tag == kCoverage) {
+      s.size = StoredBytes(std::span(reinterpret_cast<const Half*>(data), voxels.count));
+    }
+  }
+  open_ = false;
+  return file_.Commit(std::move(sections));
 }
 
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,

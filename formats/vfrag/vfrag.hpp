@@ -33,6 +33,32 @@ Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesyst
 std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta);
 Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
                   const std::filesystem::path& path);
+/// A .vfrag file that VoxelizePacked() writes into directly: its KEYS, COLR, NORM and COVR
+/// sections are regions of a temporary beside `path`, mapped (container::MappedWriter), which the
+/// voxelizer's threads fill in place; Commit() completes the file and renames it into place.
+/// The same bytes as WriteVfrag() of the same voxels, without their copy into the file (a 4096³
+/// armadillo with attributes: 290 MB). Destroyed uncommitted, it leaves nothing behind.
+class VfragFileWriter final : public PackedVoxelStorage {
+ public:
+  VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta);
+  StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
+                                      std::size_t key_bytes) override;
+  /// `voxels`: what VoxelizePacked() returned for this storage.
+  Status Commit(const PackedVoxelization& voxels);
+
+ private:
+  // The file's sections for these contents and sizes (regions: their rooms, or used sizes).
+  std::vector<container::MappedWriter::Section> Sections(const PackedVoxelContents& contents,
+                                                         std::uint64_t voxels,
+                                                         std::uint64_t key_bytes) const;
+
+  std::filesystem::path path_;
+  std::vector<std::uint8_t> metadata_, grid_, shared_color_;
+  container::MappedWriter file_;
+  bool open_ = false;
+  PackedVoxelContents contents_;
+};
+
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
                                VfragMetadata* meta = nullptr);

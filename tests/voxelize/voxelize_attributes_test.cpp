@@ -326,3 +326,73 @@ TEST(VoxelizeAttributes, OneColourEverywhereIsHeldOnce) {
 
 }  // namespace
 }  // namespace svokit
+
+namespace svokit {
+namespace {
+
+// VoxelizePacked() straight into a .vfrag file (VfragFileWriter: the voxelizer fills the mapped
+// sections) gives WriteVfrag()'s bytes: per-voxel colours (the textured torus), a shared colour
+// (the sphere), geometry only, each attribute alone, thin mode, two thread counts, and more
+// voxels than the room planned (the 45° square: its regions grow and move, and its normals,
+// all equal, are stored once). A file that is not committed leaves nothing behind.
+TEST(VfragFileWriter, WritesTheBytesOfWriteVfrag) {
+  auto torus = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(torus.ok());
+  const Mesh sphere = test::Icosphere(3, false);
+  Mesh square;
+  square.positions = {{0, 0, 0}, {60, 0, 60}, {60, 60, 60}, {0, 60, 0}};
+  square.triangles = {{0, 1, 2}, {0, 2, 3}};
+  struct Case {
+    const Mesh* mesh;
+    std::uint32_t resolution;
+    bool colors, normals;
+    VoxelMode mode;
+  };
+  const Case cases[] = {{&*torus, 120, true, true, VoxelMode::kConservative},
+                        {&*torus, 120, true, false, VoxelMode::kThin},
+                        {&*torus, 120, false, true, VoxelMode::kConservative},
+                        {&*torus, 120, false, false, VoxelMode::kConservative},
+                        {&sphere, 100, true, true, VoxelMode::kConservative},
+                        {&square, 61, true, true, VoxelMode::kConservative},
+                        {&square, 61, false, false, VoxelMode::kConservative}};
+  const VfragMetadata meta{"mesh.obj", "--resolution N"};
+  for (const Case& c : cases) {
+    auto grid = GridTransform::FitResolution(c.mesh->Bounds(), c.resolution);
+    ASSERT_TRUE(grid.ok());
+    VoxelizeOptions options;
+    options.colors = c.colors;
+    options.normals = c.normals;
+    options.mode = c.mode;
+    auto reference = VoxelizePacked(*c.mesh, *grid, options);
+    ASSERT_TRUE(reference.ok());
+    const std::vector<std::uint8_t> expected = EncodeVfrag(*reference, meta);
+    for (std::size_t threads : {1u, 2u}) {
+      ThreadLimit limit(threads);
+      test::TempDir dir;
+      const auto path = dir / "out.vfrag";
+      VfragFileWriter file(path, meta);
+      auto voxels = VoxelizePacked(*c.mesh, *grid, options, file);
+      ASSERT_TRUE(voxels.ok());
+      EXPECT_EQ(voxels->count, reference->count);
+      ASSERT_EQ(dir.Files().size(), 1u);  // a hidden temporary only, until the commit
+      EXPECT_EQ(dir.Files()[0].rfind(".out.vfrag.tmp", 0), 0u);
+      ASSERT_TRUE(file.Commit(*voxels).ok());
+      EXPECT_TRUE(test::ReadBytes(path) == expected)
+          << c.resolution << " colours " << c.colors << " normals " << c.normals << " threads "
+          << threads;
+      EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.vfrag"});
+    }
+  }
+  test::TempDir dir;
+  {
+    VfragFileWriter file(dir / "abandoned.vfrag", meta);
+    auto grid = GridTransform::FitResolution(sphere.Bounds(), 50);
+    VoxelizeOptions options;
+    options.colors = options.normals = true;
+    ASSERT_TRUE(VoxelizePacked(sphere, *grid, options, file).ok());
+  }
+  EXPECT_TRUE(dir.Files().empty());
+}
+
+}  // namespace
+}  // namespace svokit

@@ -77,10 +77,11 @@ class VoxelBitSet {
   /// The union of `sets` as sorted unique Morton keys (thread-count independent).
   template <class Sets>
   static DefaultInitVector<std::uint64_t> UnionKeys(const Sets& sets);
-  /// The same keys packed as varint gaps (core/key_gaps.hpp), with their count.
-  template <class Sets>
-  static void UnionPacked(const Sets& sets, std::uint64_t& count,
-                          DefaultInitVector<std::uint8_t>& gaps);
+  /// The same keys packed as varint gaps (core/key_gaps.hpp) into allocate(bytes), which is
+  /// called once with their size and returns where to write them (null: nothing is written).
+  /// Returns the key count.
+  template <class Sets, class Allocate>
+  static std::uint64_t UnionPacked(const Sets& sets, const Allocate& allocate);
 
  private:
   // The bits of brick (bx, by, bz), created empty on first use.
@@ -193,9 +194,8 @@ DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
 // As UnionKeys(), the keys packed (key_gaps.hpp): a brick's gaps after its first voxel are
 // counted and written in parallel; its first voxel's gap, from the previous brick's last voxel,
 // is placed in order between the two passes.
-template <class Sets>
-void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
-                              DefaultInitVector<std::uint8_t>& gaps) {
+template <class Sets, class Allocate>
+std::uint64_t VoxelBitSet::UnionPacked(const Sets& sets, const Allocate& allocate) {
   const MergedBricks merged(sets);
   const std::size_t bricks = merged.size();
   struct Span {
@@ -225,7 +225,7 @@ void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
   std::vector<std::uint64_t> offset(bricks + 1, 0);
   std::vector<std::uint64_t> previous(bricks);  // the key before each brick's first
   std::uint64_t last = kNoPreviousKey;
-  count = 0;
+  std::uint64_t count = 0;
   for (std::size_t b = 0; b < bricks; ++b) {
     std::uint8_t head[kMaxVarintBytes];
     const std::uint64_t first = merged.key(b) << kBrickBits | spans[b].first;
@@ -234,9 +234,10 @@ void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
     last = merged.key(b) << kBrickBits | spans[b].last;
     count += spans[b].voxels;
   }
-  gaps.resize(offset[bricks]);  // first touched by the writes below
+  std::uint8_t* gaps = allocate(offset[bricks]);  // first touched by the writes below
+  if (gaps == nullptr) return count;
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    std::uint8_t* out = gaps.data() + offset[b];
+    std::uint8_t* out = gaps + offset[b];
     const std::uint64_t base = merged.key(b) << kBrickBits;
     std::uint64_t prev = previous[b];
     const Brick m = merged.Merge(b);
@@ -254,6 +255,7 @@ void VoxelBitSet::UnionPacked(const Sets& sets, std::uint64_t& count,
       prev = key;
     }
   });
+  return count;
 }
 
 }  // namespace svokit

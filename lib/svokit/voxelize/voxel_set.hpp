@@ -3,6 +3,7 @@
 // grid that maps them back to world space (and, when requested, per-voxel attributes).
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "svokit/core/half.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/octahedral.hpp"
+#include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
 
 namespace svokit {
@@ -62,6 +64,44 @@ struct PackedVoxelSet : VoxelAttributes {
   DefaultInitVector<std::uint8_t> key_gaps;
 
   std::size_t size() const { return static_cast<std::size_t>(count); }
+};
+
+/// Which per-voxel arrays a packed voxelization fills, and whether it has a colour every voxel
+/// shares instead (held once, in VoxelAttributes::colors).
+struct PackedVoxelContents {
+  bool colors = false, normals = false, coverage = false;
+  bool shared_color = false;
+};
+
+/// A packed voxelization's arrays (PackedVoxelSet's), in memory its caller provides.
+struct PackedVoxelArrays {
+  std::span<std::uint8_t> key_gaps;
+  std::span<HalfRgba> colors;  ///< empty unless PackedVoxelContents::colors
+  std::span<OctNormal> normals;
+  std::span<Half> coverage;
+};
+
+/// Memory for VoxelizePacked()'s arrays that its caller provides: svo-voxelize gives it a .vfrag
+/// file's sections, mapped (VfragFileWriter), so every byte is written once, where the file
+/// keeps it, instead of into fresh memory and then into the file.
+class PackedVoxelStorage {
+ public:
+  virtual ~PackedVoxelStorage() = default;
+  /// Arrays with room for `voxels` entries (each array `contents` asks for) and `key_bytes`
+  /// bytes of keys, holding what the previous ones held (up to the smaller room). They may move:
+  /// not called while the arrays are being written.
+  virtual StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents,
+                                              std::size_t voxels, std::size_t key_bytes) = 0;
+};
+
+/// What a voxelization into a PackedVoxelStorage returns besides the arrays: grid, mode,
+/// warnings and a shared colour (`attributes`, whose arrays are otherwise empty), and how much
+/// of each array holds voxels.
+struct PackedVoxelization {
+  VoxelAttributes attributes;
+  PackedVoxelContents contents;
+  std::uint64_t count = 0;
+  std::size_t key_bytes = 0;
 };
 
 }  // namespace svokit

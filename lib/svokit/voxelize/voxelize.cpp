@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -179,17 +180,25 @@ struct VoxelRun {
   void clear() { keys.clear(), gaps.clear(), colors.clear(), normals.clear(), coverage.clear(); }
 };
 
-// Where the brick pass puts its runs: a VoxelSet's arrays, or a PackedVoxelSet's (keys as varint
-// gaps). Arrays are sized for an estimate without a write; runs are placed in key order (serial)
-// and copied in parallel, so both threads first-touch the fresh pages; runs past the room are
-// appended after, in order.
+// What the brick pass fills: 64-bit keys (a VoxelSet) or their varint gaps (packed), and the
+// per-voxel attributes asked for.
+struct OutputArrays {
+  std::span<std::uint64_t> keys;
+  std::span<std::uint8_t> gaps;
+  std::span<HalfRgba> colors;
+  std::span<OctNormal> normals;
+  std::span<Half> coverage;
+};
+// Arrays with room for (voxels, key bytes), keeping what the previous ones held.
+using ReserveOutput = std::function<StatusOr<OutputArrays>(std::size_t, std::size_t)>;
+
+// Where the brick pass puts its runs: arrays sized for an estimate up front, without a write;
+// runs are placed in key order (serial) and copied in parallel, so both threads first-touch the
+// fresh pages; runs past the room are appended after, in order, once the room is grown.
 class BrickOutput {
  public:
-  // `colors`, `normals`: the per-voxel arrays to fill (a colour held once is not).
-  BrickOutput(VoxelAttributes& attributes, DefaultInitVector<std::uint64_t>* keys,
-              PackedVoxelSet* packed, bool colors, bool normals)
-      : attributes_(attributes), keys_(keys), packed_(packed), colors_(colors), normals_(normals) {}
-  bool packed() const { return packed_ != nullptr; }
+  BrickOutput(ReserveOutput reserve, bool packed) : reserve_(std::move(reserve)), packed_(packed) {}
+  bool packed() const { return packed_; }
 
   struct Slot {
     std::size_t voxel = 0, byte = 0;
@@ -197,31 +206,14 @@ class BrickOutput {
     std::uint8_t head_size = 0;
   };
 
-  void Reserve(std::size_t voxels, std::size_t bricks) {
+  Status Reserve(std::size_t voxels, std::size_t bricks) {
     room_voxels_ = voxels;
-    if (packed_) {
-      // Gaps inside a brick take a byte; a brick's first key's may take up to ten.
-      room_bytes_ = voxels + kMaxVarintBytes * bricks;
-      packed_->key_gaps.resize(room_bytes_);
-    } else {
-      keys_->resize(voxels);
-    }
-    ForEachAttribute([&](auto& array) { array.resize(voxels); });
-    // Written once, in order, then read once by the file writer: small pages are cheaper to
-    // fault in than fresh 2 MB ones (armadillo 4096³, whole process: 1.65 → 1.52 s). Only arrays
-    // big enough for malloc to map them on their own (≥ 32 MiB, its largest threshold) are
-    // advised: heap pages would keep the advice for whatever reuses them.
-    auto small_pages = [](const auto& array) {
-      if (array.size() * sizeof(array[0]) >= (std::size_t{32} << 20)) {
-        PreferSmallPages(array.data(), array.data() + array.size());
-      }
-    };
-    ForEachAttribute(small_pages);
-    if (packed_) {
-      small_pages(packed_->key_gaps);
-    } else {
-      small_pages(*keys_);
-    }
+    // Gaps inside a brick take a byte; a brick's first key's may take up to ten.
+    room_bytes_ = packed_ ? voxels + kMaxVarintBytes * bricks : 0;
+    StatusOr<OutputArrays> arrays = reserve_(room_voxels_, room_bytes_);
+    if (!arrays.ok()) return arrays.status();
+    arrays_ = *arrays;
+    return Status::Ok();
   }
   // Serial, in key order: `slot` is where `run` goes; false when past the room (then Append it
   // after, in order).
@@ -245,70 +237,61 @@ class BrickOutput {
   }
   // Parallel.
   void Copy(const VoxelRun& run, const Slot& slot) {
-    const std::size_t n = run.keys.size();
-    if (n == 0) return;
+    if (run.keys.empty()) return;
     if (packed_) {
-      std::uint8_t* out = packed_->key_gaps.data() + slot.byte;
+      std::uint8_t* out = arrays_.gaps.data() + slot.byte;
       std::memcpy(out, slot.head, slot.head_size);
       std::memcpy(out + slot.head_size, run.gaps.data(), run.gaps.size());
     } else {
-      std::copy(run.keys.begin(), run.keys.end(), keys_->begin() + slot.voxel);
+      std::copy(run.keys.begin(), run.keys.end(), arrays_.keys.begin() + slot.voxel);
     }
-    CopyAttributes(run, [&](auto& array, const auto& values) {
-      std::copy(values.begin(), values.end(), array.begin() + slot.voxel);
-    });
+    CopyAttributes(run, slot.voxel);
   }
-  // After the pass: trims the arrays to what was placed, then appends `aside` in order.
-  void Finish(const std::vector<VoxelRun>& aside) {
-    ForEachAttribute([&](auto& array) { array.resize(placed_voxels_); });
-    if (packed_) {
-      packed_->key_gaps.resize(placed_bytes_);
-    } else {
-      keys_->resize(placed_voxels_);
-    }
-    std::size_t count = placed_voxels_;
-    for (const VoxelRun& run : aside) {
+  // After the pass: grows the room for the runs set `aside` and appends them in order.
+  Status Finish(const std::vector<VoxelRun>& aside) {
+    std::size_t voxels = placed_voxels_, bytes = placed_bytes_;
+    std::uint64_t last = last_;
+    std::vector<Slot> slots(aside.size());
+    for (std::size_t i = 0; i < aside.size(); ++i) {
+      const VoxelRun& run = aside[i];
       if (run.keys.empty()) continue;
-      count += run.keys.size();
+      slots[i].voxel = voxels, slots[i].byte = bytes;
+      voxels += run.keys.size();
       if (packed_) {
-        std::uint8_t head[kMaxVarintBytes];
-        const std::size_t h = PutVarint(run.keys[0] - last_ - 1, head);
-        packed_->key_gaps.insert(packed_->key_gaps.end(), head, head + h);
-        packed_->key_gaps.insert(packed_->key_gaps.end(), run.gaps.begin(), run.gaps.end());
-        last_ = run.keys.back();
-      } else {
-        keys_->insert(keys_->end(), run.keys.begin(), run.keys.end());
+        slots[i].head_size =
+            static_cast<std::uint8_t>(PutVarint(run.keys[0] - last - 1, slots[i].head));
+        bytes += slots[i].head_size + run.gaps.size();
       }
-      CopyAttributes(run, [](auto& array, const auto& values) {
-        array.insert(array.end(), values.begin(), values.end());
-      });
+      last = run.keys.back();
     }
-    count_ = count;
-    if (packed_) packed_->count = count;
+    if (voxels > room_voxels_ || bytes > room_bytes_) {
+      StatusOr<OutputArrays> arrays = reserve_(voxels, bytes);
+      if (!arrays.ok()) return arrays.status();
+      arrays_ = *arrays;
+    }
+    for (std::size_t i = 0; i < aside.size(); ++i) Copy(aside[i], slots[i]);
+    count_ = voxels;
+    bytes_ = bytes;
+    return Status::Ok();
   }
   std::size_t count() const { return count_; }
+  std::size_t bytes() const { return bytes_; }
 
  private:
-  // f(array) for each per-voxel attribute array the output fills (colours only when per voxel).
-  template <class F>
-  void ForEachAttribute(const F& f) {
-    f(attributes_.coverage);
-    if (colors_) f(attributes_.colors);
-    if (normals_) f(attributes_.normals);
-  }
-  // f(array, run's values) for each attribute the run carries.
-  template <class F>
-  void CopyAttributes(const VoxelRun& run, const F& f) {
-    f(attributes_.coverage, run.coverage);
-    if (colors_) f(attributes_.colors, run.colors);
-    if (normals_) f(attributes_.normals, run.normals);
+  void CopyAttributes(const VoxelRun& run, std::size_t at) {
+    auto copy = [at](const auto& values, auto out) {
+      if (!out.empty()) std::copy(values.begin(), values.end(), out.begin() + at);
+    };
+    copy(run.coverage, arrays_.coverage);
+    copy(run.colors, arrays_.colors);
+    copy(run.normals, arrays_.normals);
   }
 
-  VoxelAttributes& attributes_;
-  DefaultInitVector<std::uint64_t>* keys_;
-  PackedVoxelSet* packed_;
-  bool colors_, normals_;
-  std::size_t room_voxels_ = 0, room_bytes_ = 0, placed_voxels_ = 0, placed_bytes_ = 0, count_ = 0;
+  ReserveOutput reserve_;
+  bool packed_;
+  OutputArrays arrays_;
+  std::size_t room_voxels_ = 0, room_bytes_ = 0, placed_voxels_ = 0, placed_bytes_ = 0;
+  std::size_t count_ = 0, bytes_ = 0;
   std::uint64_t last_ = kNoPreviousKey;
   bool aside_ = false;
 };
@@ -410,8 +393,8 @@ class BrickPass {
   /// `bins`: the (brick, triangle) pairs BinToBricks listed, per chunk of triangles in index
   /// order (each brick of a triangle once); `reserve`: room for the voxels to reserve up front
   /// (more only costs a reallocation).
-  void Run(std::vector<std::vector<BrickTriangle>>& bins, std::size_t reserve, BrickOutput& output,
-           Progress& progress) {
+  Status Run(std::vector<std::vector<BrickTriangle>>& bins, std::size_t reserve,
+             BrickOutput& output, Progress& progress) {
     std::vector<BrickTriangle> pairs;
     std::uint64_t last_brick = 0;
     for (auto& b : bins) {
@@ -428,7 +411,7 @@ class BrickPass {
     starts.push_back(pairs.size());
     const std::size_t bricks = starts.size() - 1;
 
-    output.Reserve(reserve, bricks);
+    SVOKIT_RETURN_IF_ERROR(output.Reserve(reserve, bricks));
     Progress::Stage stage(progress, "attributes", bricks);
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
         [&] { return std::make_unique<BrickAccumulator>(colors_, normals_); });
@@ -488,8 +471,9 @@ class BrickPass {
                     tbb::make_filter<std::size_t, Group>(tbb::filter_mode::parallel, fill) &
                     tbb::make_filter<Group, Group>(tbb::filter_mode::serial_in_order, place) &
                     tbb::make_filter<Group, void>(tbb::filter_mode::parallel, copy));
-    output.Finish(aside);
+    SVOKIT_RETURN_IF_ERROR(output.Finish(aside));
     stage.SetSummary(fmt::format("{} voxels", output.count()));
+    return Status::Ok();
   }
 
  private:
@@ -548,11 +532,47 @@ class BrickPass {
 
 namespace {
 
-// Voxelize() and VoxelizePacked(): grid, mode and attributes into `out`; the keys into `keys`, or
-// packed into `packed` (`out` is then *packed).
+// `array` resized to `n` without zeroing; an array big enough for malloc to map it on its own
+// (≥ 32 MiB, its largest threshold) on small pages: written once, in order, then read once by the
+// file writer, and small pages are cheaper to fault in than fresh 2 MB ones (armadillo 4096³,
+// whole process: 1.65 → 1.52 s). Heap pages would keep the advice for whatever reuses them.
+template <class T>
+std::span<T> ResizeFresh(DefaultInitVector<T>& array, std::size_t n) {
+  array.resize(n);
+  if (n * sizeof(T) >= (std::size_t{32} << 20)) PreferSmallPages(array.data(), array.data() + n);
+  return array;
+}
+
+// A PackedVoxelSet's vectors as the storage of a packed voxelization.
+class PackedSetStorage final : public PackedVoxelStorage {
+ public:
+  explicit PackedSetStorage(PackedVoxelSet& set) : set_(set) {}
+  StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
+                                      std::size_t key_bytes) override {
+    PackedVoxelArrays arrays;
+    arrays.key_gaps = ResizeFresh(set_.key_gaps, key_bytes);
+    if (contents.colors) arrays.colors = ResizeFresh(set_.colors, voxels);
+    if (contents.normals) arrays.normals = ResizeFresh(set_.normals, voxels);
+    if (contents.coverage) arrays.coverage = ResizeFresh(set_.coverage, voxels);
+    return arrays;
+  }
+
+ private:
+  PackedVoxelSet& set_;
+};
+
+// Where VoxelizeInto() puts the voxels: 64-bit keys and attribute arrays into `set`, or packed
+// into `storage`, with `packed` told the counts.
+struct Destination {
+  VoxelSet* set = nullptr;
+  PackedVoxelStorage* storage = nullptr;
+  PackedVoxelization* packed = nullptr;
+};
+
+// Voxelize() and VoxelizePacked().
 Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
-                    Progress& progress, VoxelAttributes& out,
-                    DefaultInitVector<std::uint64_t>* keys, PackedVoxelSet* packed) {
+                    Progress& progress, const Destination& to) {
+  VoxelAttributes& out = to.set ? *to.set : to.packed->attributes;
   if (mesh.triangles.empty()) return Status::BadInput("the mesh has no triangles to voxelize");
   const std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
   for (const FixedPoint3& v : vertices) {
@@ -605,10 +625,38 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
     const std::optional<Rgba> shared_color = sampler.SharedColor();
     if (shared_color) out.colors.assign(1, *shared_color);
     const bool colors = options.colors && !shared_color;
+    const PackedVoxelContents contents{colors, options.normals, true, shared_color.has_value()};
+    ReserveOutput reserve;
+    if (to.set) {
+      reserve = [&](std::size_t voxels, std::size_t) -> StatusOr<OutputArrays> {
+        OutputArrays arrays;
+        arrays.keys = ResizeFresh(to.set->keys, voxels);
+        if (colors) arrays.colors = ResizeFresh(to.set->colors, voxels);
+        if (options.normals) arrays.normals = ResizeFresh(to.set->normals, voxels);
+        arrays.coverage = ResizeFresh(to.set->coverage, voxels);
+        return arrays;
+      };
+    } else {
+      reserve = [&](std::size_t voxels, std::size_t bytes) -> StatusOr<OutputArrays> {
+        StatusOr<PackedVoxelArrays> a = to.storage->Reserve(contents, voxels, bytes);
+        if (!a.ok()) return a.status();
+        return OutputArrays{{}, a->key_gaps, a->colors, a->normals, a->coverage};
+      };
+    }
     BrickPass pass(voxelizer, sampler, colors, options.normals);
-    BrickOutput output(out, keys, packed, colors, options.normals);
+    BrickOutput output(std::move(reserve), to.set == nullptr);
     // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-    pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, output, progress);
+    SVOKIT_RETURN_IF_ERROR(
+        pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, output, progress));
+    if (to.set) {
+      VoxelSet& set = *to.set;
+      set.keys.resize(output.count());
+      if (colors) set.colors.resize(output.count());
+      if (options.normals) set.normals.resize(output.count());
+      set.coverage.resize(output.count());
+    } else {
+      *to.packed = {std::move(out), contents, output.count(), output.bytes()};
+    }
     return Status::Ok();
   }
 
@@ -710,12 +758,23 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
   }
 
   std::uint64_t count = 0;
-  if (packed != nullptr) {
-    VoxelBitSet::UnionPacked(parts, packed->count, packed->key_gaps);
-    count = packed->count;
+  if (to.storage) {
+    Status reserved;
+    std::size_t key_bytes = 0;
+    count = VoxelBitSet::UnionPacked(parts, [&](std::size_t bytes) -> std::uint8_t* {
+      StatusOr<PackedVoxelArrays> arrays = to.storage->Reserve({}, 0, bytes);
+      if (!arrays.ok()) {
+        reserved = arrays.status();
+        return nullptr;
+      }
+      key_bytes = bytes;
+      return arrays->key_gaps.data();
+    });
+    SVOKIT_RETURN_IF_ERROR(reserved);
+    *to.packed = {std::move(out), {}, count, key_bytes};
   } else {
-    *keys = VoxelBitSet::UnionKeys(parts);
-    count = keys->size();
+    to.set->keys = VoxelBitSet::UnionKeys(parts);
+    count = to.set->keys.size();
   }
   stage->SetSummary(fmt::format("{} voxels", count));
   return Status::Ok();
@@ -726,15 +785,36 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
 StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                             const VoxelizeOptions& options, Progress& progress) {
   VoxelSet set;
-  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, set, &set.keys, nullptr));
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, {&set, nullptr, nullptr}));
   return set;
+}
+
+StatusOr<PackedVoxelization> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
+                                            const VoxelizeOptions& options,
+                                            PackedVoxelStorage& storage, Progress& progress) {
+  PackedVoxelization packed;
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, {nullptr, &storage, &packed}));
+  return packed;
 }
 
 StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
                                         const VoxelizeOptions& options, Progress& progress) {
-  PackedVoxelSet packed;
-  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, packed, nullptr, &packed));
-  return packed;
+  PackedVoxelSet set;
+  PackedSetStorage storage(set);
+  StatusOr<PackedVoxelization> packed = VoxelizePacked(mesh, grid, options, storage, progress);
+  if (!packed.ok()) return packed.status();
+  // The arrays cut to what holds voxels; grid, mode, warnings and a shared colour beside them.
+  const PackedVoxelization& p = *packed;
+  set.key_gaps.resize(p.key_bytes);
+  if (p.contents.colors) set.colors.resize(p.count);
+  if (p.contents.normals) set.normals.resize(p.count);
+  if (p.contents.coverage) set.coverage.resize(p.count);
+  set.count = p.count;
+  set.grid = p.attributes.grid;
+  set.mode = p.attributes.mode;
+  set.warnings = p.attributes.warnings;
+  if (!p.contents.colors) set.colors = p.attributes.colors;
+  return set;
 }
 
 }  // namespace svokit

@@ -38,4 +38,11 @@ StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& g
                                         const VoxelizeOptions& options,
                                         Progress& progress = Progress::Silent());
 
+/// VoxelizePacked() into arrays `storage` provides (e.g. a file's sections, mapped): the same
+/// voxels and attributes, the same bytes.
+StatusOr<PackedVoxelization> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
+                                            const VoxelizeOptions& options,
+                                            PackedVoxelStorage& storage,
+                                            Progress& progress = Progress::Silent());
+
 }  // namespace svokit
