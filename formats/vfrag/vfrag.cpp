@@ -293,13 +293,13 @@ container::Writer::Producer BytesProducer(std::span<const std::uint8_t> bytes,
 }
 
 // KEYS from keys already packed: the count, then the bytes.
-container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set, bool release) {
-  return [&set, release](const container::Writer::Emit& emit) -> Status {
+container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set) {
+  return [&set](const container::Writer::Emit& emit) -> Status {
     std::uint8_t head[sizeof(set.count)];
     std::memcpy(head, &set.count, sizeof(set.count));
     SVOKIT_RETURN_IF_ERROR(emit(head));
     const std::span<const std::uint8_t> gaps = Bytes(set.key_gaps);
-    return BytesProducer(gaps, gaps, release)(emit);
+    return BytesProducer(gaps, gaps, false)(emit);
   };
 }
 
@@ -333,7 +333,7 @@ std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& 
 }
 
 std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta) {
-  return MakeWriter(set, PackedKeysProducer(set, false), meta, false).Serialize();
+  return MakeWriter(set, PackedKeysProducer(set), meta, false).Serialize();
 }
 
 Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
@@ -344,13 +344,6 @@ Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
 Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path) {
   const Status status = MakeWriter(set, KeysProducer(set.keys, true), meta, true).WriteFile(path);
   set = VoxelSet{};  // its pages are gone
-  return status;
-}
-
-Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
-                  const std::filesystem::path& path) {
-  const Status status = MakeWriter(set, PackedKeysProducer(set, true), meta, true).WriteFile(path);
-  set = PackedVoxelSet{};  // its pages are gone
   return status;
 }
 

@@ -29,10 +29,8 @@ Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
 /// The same file from a set that is consumed: its arrays' memory goes back to the kernel as it is
 /// written, for the file's page cache to reuse (fresh pages are slow on VMs); `set` is left empty.
 Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path);
-/// The same file from voxels whose keys are packed already (VoxelizePacked), consumed likewise.
+/// The same file from voxels whose keys are packed already (VoxelizePacked).
 std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta);
-Status WriteVfrag(PackedVoxelSet&& set, const VfragMetadata& meta,
-                  const std::filesystem::path& path);
 /// A .vfrag file that VoxelizePacked() writes into directly: its KEYS, COLR, NORM and COVR
 /// sections are regions of a temporary beside `path`, mapped (container::MappedWriter), which the
 /// voxelizer's threads fill in place; Commit() completes the file and renames it into place.
