@@ -161,8 +161,12 @@ Status MappedWriter::MapFile(std::uint64_t size) {
   const auto current = static_cast<std::uint64_t>(st.st_size);
   // Blocks reserved now: a store into a mapped hole of a full disk would be a SIGBUS.
   if (size > current) {
+    // fallocate(2), not posix_fallocate: where the file system cannot reserve, go on without
+    // rather than have glibc write every block.
     const int err =
-        ::posix_fallocate(fd, static_cast<off_t>(current), static_cast<off_t>(size - current));
+        ::fallocate(fd, 0, static_cast<off_t>(current), static_cast<off_t>(size - current)) == 0
+            ? 0
+            : errno;
     if (err != 0 && err != EOPNOTSUPP && err != EINVAL) {
       return Status::BadInput("{}: cannot reserve {} bytes ({})", name, size, std::strerror(err));
     }
