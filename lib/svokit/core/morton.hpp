@@ -2,6 +2,7 @@
 // 64-bit Morton keys, 21 bits per axis: bit 3i is bit i of x, 3i+1 of y, 3i+2 of z. Sorting keys
 // orders voxels along the Z-curve, so every octree node is a contiguous key range.
 
+#include <array>
 #include <cstdint>
 
 namespace svokit {
@@ -49,6 +50,38 @@ constexpr MortonCoord MortonDecode(std::uint64_t key) {
 constexpr std::uint64_t MortonParent(std::uint64_t key, int levels = 1) {
   return key >> (3 * levels);
 }
+
+/// Morton codes inside a brick: a cube of 2^kSideBits voxels a side on the grid of that size,
+/// whose voxels' keys are contiguous (key = brick's key << kCodeBits | local code).
+template <int kSideBits>
+struct MortonBrick {
+  static constexpr std::uint32_t kSide = 1u << kSideBits;
+  static constexpr int kCodeBits = 3 * kSideBits;
+  static constexpr std::uint32_t kVoxels = 1u << kCodeBits;
+
+  /// Local code of (x, y, z) mod kSide.
+  static std::uint32_t LocalCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+    constexpr std::uint32_t kMask = kSide - 1;
+    return kSpread[x & kMask] | kSpread[y & kMask] << 1 | kSpread[z & kMask] << 2;
+  }
+  /// The local code one voxel further along `axis` (inside the brick): that axis's bits are
+  /// incremented, the carry passing through the other axes' bits by filling them.
+  static std::uint32_t NextLocal(std::uint32_t local, int axis) {
+    const std::uint32_t mask = kAxisBits << axis;
+    return (((local | ~mask) + 1) & mask) | (local & ~mask);
+  }
+
+ private:
+  static constexpr std::uint32_t kAxisBits = (kVoxels - 1) / 7;  // every third bit: 0b1001…001
+  static constexpr std::array<std::uint16_t, kSide> kSpread = [] {
+    std::array<std::uint16_t, kSide> spread{};
+    for (std::uint32_t i = 0; i < kSide; ++i) {
+      spread[i] = static_cast<std::uint16_t>(detail::SpreadBits3(i));
+    }
+    return spread;
+  }();
+  static_assert(kSideBits >= 1 && kCodeBits <= 16, "local codes are kept in 16 bits");
+};
 
 /// Which of the 8 children of its parent a key is (bit 0: x, bit 1: y, bit 2: z).
 constexpr unsigned MortonChildIndex(std::uint64_t key) {

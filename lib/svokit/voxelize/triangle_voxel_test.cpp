@@ -208,7 +208,7 @@ bool TriangleVoxelizer::OverlapsWith(const Setup<Int>& setup, std::int64_t x, st
     if (e.a * lu + e.b * lv + e.c < 0) return false;
   }
   std::int64_t w0, w1;
-  ClipDepth(MakeFrame(), setup.depth, StartDepth(setup.depth, lu, lv), w0, w1);
+  ClipDepth(MakeFrame(lo_[w_], hi_[w_]), setup.depth, StartDepth(setup.depth, lu, lv), w0, w1);
   return lw >= w0 && lw <= w1 && StartSideRun(setup.edges, lu, lv, lw).Inside();
 }
 

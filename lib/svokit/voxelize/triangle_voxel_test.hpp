@@ -57,6 +57,11 @@ class TriangleVoxelizer {
   template <class EmitRun>
   void RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
                      const EmitRun& emit) const;
+  /// RunsAlongAxis() with the runs also cut to [w0, w1) along the dominant axis: the triangle's
+  /// voxels in one box. A column whose run lies outside the cut skips its side tests.
+  template <class EmitRun>
+  void RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
+                     std::int64_t w0, std::int64_t w1, const EmitRun& emit) const;
   /// The same voxels one by one: emit(x, y, z).
   template <class Emit>
   void Columns(std::int64_t u0, std::int64_t u1, std::int64_t v0, std::int64_t v1,
@@ -116,12 +121,15 @@ class TriangleVoxelizer {
   // stores could alias the members, which would reload them at every column.
   struct Frame {
     std::int64_t origin[3];
-    std::int64_t w_last;  // the candidate range along w is [0, w_last] locally (origin_ = lo_)
+    // The runs' range along w, [w_first, w_last] locally: the candidate range (from 0, as
+    // origin_ = lo_), cut to what the caller asked for.
+    std::int64_t w_first, w_last;
     bool has_plane, conservative;
   };
-  Frame MakeFrame() const {
+  Frame MakeFrame(std::int64_t w0, std::int64_t w1) const {
     return {{origin_[0], origin_[1], origin_[2]},
-            hi_[w_] - 1 - lo_[w_],
+            std::max(w0, lo_[w_]) - origin_[w_],
+            std::min(w1, hi_[w_]) - 1 - origin_[w_],
             has_plane_,
             mode_ == VoxelMode::kConservative};
   }
@@ -131,7 +139,7 @@ class TriangleVoxelizer {
                             std::int64_t lw) const;
   template <int W, class Int, class EmitRun>
   void RunsWith(const Setup<Int>& setup, std::int64_t u0, std::int64_t u1, std::int64_t v0,
-                std::int64_t v1, const EmitRun& emit) const;
+                std::int64_t v1, const Frame& f, const EmitRun& emit) const;
   // The plane_lo cursor at column (lu, lv); zero without a plane.
   template <class Int>
   FloorCursor<Int> StartDepth(const Depth<Int>& depth, std::int64_t lu, std::int64_t lv) const;
@@ -149,7 +157,7 @@ class TriangleVoxelizer {
   template <class Int>
   static bool ClipDepth(const Frame& f, const Depth<Int>& d, const FloorCursor<Int>& c,
                         std::int64_t& w0, std::int64_t& w1) {
-    w0 = 0;
+    w0 = f.w_first;
     w1 = f.w_last;
     if (!f.has_plane) return false;
     const Int lo = c.q, hi = c.q + d.span.dq + (c.r >= d.den - d.span.dr);

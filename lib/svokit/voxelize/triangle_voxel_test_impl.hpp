@@ -37,15 +37,24 @@ void TriangleVoxelizer::RunsWithInterior(std::int64_t u0, std::int64_t u1, std::
 template <class EmitRun>
 void TriangleVoxelizer::RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0,
                                       std::int64_t v1, const EmitRun& emit) const {
+  RunsAlongAxis(u0, u1, v0, v1, lo_[w_], hi_[w_], emit);
+}
+
+template <class EmitRun>
+void TriangleVoxelizer::RunsAlongAxis(std::int64_t u0, std::int64_t u1, std::int64_t v0,
+                                      std::int64_t v1, std::int64_t w0, std::int64_t w1,
+                                      const EmitRun& emit) const {
   if (empty_) return;
+  const Frame f = MakeFrame(w0, w1);
+  if (f.w_first > f.w_last) return;
   auto along = [&](const auto& setup) {
     switch (w_) {
       case 0:
-        return RunsWith<0>(setup, u0, u1, v0, v1, emit);
+        return RunsWith<0>(setup, u0, u1, v0, v1, f, emit);
       case 1:
-        return RunsWith<1>(setup, u0, u1, v0, v1, emit);
+        return RunsWith<1>(setup, u0, u1, v0, v1, f, emit);
       default:
-        return RunsWith<2>(setup, u0, u1, v0, v1, emit);
+        return RunsWith<2>(setup, u0, u1, v0, v1, f, emit);
     }
   };
   if (fits_int64_) {
@@ -96,10 +105,11 @@ TriangleVoxelizer::FloorCursor<Int> TriangleVoxelizer::StartDepth(const Depth<In
 
 template <int W, class Int, class EmitRun>
 void TriangleVoxelizer::RunsWith(const Setup<Int>& setup, std::int64_t u0, std::int64_t u1,
-                                 std::int64_t v0, std::int64_t v1, const EmitRun& emit) const {
+                                 std::int64_t v0, std::int64_t v1, const Frame& frame,
+                                 const EmitRun& emit) const {
   constexpr int U = (W + 1) % 3, V = (W + 2) % 3;
   const std::integral_constant<int, W> axis;
-  const Frame f = MakeFrame();
+  const Frame f = frame;  // a local copy: the emitter's stores cannot alias it
   u0 = std::max(u0, lo_[U]), u1 = std::min(u1, hi_[U]);
   v0 = std::max(v0, lo_[V]), v1 = std::min(v1, hi_[V]);
   if (u0 >= u1 || v0 >= v1) return;

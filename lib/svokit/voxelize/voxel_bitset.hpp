@@ -22,21 +22,17 @@ namespace svokit {
 
 class VoxelBitSet {
  public:
-  static constexpr int kBrickBits = 12;  // 16³ voxels per brick
-  using Brick = std::array<std::uint64_t, (1u << kBrickBits) / 64>;
+  using Local = MortonBrick<4>;  // 16³ voxels per brick
+  static constexpr int kBrickBits = Local::kCodeBits;
+  using Brick = std::array<std::uint64_t, Local::kVoxels / 64>;
 
   /// Morton code of (x, y, z) mod 16 inside its brick.
   static std::uint32_t LocalCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-    static constexpr std::uint16_t kSpread[16] = {0x000, 0x001, 0x008, 0x009, 0x040, 0x041,
-                                                  0x048, 0x049, 0x200, 0x201, 0x208, 0x209,
-                                                  0x240, 0x241, 0x248, 0x249};
-    return kSpread[x & 15] | kSpread[y & 15] << 1 | kSpread[z & 15] << 2;
+    return Local::LocalCode(x, y, z);
   }
-  /// The local code one voxel further along `axis` (inside the brick): that axis's bits are
-  /// incremented, the carry passing through the other axes' bits by filling them.
+  /// The local code one voxel further along `axis` (inside the brick).
   static std::uint32_t NextLocal(std::uint32_t local, int axis) {
-    const std::uint32_t mask = 0x249u << axis;
-    return (((local | ~mask) + 1) & mask) | (local & ~mask);
+    return Local::NextLocal(local, axis);
   }
 
   /// Calls f(bx, by, bz, local, count) for each brick (bx, by, bz) that the `n` voxels from

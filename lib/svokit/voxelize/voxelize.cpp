@@ -79,16 +79,23 @@ class MeshVoxelizer {
   VoxelMode mode_;
 };
 
-// Which triangles touch which 16³ brick: attributes are accumulated brick by brick, each voxel's
+// The attribute pass's bricks: its unit of work and of accumulation. Each (brick, triangle) pair
+// costs a triangle set-up and a walk of the brick's columns, so bricks larger than the bit sets'
+// 16³ pay off: armadillo at 4096³ had 607 k pairs of 16³ bricks, 40 % of whose column runs lay
+// in another brick along the dominant axis (1.22 → 0.91 s whole process with 32³).
+using PassBrick = MortonBrick<5>;
+constexpr std::int64_t kPassSide = PassBrick::kSide;
+
+// Which triangles touch which pass brick: attributes are accumulated brick by brick, each voxel's
 // contributions summed in triangle order, so the result does not depend on threads or method.
 struct BrickTriangle {
   std::uint64_t brick;
   std::uint32_t triangle;
 };
 
-// Appends (brick, triangle) for the 16³ bricks the triangle may have voxels in: a superset,
+// Appends (brick, triangle) for the pass bricks the triangle may have voxels in: a superset,
 // which is all the brick pass needs (a brick the triangle misses costs a walk of its columns
-// there). Per 16 × 16 window of dominant-axis columns its candidate box spans: none when the
+// there). Per brick-sized window of dominant-axis columns its candidate box spans: none when the
 // projected triangle stays over a voxel away from the window, else the bricks along w between
 // the plane's lowest and highest point over the window's part of the box, widened by the voxels
 // a closed box can touch and one more for rounding. Doubles are exact on the snapped vertices'
@@ -106,12 +113,14 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
   // A (nearly) degenerate triangle, whose rounded normal may point anywhere: its whole box.
   const bool plane = std::abs(nw) > 1e-9 * Length(e1) * Length(e2);
   const std::int64_t lo_u = tv.lo(u), hi_u = tv.hi(u), lo_v = tv.lo(v), hi_v = tv.hi(v);
-  for (std::int64_t bv = lo_v >> 4; bv <= (hi_v - 1) >> 4; ++bv) {
-    for (std::int64_t bu = lo_u >> 4; bu <= (hi_u - 1) >> 4; ++bu) {
-      const double u0 = static_cast<double>(std::max(bu * 16, lo_u));
-      const double u1 = static_cast<double>(std::min(bu * 16 + 16, hi_u));
-      const double v0 = static_cast<double>(std::max(bv * 16, lo_v));
-      const double v1 = static_cast<double>(std::min(bv * 16 + 16, hi_v));
+  constexpr int kB = std::countr_zero(PassBrick::kSide);
+  constexpr std::int64_t kS = kPassSide;
+  for (std::int64_t bv = lo_v >> kB; bv <= (hi_v - 1) >> kB; ++bv) {
+    for (std::int64_t bu = lo_u >> kB; bu <= (hi_u - 1) >> kB; ++bu) {
+      const double u0 = static_cast<double>(std::max(bu * kS, lo_u));
+      const double u1 = static_cast<double>(std::min(bu * kS + kS, hi_u));
+      const double v0 = static_cast<double>(std::max(bv * kS, lo_v));
+      const double v1 = static_cast<double>(std::min(bv * kS + kS, hi_v));
       std::int64_t w_lo = tv.lo(w), w_hi = tv.hi(w) - 1;
       if (plane) {
         bool apart = false;  // an edge separates the triangle from the window grown by a voxel
@@ -134,7 +143,7 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
         w_lo = std::max(w_lo, static_cast<std::int64_t>(std::floor(h_lo)) - 2);
         w_hi = std::min(w_hi, static_cast<std::int64_t>(std::floor(h_hi)) + 1);
       }
-      for (std::int64_t bw = w_lo >> 4; bw <= w_hi >> 4 && w_lo <= w_hi; ++bw) {
+      for (std::int64_t bw = w_lo >> kB; bw <= w_hi >> kB && w_lo <= w_hi; ++bw) {
         std::uint32_t c[3];
         c[u] = Coord(bu), c[v] = Coord(bv), c[w] = Coord(bw);
         out.push_back({MortonEncode(c[0], c[1], c[2]), triangle});
@@ -144,8 +153,8 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
 }
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
-// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 42 % of the
-// 144 k (brick, triangle) pairs hit at 1024³, 79 % of 607 k at 4096³; 64 entries: 31 %, 74 %).
+// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 16 % of the
+// 91 k (brick, triangle) pairs hit at 1024³, 55 % of 258 k at 4096³).
 // Both are functions of the triangle alone, so hits change only the time.
 class TriangleCache {
  public:
@@ -296,13 +305,14 @@ class BrickOutput {
   bool aside_ = false;
 };
 
-// One brick's voxels (a 16³ bit set) and their area-weighted sums, indexed by local Morton code.
+// One pass brick's voxels (a bit set) and their area-weighted sums, indexed by local Morton code.
 // Colours are summed only when they differ between voxels (else the set holds the shared one),
 // in an array of their own that is otherwise never touched.
 class BrickAccumulator {
  public:
-  BrickAccumulator(bool colors, bool normals) : colors_(colors), normals_(normals) {}
-  static constexpr std::size_t kVoxels = std::size_t{1} << VoxelBitSet::kBrickBits;
+  BrickAccumulator(bool colors, bool normals)
+      : color_sums_(colors ? kVoxels : 0), colors_(colors), normals_(normals) {}
+  static constexpr std::size_t kVoxels = PassBrick::kVoxels;
   // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
   // only that way still averages its contacts.
   static constexpr double kMinWeight = 1.0 / (1 << 20);
@@ -322,7 +332,7 @@ class BrickAccumulator {
   // Appends the brick's voxels (bits set in local Morton order = key order) to `out`, and
   // clears the brick.
   void Finish(std::uint64_t brick, VoxelRun& out) {
-    std::uint16_t locals[kVoxels];
+    std::uint16_t* locals = locals_.data();
     std::size_t n = 0;
     for (std::size_t word = 0; word < bits_.size(); ++word) {
       for (std::uint64_t bits = bits_[word]; bits != 0; bits &= bits - 1) {
@@ -331,7 +341,7 @@ class BrickAccumulator {
       bits_[word] = 0;
     }
     const std::size_t at = out.keys.size();
-    const std::uint64_t base = brick << VoxelBitSet::kBrickBits;
+    const std::uint64_t base = brick << PassBrick::kCodeBits;
     out.keys.resize(at + n);
     out.coverage.resize(at + n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -374,9 +384,10 @@ class BrickAccumulator {
   struct ColorSum {
     double r = 0, g = 0, b = 0, a = 0;
   };
-  VoxelBitSet::Brick bits_{};
+  std::array<std::uint64_t, kVoxels / 64> bits_{};
+  std::array<std::uint16_t, kVoxels> locals_;
   std::array<Sum, kVoxels> sums_{};
-  std::array<ColorSum, kVoxels> color_sums_{};
+  std::vector<ColorSum> color_sums_;
   bool colors_, normals_;
 };
 
@@ -477,16 +488,15 @@ class BrickPass {
   }
 
  private:
-  static constexpr std::size_t kGroupBricks = 16;
+  static constexpr std::size_t kGroupBricks = 4;
 
   void FillBrick(const std::vector<BrickTriangle>& pairs, std::size_t first, std::size_t last,
                  BrickAccumulator& acc, TriangleCache& cache, VoxelRun& out) const {
     const std::uint64_t brick = pairs[first].brick;
     const MortonCoord bc = MortonDecode(brick);
-    const std::int64_t lo[3] = {std::int64_t{bc.x} << 4, std::int64_t{bc.y} << 4,
-                                std::int64_t{bc.z} << 4};
-    AttributeSample samples[16];  // one run's samples (built once: a run is often one voxel)
-    double areas[16];
+    const std::int64_t lo[3] = {bc.x * kPassSide, bc.y * kPassSide, bc.z * kPassSide};
+    AttributeSample samples[kPassSide];  // one run's samples (built once: a run is often one voxel)
+    double areas[kPassSide];
     for (std::size_t i = first; i < last; ++i) {
       const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
       const TriangleVoxelizer& tv = *entry.tv;
@@ -496,25 +506,20 @@ class BrickPass {
       const bool uniform = p.uniform && p.axis == w;
       AttributeSampler::ColumnSampler columns(sampler_, p);
       tv.RunsAlongAxis(
-          lo[u], lo[u] + 16, lo[v], lo[v] + 16,
+          lo[u], lo[u] + kPassSide, lo[v], lo[v] + kPassSide, lo[w], lo[w] + kPassSide,
           [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
               bool interior) {
-            // The part of the run inside the brick.
-            std::int64_t c[3] = {x, y, z};
-            const std::int64_t begin = std::max(c[axis], lo[axis]);
-            const std::int64_t end = std::min(c[axis] + k, lo[axis] + 16);
-            if (begin >= end) return;
-            c[axis] = begin;
-            const int count = static_cast<int>(end - begin);
-            std::uint32_t local = VoxelBitSet::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
+            const std::int64_t c[3] = {x, y, z};
+            const int count = static_cast<int>(k);  // ≤ kPassSide: the runs are the brick's
+            std::uint32_t local = PassBrick::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
             if (uniform) {
               columns.Areas(c[0], c[1], c[2], count, interior, areas);
-              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, axis)) {
+              for (int s = 0; s < count; ++s, local = PassBrick::NextLocal(local, axis)) {
                 acc.Add(local, areas[s], p.color, p.unit_normal);
               }
             } else {
               columns.Sample(c[0], c[1], c[2], axis, count, interior, samples);
-              for (int s = 0; s < count; ++s, local = VoxelBitSet::NextLocal(local, axis)) {
+              for (int s = 0; s < count; ++s, local = PassBrick::NextLocal(local, axis)) {
                 acc.Add(local, samples[s].area, samples[s].color, samples[s].normal);
               }
             }
