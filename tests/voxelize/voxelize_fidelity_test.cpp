@@ -206,6 +206,36 @@ TriangleResult CheckTriangle(const FixedPoint3& a, const FixedPoint3& b, const F
         ADD_FAILURE() << ModeName(kModes[m]) << " Columns over tiles differ from one call; "
                       << Describe(a, b, c);
       }
+
+      // Cut along the dominant axis as well (the attribute pass's bricks): each box's runs must
+      // be exactly the triangle's voxels inside it.
+      std::int64_t sw[] = {t.lo(w) - 1, t.lo(w) + 1, (t.lo(w) + t.hi(w)) / 2, t.hi(w) + 2};
+      std::sort(std::begin(sw), std::end(sw));
+      std::vector<std::uint64_t> boxed;
+      std::size_t outside = 0;
+      for (int i = 0; i + 1 < 5; ++i) {
+        for (int j = 0; j + 1 < 4; ++j) {
+          for (int k = 0; k + 1 < 4; ++k) {
+            t.RunsAlongAxis(su[i], su[i + 1], sv[j], sv[j + 1], sw[k], sw[k + 1],
+                            [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z,
+                                std::int64_t n, bool) {
+                              std::int64_t p[3] = {x, y, z};
+                              for (; n > 0; --n, ++p[axis]) {
+                                outside += p[w] < sw[k] || p[w] >= sw[k + 1];
+                                boxed.push_back(grid.Contains({p[0], p[1], p[2]})
+                                                    ? Key(p[0], p[1], p[2])
+                                                    : ~std::uint64_t{0});
+                              }
+                            });
+          }
+        }
+      }
+      std::sort(boxed.begin(), boxed.end());
+      if (outside != 0 || boxed != got) {
+        ++result.split_errors;
+        ADD_FAILURE() << ModeName(kModes[m]) << " runs cut to boxes differ from one call ("
+                      << outside << " voxels outside their box); " << Describe(a, b, c);
+      }
     }
   }
   if (result.overlap_errors > 0) {
