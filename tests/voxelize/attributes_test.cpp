@@ -228,7 +228,7 @@ TEST(AttributeClip, ProjectedColumnAreasOfUniformTrianglesEqualClippedAreas) {
   std::mt19937_64 rng(20261123);
   std::uniform_int_distribution<std::int64_t> coord(0, 12 * kFixedPointOne);
   const IBox3 grid{{-2, -2, -2}, {20, 20, 20}};
-  int interior_columns = 0, boundary_columns = 0;
+  int interior_columns = 0, boundary_columns = 0, cut_voxels = 0;
   for (int iter = 0; iter < 400; ++iter) {
     TestMesh m({{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, {{0, 1, 2}});
     m.mesh.materials[0].base_color = {0.25f, 0.5f, 0.75f, 1};
@@ -294,8 +294,29 @@ TEST(AttributeClip, ProjectedColumnAreasOfUniformTrianglesEqualClippedAreas) {
           ++boundary_columns;
         }
       }
+
+      // Runs cut to slabs two voxels deep along w (the brick pass's bricks cut runs this way):
+      // a cut run's areas are still its voxels' own.
+      AttributeSampler::ColumnSampler cut_order(sampler, p);
+      for (std::int64_t w0 = tv.lo(w); w0 < tv.hi(w); w0 += 2) {
+        tv.RunsAlongAxis(tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi(), w0, w0 + 2,
+                         [&](auto, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t n,
+                             bool interior) {
+                           ASSERT_LE(n, 2);
+                           AttributeSample cut[2];
+                           cut_order.Sample(x, y, z, w, static_cast<int>(n), interior, cut);
+                           std::int64_t c[3] = {x, y, z};
+                           for (int i = 0; i < n; ++i, ++c[w]) {
+                             const AttributeSample clipped = sampler.Sample(0, c[0], c[1], c[2]);
+                             EXPECT_NEAR(cut[i].area, clipped.area, 1e-9 * (1 + clipped.area))
+                                 << iter << " cut voxel " << c[0] << " " << c[1] << " " << c[2];
+                             ++cut_voxels;
+                           }
+                         });
+      }
     }
   }
+  EXPECT_GT(cut_voxels, 10000);
   EXPECT_GT(interior_columns, 1000);
   EXPECT_GT(boundary_columns, 1000);
 }

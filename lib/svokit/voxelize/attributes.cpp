@@ -306,6 +306,20 @@ AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const
     p.slope_u = -n[u] / n[p.axis];
     p.slope_v = -n[v] / n[p.axis];
     p.secant = p.normal_length / std::abs(n[p.axis]);
+    // Inward normals: n[axis] is the projection's doubled signed area ((u, v, w) is cyclic).
+    const double side = n[p.axis] > 0 ? 1.0 : -1.0;
+    const double ps[3] = {0, p.e1[u], p.e2[u]}, pt[3] = {0, p.e1[v], p.e2[v]};
+    for (int k = 0; k < 3; ++k) {
+      const int j = (k + 1) % 3;
+      ProjectedEdge& e = p.edges[k];
+      e.a = -(pt[j] - pt[k]) * side;
+      e.b = (ps[j] - ps[k]) * side;
+      e.c = -(e.a * ps[k] + e.b * pt[k]);
+      e.square_low = std::min(e.a, 0.0) + std::min(e.b, 0.0);
+      e.square_high = std::max(e.a, 0.0) + std::max(e.b, 0.0);
+      e.big = std::max(std::abs(e.a), std::abs(e.b));
+      e.small = std::min(std::abs(e.a), std::abs(e.b));
+    }
   }
   return p;
 }
@@ -384,6 +398,35 @@ void AttributeSampler::ColumnSampler::Areas(std::int64_t x, std::int64_t y, std:
   ForEachArea(x, y, z, n, interior, [&](int i, double a) { area[i] = a; });
 }
 
+void AttributeSampler::ColumnSampler::ColumnPolygon(std::int64_t u, std::int64_t v, Point2* buffer,
+                                                    Point2*& poly, int& m) {
+  if (!row_valid_ || v != row_v_ || u < next_u_) StartRow(u, v);
+  const double s_lo = static_cast<double>(u - row_u_), s_hi = s_lo + 1;
+  poly = buffer;
+  m = 0;
+  if (row_n_ > 0) {
+    double lo = row_[0].s, hi = lo;
+    for (int k = 1; k < row_n_; ++k) lo = std::min(lo, row_[k].s), hi = std::max(hi, row_[k].s);
+    if (next_u_ != u && lo < s_lo) {  // columns skipped (interior ones, or row start)
+      Point2 kept[kClipCapacity];
+      row_n_ = ClipHalfPlane(row_, row_n_, kept, [&](const Point2& q) { return q.s - s_lo; });
+      std::copy(kept, kept + row_n_, row_);
+    }
+    if (hi <= s_hi) {  // the row ends in this column
+      poly = row_;
+      m = row_n_;
+      row_n_ = 0;
+    } else if (row_n_ > 0) {
+      Point2 rest[kClipCapacity];
+      const int rest_n = CutByLine<true>(row_, row_n_, rest, buffer, &m,
+                                         [&](const Point2& q) { return q.s - s_hi; });
+      std::copy(rest, rest + rest_n, row_);
+      row_n_ = rest_n;
+    }
+  }
+  next_u_ = u + 1;
+}
+
 template <class Out>
 void AttributeSampler::ColumnSampler::ForEachArea(std::int64_t x, std::int64_t y, std::int64_t z,
                                                   int n, bool interior, const Out& out) {
@@ -401,17 +444,19 @@ void AttributeSampler::ColumnSampler::ForEachArea(std::int64_t x, std::int64_t y
   // below(level): projected area of the column's part of the triangle under the plane height
   // `level`; voxel i of the run holds what lies between levels i and i + 1.
   double below_prev = 0;
+  // The plane's range over the column's whole square.
+  const double plane_lo = h00 + std::min(p.slope_u, 0.0) + std::min(p.slope_v, 0.0);
+  const double plane_hi = plane_lo + std::abs(p.slope_u) + std::abs(p.slope_v);
   if (interior) {
     const double gs = std::abs(p.slope_u), gt = std::abs(p.slope_v);
     const double big = std::max(gs, gt), small = std::min(gs, gt);
-    const double offset = h00 + std::min(p.slope_u, 0.0) + std::min(p.slope_v, 0.0);
     for (int i = 0; i < n; ++i) {
       double area;
       if (big == 0) {  // a face in a voxel boundary counts fully on both sides (closed boxes)
         area = i <= h00 && h00 <= i + 1 ? 1.0 : 0.0;
       } else {
-        if (i == 0) below_prev = SquareAreaBelow(big, small, -offset);
-        const double below = SquareAreaBelow(big, small, i + 1 - offset);
+        if (i == 0) below_prev = SquareAreaBelow(big, small, -plane_lo);
+        const double below = SquareAreaBelow(big, small, i + 1 - plane_lo);
         area = std::max(below - below_prev, 0.0);
         below_prev = below;
       }
@@ -419,35 +464,37 @@ void AttributeSampler::ColumnSampler::ForEachArea(std::int64_t x, std::int64_t y
     }
     return;
   }
-  // The projected triangle clipped to the column's square: the row's part left of the column's
-  // far side, split off the row (s relative to the row's first column, t to the row).
-  if (!row_valid_ || corner[v] != row_v_ || corner[u] < next_u_) StartRow(corner[u], corner[v]);
-  const double s_lo = static_cast<double>(corner[u] - row_u_), s_hi = s_lo + 1;
   Point2 buffer[kClipCapacity];
   Point2* poly = buffer;
   int m = 0;
-  if (row_n_ > 0) {
-    double lo = row_[0].s, hi = lo;
-    for (int k = 1; k < row_n_; ++k) lo = std::min(lo, row_[k].s), hi = std::max(hi, row_[k].s);
-    if (next_u_ != corner[u] && lo < s_lo) {  // columns skipped (interior ones, or row start)
-      Point2 kept[kClipCapacity];
-      row_n_ = ClipHalfPlane(row_, row_n_, kept, [&](const Point2& q) { return q.s - s_lo; });
-      std::copy(kept, kept + row_n_, row_);
-    }
-    if (hi <= s_hi) {  // the row ends in this column
-      poly = row_;
-      m = row_n_;
-      row_n_ = 0;
-    } else if (row_n_ > 0) {
-      Point2 rest[kClipCapacity];
-      const int rest_n = CutByLine<true>(row_, row_n_, rest, buffer, &m,
-                                         [&](const Point2& q) { return q.s - s_hi; });
-      std::copy(rest, rest + rest_n, row_);
-      row_n_ = rest_n;
-    }
+  double h0;  // the plane's height over poly's (s, t) = (0, 0)
+  // A column that one edge alone crosses, the square lying inside the other two (armadillo: 83 %
+  // of boundary columns at 1024³, 96 % at 4096³): the triangle's part is the square's part
+  // inside that edge, whose area has a closed form; the row's polygons are left as they are.
+  int crossing = -1, outside = 0;
+  double edge_c = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ProjectedEdge& e = p.edges[k];
+    const double c = e.c - e.a * a[u] - e.b * a[v];  // relative to the column's corner
+    const bool crosses = c + e.square_low < 0;
+    outside += crosses;
+    crossing = crosses ? k : crossing;
+    edge_c = crosses ? c : edge_c;
   }
-  next_u_ = corner[u] + 1;
-  const double h0 = h00 - p.slope_u * s_lo;  // height over (s, t) = (0, 0) of the row's frame
+  const ProjectedEdge& edge = p.edges[std::max(crossing, 0)];
+  if (outside == 1 && edge_c + edge.square_high > 0) {
+    if (n == 1 && 0 < plane_lo && plane_hi < 1) {  // the plane crosses one voxel of the column
+      out(0, (1 - SquareAreaBelow(edge.big, edge.small, -(edge_c + edge.square_low))) * p.secant);
+      return;
+    }
+    static constexpr Point2 kSquare[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    m = ClipHalfPlane(kSquare, 4, buffer,
+                      [&](const Point2& q) { return edge.a * q.s + edge.b * q.t + edge_c; });
+    h0 = h00;
+  } else {
+    ColumnPolygon(corner[u], corner[v], buffer, poly, m);
+    h0 = h00 - p.slope_u * static_cast<double>(corner[u] - row_u_);
+  }
   auto height = [&](const Point2& q) { return h0 + p.slope_u * q.s + p.slope_v * q.t; };
   double lo = 0, hi = 0;
   for (int k = 0; k < m; ++k) {

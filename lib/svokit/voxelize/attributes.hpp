@@ -74,6 +74,13 @@ class AttributeSampler {
   AttributeSample Sample(std::size_t triangle, std::int64_t x, std::int64_t y,
                          std::int64_t z) const;
 
+  /// An edge of a triangle's dominant-axis projection, as the function that is ≥ 0 on its
+  /// inner side: E(s, t) = a·s + b·t + c, with the extremes over a unit square added to c.
+  struct ProjectedEdge {
+    double a = 0, b = 0, c = 0;
+    double square_low = 0, square_high = 0;  // min(a, 0) + min(b, 0), max(a, 0) + max(b, 0)
+    double big = 0, small = 0;               // max(|a|, |b|), min(|a|, |b|)
+  };
   /// The per-triangle part of Sample(), computed once for all the voxels of a triangle.
   struct Prepared {
     std::size_t triangle = 0;
@@ -90,6 +97,8 @@ class AttributeSampler {
     Rgba color;
     Vec3f unit_normal;
     double slope_u = 0, slope_v = 0, secant = 0;
+    // A uniform triangle's projected edges k → k + 1, (s, t) relative to corner 0.
+    ProjectedEdge edges[3];
   };
   Prepared Prepare(std::size_t triangle) const;
 
@@ -119,6 +128,10 @@ class AttributeSampler {
     // coordinates relative to column (u, v), and above_ the part above it; the next row splits
     // above_ (walks go up row by row). The part left of column u is dropped on use.
     void StartRow(std::int64_t u, std::int64_t v);
+    // The projected triangle's part in column (u, v)'s square, into poly[0..m): `buffer`, or the
+    // row's last part; s relative to the row's first column (row_u_), t to the row.
+    void ColumnPolygon(std::int64_t u, std::int64_t v, attributes_detail::Point2* buffer,
+                       attributes_detail::Point2*& poly, int& m);
 
     const AttributeSampler& sampler_;
     const Prepared& p_;
