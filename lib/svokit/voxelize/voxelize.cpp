@@ -321,10 +321,10 @@ class BrickAccumulator {
     bits_[local >> 6] |= std::uint64_t{1} << (local & 63);
     Sum& sum = sums_[local];
     const double w = area + kMinWeight;
-    sum.weight += w;
     sum.area += area;
     if (colors_) {
       ColorSum& c = color_sums_[local];
+      c.weight += w;
       c.r += color.r * w, c.g += color.g * w, c.b += color.b * w, c.a += color.a * w;
     }
     sum.nx += normal.x * w, sum.ny += normal.y * w, sum.nz += normal.z * w;
@@ -352,8 +352,8 @@ class BrickAccumulator {
     if (colors_) {
       out.colors.resize(at + n);
       for (std::size_t i = 0; i < n; ++i) {
-        const double inv = 1.0 / sums_[locals[i]].weight;  // ≥ kMinWeight
         ColorSum& c = color_sums_[locals[i]];
+        const double inv = 1.0 / c.weight;  // ≥ kMinWeight
         out.colors[at + i] = Rgba{static_cast<float>(c.r * inv), static_cast<float>(c.g * inv),
                                   static_cast<float>(c.b * inv), static_cast<float>(c.a * inv)};
         c = {};
@@ -378,11 +378,13 @@ class BrickAccumulator {
   }
 
  private:
-  struct Sum {
-    double weight = 0, area = 0, nx = 0, ny = 0, nz = 0;
+  // A normal's weights need no sum (only its direction is kept): a voxel's sums fill half a
+  // cache line, and the colours' (with their weights) an array of their own.
+  struct alignas(32) Sum {
+    double area = 0, nx = 0, ny = 0, nz = 0;
   };
   struct ColorSum {
-    double r = 0, g = 0, b = 0, a = 0;
+    double weight = 0, r = 0, g = 0, b = 0, a = 0;
   };
   std::array<std::uint64_t, kVoxels / 64> bits_{};
   std::array<std::uint16_t, kVoxels> locals_;
