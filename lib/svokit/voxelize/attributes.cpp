@@ -430,8 +430,22 @@ void AttributeSampler::ColumnSampler::ColumnPolygon(std::int64_t u, std::int64_t
 template <class Out>
 void AttributeSampler::ColumnSampler::ForEachArea(std::int64_t x, std::int64_t y, std::int64_t z,
                                                   int n, bool interior, const Out& out) {
+  switch (p_.axis) {
+    case 0:
+      return ForEachAreaAlong<0>(x, y, z, n, interior, out);
+    case 1:
+      return ForEachAreaAlong<1>(x, y, z, n, interior, out);
+    default:
+      return ForEachAreaAlong<2>(x, y, z, n, interior, out);
+  }
+}
+
+template <int kAxis, class Out>
+void AttributeSampler::ColumnSampler::ForEachAreaAlong(std::int64_t x, std::int64_t y,
+                                                       std::int64_t z, int n, bool interior,
+                                                       const Out& out) {
   const Prepared& p = p_;
-  const int axis = p.axis, u = (axis + 1) % 3, v = (axis + 2) % 3;
+  constexpr int axis = kAxis, u = (axis + 1) % 3, v = (axis + 2) % 3;
   const std::int64_t corner[3] = {x, y, z};
   constexpr double kScale = 1.0 / static_cast<double>(kFixedPointOne);
   // The first vertex relative to the run's first voxel corner: exact fixed-point differences.

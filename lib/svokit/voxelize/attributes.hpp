@@ -124,6 +124,11 @@ class AttributeSampler {
     template <class Out>
     void ForEachArea(std::int64_t x, std::int64_t y, std::int64_t z, int n, bool interior,
                      const Out& out);
+    // ForEachArea() with the dominant axis (Prepared::axis) a compile-time constant: the corner's
+    // coordinates then stay in registers.
+    template <int kAxis, class Out>
+    void ForEachAreaAlong(std::int64_t x, std::int64_t y, std::int64_t z, int n, bool interior,
+                          const Out& out);
     // Makes row_ the part of the projected triangle in the row's strip v ≤ t ≤ v + 1, in
     // coordinates relative to column (u, v), and above_ the part above it; the next row splits
     // above_ (walks go up row by row). The part left of column u is dropped on use.
