@@ -56,6 +56,18 @@ class MeshVoxelizer {
     return TriangleVoxelizer(vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]], mode_, box_);
   }
 
+  /// Asks for triangle t's corner indices (kCorners) or corners (kVertices) to be brought into
+  /// the cache: the brick pass sets triangles up in brick order, far apart in memory.
+  enum PrefetchWhat { kCorners, kVertices };
+  void Prefetch(std::size_t t, PrefetchWhat what) const {
+    const svokit::Triangle& tri = mesh_.triangles[t];
+    if (what == kCorners) {
+      __builtin_prefetch(&tri);
+    } else {
+      for (int k = 0; k < 3; ++k) __builtin_prefetch(&vertices_[tri[k]]);
+    }
+  }
+
   /// The snapped corners in voxel coordinates (exact in doubles).
   std::array<Vec3d, 3> Corners(std::size_t t) const {
     const svokit::Triangle& tri = mesh_.triangles[t];
@@ -500,6 +512,9 @@ class BrickPass {
     AttributeSample samples[kPassSide];  // one run's samples (built once: a run is often one voxel)
     double areas[kPassSide];
     for (std::size_t i = first; i < last; ++i) {
+      if (i + 2 < pairs.size()) voxelizer_.Prefetch(pairs[i + 2].triangle, MeshVoxelizer::kCorners);
+      if (i + 1 < pairs.size())
+        voxelizer_.Prefetch(pairs[i + 1].triangle, MeshVoxelizer::kVertices);
       const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
       const TriangleVoxelizer& tv = *entry.tv;
       const AttributeSampler::Prepared& p = entry.prepared;
