@@ -75,7 +75,7 @@ class AttributeSampler {
                          std::int64_t z) const;
 
   /// An edge of a triangle's dominant-axis projection, as the function that is ≥ 0 on its
-  /// inner side: E(s, t) = a·s + b·t + c, with the extremes over a unit square added to c.
+  /// inner side, E(s, t) = a·s + b·t + c, and what its range over a unit square needs.
   struct ProjectedEdge {
     double a = 0, b = 0, c = 0;
     double square_low = 0, square_high = 0;  // min(a, 0) + min(b, 0), max(a, 0) + max(b, 0)
