@@ -171,13 +171,6 @@ ClipVertex NearestPoint(const Frame& f) {
   return {vb / sum, vc / sum};
 }
 
-// Twice the polygon's area (shoelace formula), whichever its orientation.
-double TwiceArea(const Point2* q, int n) {
-  double twice = 0;
-  for (int i = 0, j = n - 1; i < n; j = i++) twice += q[j].s * q[i].t - q[j].t * q[i].s;
-  return std::abs(twice);
-}
-
 // Area of the part of convex polygon q[0..n) where `height` (the plane's, linear) is ≤ level:
 // the shoelace sum over the parts of its edges below the level, closed by the segment where the
 // level cuts it (from where the boundary leaves the part to where it comes back), in one pass
@@ -530,13 +523,16 @@ void AttributeSampler::ColumnSampler::ForEachAreaAlong(std::int64_t x, std::int6
     h0 = h00 - p.slope_u * static_cast<double>(corner[u] - row_u_);
   }
   auto height = [&](const Point2& q) { return h0 + p.slope_u * q.s + p.slope_v * q.t; };
-  double lo = 0, hi = 0;
-  for (int k = 0; k < m; ++k) {
+  // The polygon's height range and area, in one pass.
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, twice = 0;
+  for (int k = 0, j = m - 1; k < m; j = k++) {
     const double h = height(poly[k]);
-    lo = k == 0 ? h : std::min(lo, h);
-    hi = k == 0 ? h : std::max(hi, h);
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+    twice += poly[j].s * poly[k].t - poly[j].t * poly[k].s;
   }
-  const double total = m > 0 ? 0.5 * TwiceArea(poly, m) : 0.0;
+  if (m == 0) lo = hi = 0;
+  const double total = 0.5 * std::abs(twice);
   auto below = [&](double level) {
     return level <= lo ? 0.0 : level >= hi ? total : AreaBelow(poly, m, height, level);
   };
