@@ -363,7 +363,7 @@ void AttributeSampler::SampleColumn(const Prepared& p, std::int64_t x, std::int6
 }
 
 void AttributeSampler::ColumnSampler::StartRow(std::int64_t u, std::int64_t v) {
-  Point2 poly[kClipCapacity];
+  Point2* poly = spare_row();
   int n;
   if (row_valid_ && v == row_v_ + 1) {  // the previous row's upper part, moved to this frame
     const double ds = static_cast<double>(u - row_u_);
@@ -382,12 +382,12 @@ void AttributeSampler::ColumnSampler::StartRow(std::int64_t u, std::int64_t v) {
   double hi = 0;
   for (int k = 0; k < n; ++k) hi = std::max(hi, poly[k].t);
   if (hi <= 1) {
-    std::copy(poly, poly + n, row_);
+    row_ ^= 1;
     row_n_ = n;
     above_n_ = 0;
   } else if (n > 0) {
     above_n_ =
-        CutByLine<true>(poly, n, above_, row_, &row_n_, [](const Point2& q) { return q.t - 1; });
+        CutByLine<true>(poly, n, above_, row(), &row_n_, [](const Point2& q) { return q.t - 1; });
   } else {
     row_n_ = above_n_ = 0;
   }
@@ -418,23 +418,22 @@ void AttributeSampler::ColumnSampler::ColumnPolygon(std::int64_t u, std::int64_t
   poly = buffer;
   m = 0;
   if (row_n_ > 0) {
-    double lo = row_[0].s, hi = lo;
-    for (int k = 1; k < row_n_; ++k) lo = std::min(lo, row_[k].s), hi = std::max(hi, row_[k].s);
+    const Point2* r = row();
+    double lo = r[0].s, hi = lo;
+    for (int k = 1; k < row_n_; ++k) lo = std::min(lo, r[k].s), hi = std::max(hi, r[k].s);
     if (next_u_ != u && lo < s_lo) {  // columns skipped (interior ones, or row start)
-      Point2 kept[kClipCapacity];
-      row_n_ = ClipHalfPlane(row_, row_n_, kept, [&](const Point2& q) { return q.s - s_lo; });
-      std::copy(kept, kept + row_n_, row_);
+      row_n_ =
+          ClipHalfPlane(row(), row_n_, spare_row(), [&](const Point2& q) { return q.s - s_lo; });
+      row_ ^= 1;
     }
     if (hi <= s_hi) {  // the row ends in this column
-      poly = row_;
+      poly = row();
       m = row_n_;
       row_n_ = 0;
     } else if (row_n_ > 0) {
-      Point2 rest[kClipCapacity];
-      const int rest_n = CutByLine<true>(row_, row_n_, rest, buffer, &m,
-                                         [&](const Point2& q) { return q.s - s_hi; });
-      std::copy(rest, rest + rest_n, row_);
-      row_n_ = rest_n;
+      row_n_ = CutByLine<true>(row(), row_n_, spare_row(), buffer, &m,
+                               [&](const Point2& q) { return q.s - s_hi; });
+      row_ ^= 1;
     }
   }
   next_u_ = u + 1;

@@ -140,12 +140,16 @@ class AttributeSampler {
 
     const AttributeSampler& sampler_;
     const Prepared& p_;
-    attributes_detail::Point2 row_[attributes_detail::kClipCapacity];
+    // The row's part not yet split off: rows_[row_], the other buffer taking each cut's result
+    // (no copies back).
+    attributes_detail::Point2* row() { return rows_[row_]; }
+    attributes_detail::Point2* spare_row() { return rows_[row_ ^ 1]; }
+    attributes_detail::Point2 rows_[2][attributes_detail::kClipCapacity];
     attributes_detail::Point2 above_[attributes_detail::kClipCapacity];
-    int row_n_ = 0, above_n_ = 0;
+    int row_ = 0, row_n_ = 0, above_n_ = 0;
     bool row_valid_ = false;
     std::int64_t row_u_ = 0, row_v_ = 0;  // the column the row's coordinates are relative to
-    std::int64_t next_u_ = 0;             // row_ holds only the part with u ≥ next_u_
+    std::int64_t next_u_ = 0;             // the row holds only the part with u ≥ next_u_
   };
   /// ColumnSampler::Sample() of a fresh sampler: one column, out of any order.
   void SampleColumn(const Prepared& p, std::int64_t x, std::int64_t y, std::int64_t z, int axis,
