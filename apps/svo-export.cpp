@@ -7,7 +7,7 @@
 #include "apps/app.hpp"
 #include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
-#include "svokit/svo/export.hpp"
+#include "svokit/export/export.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

@@ -10,9 +10,9 @@
 #include "apps/app.hpp"
 #include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
-#include "svokit/render/ray_cast.hpp"
-#include "svokit/render/slice.hpp"
-#include "svokit/svo/stats.hpp"
+#include "svokit/inspect/ray_cast.hpp"
+#include "svokit/inspect/slice.hpp"
+#include "svokit/inspect/stats.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

@@ -5,9 +5,10 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
+#include "formats/mesh_import.hpp"
 #include "formats/vfrag/vfrag.hpp"
 #include "svokit/core/parallel.hpp"
-#include "svokit/mesh/import.hpp"
+#include "svokit/export/voxel_writers.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 int main(int argc, char** argv) {

@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "formats/container/bytes.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 

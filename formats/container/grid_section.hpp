@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "formats/container/bytes.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/voxelize/voxel_set.hpp"

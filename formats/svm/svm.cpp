@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "formats/container/bytes.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 
 namespace svokit {

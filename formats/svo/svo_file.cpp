@@ -4,10 +4,9 @@
 #include <cstring>
 #include <map>
 
-#include "formats/container/bytes.hpp"
 #include "formats/container/grid_section.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/svo/build.hpp"
 
 namespace svokit {
 namespace {

@@ -62,10 +62,4 @@ StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::s
                                VfragMetadata* meta = nullptr);
 StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta = nullptr);
 
-/// Text export: "# origin X Y Z", "# voxel_size H", "# dims NX NY NZ" (round-trip precision),
-/// then "i j k" per voxel in Morton order.
-Status WriteVoxelsXyz(const VoxelSet& set, const std::filesystem::path& path);
-/// Binary little-endian PLY point cloud of voxel centres in world space.
-Status WriteVoxelsPly(const VoxelSet& set, const std::filesystem::path& path);
-
 }  // namespace svokit

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "svokit/mesh/import.hpp"
+#include "formats/mesh_import.hpp"
 
 namespace {
 

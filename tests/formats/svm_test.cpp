@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "formats/mesh_import.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/mesh/import.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

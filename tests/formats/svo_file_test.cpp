@@ -10,8 +10,8 @@
 #include <array>
 #include <map>
 
+#include "formats/mesh_import.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/mesh/import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"

@@ -1,4 +1,5 @@
 #include "formats/vfrag/vfrag.hpp"
+#include "svokit/export/voxel_writers.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // 128³ against the analytic circle in every view, contours measurably smoothing it, shading
 // normals, determinism over thread counts, and option errors.
 
-#include "svokit/render/ray_cast.hpp"
+#include "svokit/inspect/ray_cast.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // values, contour and brick figures on a real mesh against the octree's own arrays; grid slices
 // against the voxel set; PNG writing through the plugin.
 
-#include "svokit/svo/stats.hpp"
+#include "svokit/inspect/stats.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/inspect/slice.hpp"
 #include "svokit/mesh/image_codec.hpp"
-#include "svokit/render/slice.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit {

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "svokit/mesh/import.hpp"
+#include "formats/mesh_import.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

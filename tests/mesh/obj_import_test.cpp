@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "svokit/mesh/import.hpp"
+#include "formats/mesh_import.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

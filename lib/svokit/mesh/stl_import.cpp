@@ -8,7 +8,7 @@
 #include <cctype>
 #include <cstring>
 
-#include "formats/container/bytes.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/mesh/importers.hpp"
 #include "svokit/mesh/mesh_builder.hpp"
 #include "svokit/mesh/text_scanner.hpp"

@@ -1,8 +1,11 @@
 #include "svokit/mesh/texture.hpp"
 
+#include <algorithm>
 #include <mutex>
 
+#include "svokit/core/file_io.hpp"
 #include "svokit/mesh/image_codec.hpp"
+#include "svokit/mesh/importers.hpp"
 
 namespace svokit {
 
@@ -55,5 +58,34 @@ StatusOr<const Image*> Texture::Decoded() const {
   if (!cache_->status.ok()) return cache_->status;
   return &cache_->image;
 }
+
+namespace detail {
+
+void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
+                       Material& material, Mesh& mesh) {
+  // Windows exporters write "textures\\wood.jpg"; on POSIX that is one odd file name.
+  std::string portable = uri;
+  std::replace(portable.begin(), portable.end(), '\\', '/');
+  std::filesystem::path file = portable;
+  if (file.is_relative()) file = base_dir / file;
+  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file);
+  if (!bytes.ok() || bytes->empty()) {
+    material.missing_texture = uri;
+    mesh.warnings.push_back(fmt::format("material '{}': texture '{}' not found, using base colour",
+                                        material.name, uri));
+    return;
+  }
+  // Several materials often share one image: embed it once.
+  for (std::size_t i = 0; i < mesh.textures.size(); ++i) {
+    if (mesh.textures[i].name() == uri && mesh.textures[i].encoded() == *bytes) {
+      material.texture = static_cast<std::int32_t>(i);
+      return;
+    }
+  }
+  mesh.textures.emplace_back(uri, std::move(bytes).value());
+  material.texture = static_cast<std::int32_t>(mesh.textures.size() - 1);
+}
+
+}  // namespace detail
 
 }  // namespace svokit

@@ -1,16 +1,10 @@
 #include "svokit/svo/build.hpp"
 
 #include <algorithm>
-#include <bit>
 
 #include "svokit/svo/bricks.hpp"
 
 namespace svokit {
-
-std::uint32_t OctreeDepth(const GridTransform& grid) {
-  // At least one level above the voxels, so the root is always an inner node.
-  return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
-}
 
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth) {

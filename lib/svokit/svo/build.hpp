@@ -28,7 +28,5 @@ StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
 /// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending.
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth);
-/// The depth whose 2^depth cube encloses the grid.
-std::uint32_t OctreeDepth(const GridTransform& grid);
 
 }  // namespace svokit

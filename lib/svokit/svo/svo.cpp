@@ -1,5 +1,7 @@
 #include "svokit/svo/svo.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <iterator>
 
 #include <fmt/format.h>
@@ -57,6 +59,11 @@ std::string LevelTable(const Svo& svo) {
   fmt::format_to(std::back_inserter(out), "{:>5} {:>12} {:>12} {:>10} {:>12} {:>13} {:>11}\n",
                  "all", "", "", "", sum.nodes, sum.bricks, sum.contours);
   return out;
+}
+
+std::uint32_t OctreeDepth(const GridTransform& grid) {
+  // At least one level above the voxels, so the root is always an inner node.
+  return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
 }
 
 }  // namespace svokit

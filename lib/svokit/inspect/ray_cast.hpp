@@ -13,7 +13,7 @@
 
 #include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
-#include "svokit/render/image.hpp"
+#include "svokit/inspect/image.hpp"
 #include "svokit/svo/svo.hpp"
 
 namespace svokit {

@@ -1,5 +1,3 @@
-#include "svokit/svo/export.hpp"
-
 #include <algorithm>
 #include <array>
 #include <map>
@@ -8,59 +6,15 @@
 
 #include <fmt/format.h>
 
-#include "formats/container/bytes.hpp"
-#include "formats/vfrag/vfrag.hpp"
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/export/voxel_writers.hpp"
+#include "svokit/svo/sample_codec.hpp"
 
 namespace svokit {
 
 namespace {
-
-// The brick samples that stand for a node as a whole: the centre of an odd brick, the 8 corners
-// of an even one (their opacity-weighted mean is then the node's value).
-std::vector<std::uint32_t> NodeSamples(std::uint32_t side) {
-  if (side == 0) return {};
-  if (side % 2 == 1) return {side / 2 * (1 + side + side * side)};
-  std::vector<std::uint32_t> corners;
-  for (std::uint32_t c = 0; c < 8; ++c) {
-    const std::uint32_t x = c & 1 ? side - 1 : 0, y = c & 2 ? side - 1 : 0,
-                        z = c & 4 ? side - 1 : 0;
-    corners.push_back(x + side * (y + side * z));
-  }
-  return corners;
-}
-
-// Buffers output in 1 MiB pieces for an AtomicFileWriter: binvox's size grows with the cube, not
-// with the voxels, so it is streamed rather than held whole.
-class StreamedFile {
- public:
-  explicit StreamedFile(const std::filesystem::path& path) : file_(path) { status_ = file_.Open(); }
-  void Put(std::string_view text) {
-    buffer_.insert(buffer_.end(), text.begin(), text.end());
-    if (buffer_.size() >= (1u << 20)) Flush();
-  }
-  void Put(std::uint8_t byte) {
-    buffer_.push_back(byte);
-    if (buffer_.size() >= (1u << 20)) Flush();
-  }
-  const Status& status() const { return status_; }
-  Status Commit() {
-    Flush();
-    return status_.ok() ? file_.Commit() : status_;
-  }
-
- private:
-  void Flush() {
-    if (status_.ok()) status_ = file_.Write(buffer_);
-    buffer_.clear();
-  }
-
-  AtomicFileWriter file_;
-  Status status_;
-  std::vector<std::uint8_t> buffer_;
-};
 
 std::uint32_t Channel(std::uint32_t rgb, int channel) {
   return rgb >> (8 * channel) & 0xffu;
@@ -188,90 +142,6 @@ constexpr std::uint32_t kVoxTile = 256;  // MagicaVoxel stores model coordinates
 
 }  // namespace
 
-const std::vector<std::string>& ExportExtensions() {
-  static const std::vector<std::string> kExtensions = {"vdb", "binvox", "vox", "ply", "xyz"};
-  return kExtensions;
-}
-
-VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
-  VoxelSet set;
-  const std::uint32_t shift = svo.depth - level;
-  std::array<std::uint32_t, 3> dims = svo.grid.dims();
-  for (std::uint32_t& d : dims) d = ((d - 1) >> shift) + 1;
-  set.grid = GridTransform(svo.grid.origin(), svo.NodeSize(level), dims);
-  set.mode = svo.mode;
-  const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
-  set.keys.assign(keys.begin(), keys.end());
-  const std::vector<std::uint32_t> samples = NodeSamples(svo.brick_side);
-  if (samples.empty()) return set;
-  if (svo.has_color) set.colors.resize(set.keys.size());
-  if (svo.has_normal) set.normals.resize(set.keys.size());
-  ParallelChunks(set.keys.size(), 4096, [&](std::size_t begin, std::size_t end) {
-    std::vector<BrickSample> s(samples.size());
-    for (std::size_t i = begin; i < end; ++i) {
-      float total = 0;
-      for (std::size_t k = 0; k < samples.size(); ++k) {
-        s[k] = svo.Sample(level, i, samples[k]);
-        total += s[k].opacity;
-      }
-      Rgba color{0, 0, 0, 0};
-      Vec3f normal{0, 0, 0};
-      for (const BrickSample& b : s) {
-        // An all-empty set of samples (possible only at coarse corners) falls back to a plain mean.
-        const float w = total > 0 ? b.opacity / total : 1.f / static_cast<float>(s.size());
-        color = {color.r + w * b.color.r, color.g + w * b.color.g, color.b + w * b.color.b,
-                 color.a + w * b.color.a};
-        normal = normal + b.normal * w;
-      }
-      if (svo.has_color) set.colors[i] = color;
-      if (svo.has_normal) {
-        const float len = Length(normal);
-        set.normals[i] = len > 0 ? normal / len : normal;
-      }
-    }
-  });
-  return set;
-}
-
-Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path) {
-  const std::uint64_t d = voxels.grid.max_dim();
-  // The cube is stored whole (runs of at most 255): beyond 4096³ the empty runs alone pass 0.5 GB.
-  if (d > 4096) {
-    return Status::BadInput("{}: a {}³ binvox cube is too large; export a coarser --level",
-                            path.string(), d);
-  }
-  std::vector<std::uint64_t> order(voxels.keys.size());
-  std::transform(voxels.keys.begin(), voxels.keys.end(), order.begin(), [d](std::uint64_t key) {
-    const MortonCoord c = MortonDecode(key);
-    return (std::uint64_t{c.x} * d + c.z) * d + c.y;  // y fastest, then z, then x
-  });
-  std::sort(order.begin(), order.end());
-
-  StreamedFile out(path);
-  if (!out.status().ok()) return out.status();
-  const Vec3d& o = voxels.grid.origin();
-  // binvox maps voxel i to translate + (i + ½)/d · scale: scale is the cube's world edge.
-  out.Put(fmt::format("#binvox 1\ndim {} {} {}\ntranslate {} {} {}\nscale {}\ndata\n", d, d, d, o.x,
-                      o.y, o.z, static_cast<double>(d) * voxels.grid.voxel_size()));
-  auto run = [&out](std::uint8_t value, std::uint64_t n) {
-    for (; n > 0; n -= std::min<std::uint64_t>(n, 255)) {
-      out.Put(value);
-      out.Put(static_cast<std::uint8_t>(std::min<std::uint64_t>(n, 255)));
-    }
-  };
-  std::uint64_t next = 0;  // first index not yet written
-  for (std::size_t i = 0; i < order.size();) {
-    std::size_t j = i + 1;
-    while (j < order.size() && order[j] == order[j - 1] + 1) ++j;
-    run(0, order[i] - next);
-    run(1, j - i);
-    next = order[j - 1] + 1;
-    i = j;
-  }
-  run(0, d * d * d - next);
-  return out.Commit();
-}
-
 Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path) {
   std::vector<std::uint32_t> rgb(voxels.size(), 0xffffffu);  // white without colours
   if (voxels.has_colors()) {
@@ -357,33 +227,6 @@ Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path)
   children.PutArray<std::uint8_t>(scene.bytes());
   PutChunk(out, "MAIN", {}, std::move(children));
   return WriteFileAtomic(path, out.bytes());
-}
-
-Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options) {
-  const std::string ext = LowerExtension(path);
-  const auto& known = ExportExtensions();
-  if (std::find(known.begin(), known.end(), ext) == known.end()) {
-    return Status::BadInput("{}: unknown export format (use .vdb, .binvox, .vox, .ply or .xyz)",
-                            path.string());
-  }
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    return Status::BadInput("{}: is a directory, not a file", path.string());
-  }
-  const std::uint32_t level = options.level.value_or(svo.depth);
-  if (level > svo.depth) {
-    return Status::BadInput("{}: level {} does not exist (the octree has levels 0 to {})",
-                            path.string(), level, svo.depth);
-  }
-  if (level >= svo.levels.size()) {
-    return Status::BadInput("{}: level {} was not loaded", path.string(), level);
-  }
-  const VoxelSet voxels = LevelVoxels(svo, level);
-  if (ext == "vdb") return WriteVoxelsVdb(voxels, path);
-  if (ext == "binvox") return WriteVoxelsBinvox(voxels, path);
-  if (ext == "vox") return WriteVoxelsVox(voxels, path);
-  if (ext == "ply") return WriteVoxelsPly(voxels, path);
-  return WriteVoxelsXyz(voxels, path);
 }
 
 }  // namespace svokit

@@ -13,9 +13,9 @@
 #include <set>
 #include <sstream>
 
-#include "svokit/mesh/import.hpp"
+#include "formats/mesh_import.hpp"
+#include "svokit/export/export.hpp"
 #include "svokit/svo/build.hpp"
-#include "svokit/svo/export.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 

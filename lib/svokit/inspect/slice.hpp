@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "svokit/core/status.hpp"
-#include "svokit/render/image.hpp"
+#include "svokit/inspect/image.hpp"
 #include "svokit/svo/svo.hpp"
 
 namespace svokit {

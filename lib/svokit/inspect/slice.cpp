@@ -1,4 +1,4 @@
-#include "svokit/render/slice.hpp"
+#include "svokit/inspect/slice.hpp"
 
 #include <algorithm>
 #include <array>

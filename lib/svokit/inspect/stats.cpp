@@ -1,4 +1,4 @@
-#include "svokit/svo/stats.hpp"
+#include "svokit/inspect/stats.hpp"
 
 #include <algorithm>
 #include <bit>

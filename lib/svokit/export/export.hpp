@@ -35,14 +35,4 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
 /// of its 8 corners (side 2); without bricks only occupancy.
 VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level);
 
-/// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
-/// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).
-Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path);
-/// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
-/// scene graph at its grid position; colours median-cut into at most 255 palette entries.
-Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
-/// OpenVDB: BoolGrid "occupancy", Vec3f grids "color" (linear RGB) and "normal" when present, all
-/// sharing a transform whose voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp).
-Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path);
-
 }  // namespace svokit

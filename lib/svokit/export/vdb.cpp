@@ -7,7 +7,7 @@
 #include <openvdb/openvdb.h>
 
 #include "svokit/core/file_io.hpp"
-#include "svokit/svo/export.hpp"
+#include "svokit/export/voxel_writers.hpp"
 
 namespace svokit {
 

@@ -1,4 +1,4 @@
-#include "svokit/render/ray_cast.hpp"
+#include "svokit/inspect/ray_cast.hpp"
 
 #include <algorithm>
 #include <array>

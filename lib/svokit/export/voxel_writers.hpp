@@ -1,0 +1,30 @@
+#pragma once
+// Writers of voxels in other tools' formats, one file each: binvox.cpp, vox.cpp, points.cpp (PLY
+// points and xyz text), vdb.cpp (OpenVDB, in the svokit_export library so that only the tools that
+// write .vdb load OpenVDB). Each writes atomically: a complete file or none.
+
+#include <filesystem>
+
+#include "svokit/core/status.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+/// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
+/// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).
+Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path);
+/// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
+/// scene graph at its grid position; colours median-cut into at most 255 palette entries.
+Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
+/// OpenVDB: BoolGrid "occupancy", Vec3f grids "color" (linear RGB) and "normal" when present, all
+/// sharing a transform whose voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp).
+Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path);
+
+/// Text: "# origin X Y Z", "# voxel_size H", "# dims NX NY NZ" (round-trip precision), then
+/// "i j k" per voxel in Morton order.
+Status WriteVoxelsXyz(const VoxelSet& voxels, const std::filesystem::path& path);
+/// Binary little-endian PLY point cloud of voxel centres in world space, with normals and sRGB
+/// colours when the set has them.
+Status WriteVoxelsPly(const VoxelSet& voxels, const std::filesystem::path& path);
+
+}  // namespace svokit
