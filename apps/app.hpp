@@ -20,11 +20,11 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
-#include "formats/mesh_import.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 
 namespace svokit::app {
 

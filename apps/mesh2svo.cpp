@@ -7,8 +7,8 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

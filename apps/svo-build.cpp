@@ -7,9 +7,9 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
-#include "formats/svo/svo_file.hpp"
-#include "formats/vfrag/vfrag.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

@@ -5,9 +5,9 @@
 #include <optional>
 
 #include "apps/app.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/export.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

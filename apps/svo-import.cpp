@@ -3,10 +3,10 @@
 #include <filesystem>
 
 #include "apps/app.hpp"
-#include "formats/mesh_import.hpp"
-#include "formats/svm/svm.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/mesh_report.hpp"
 
 int main(int argc, char** argv) {

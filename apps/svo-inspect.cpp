@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/app.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "apps/app.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/validate/validate.hpp"
 
 int main(int argc, char** argv) {

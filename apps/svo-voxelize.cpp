@@ -5,10 +5,10 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
-#include "formats/mesh_import.hpp"
-#include "formats/vfrag/vfrag.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/voxel_writers.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 int main(int argc, char** argv) {

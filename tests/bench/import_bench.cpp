@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 
 namespace {
 

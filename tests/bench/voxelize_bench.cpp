@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {

@@ -6,8 +6,8 @@
 #include <functional>
 #include <sstream>
 
-#include "formats/svo/svo_file.hpp"
-#include "formats/vfrag/vfrag.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
 namespace svokit::test {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "formats/vfrag/vfrag.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
 namespace svokit::test {

@@ -13,8 +13,8 @@
 #include <set>
 #include <sstream>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/export/export.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"

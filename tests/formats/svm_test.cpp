@@ -1,9 +1,9 @@
-#include "formats/svm/svm.hpp"
+#include "svokit/formats/svm/svm.hpp"
 
 #include <gtest/gtest.h>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

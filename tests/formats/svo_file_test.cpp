@@ -2,7 +2,7 @@
 // every brick option, files on disk, loading the top levels only, and rejection of corrupt,
 // truncated and structurally inconsistent files with a message naming the file.
 
-#include "formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 #include <array>
 #include <map>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"

@@ -1,4 +1,4 @@
-#include "formats/vfrag/vfrag.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/export/voxel_writers.hpp"
 
 #include <gtest/gtest.h>
@@ -9,9 +9,9 @@
 #include <random>
 #include <sstream>
 
-#include "formats/container/grid_section.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/key_gaps.hpp"
+#include "svokit/formats/container/grid_section.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

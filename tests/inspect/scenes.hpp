@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_meshes.hpp"

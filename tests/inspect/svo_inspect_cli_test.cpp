@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "tests/cli/run_tool.hpp"
 

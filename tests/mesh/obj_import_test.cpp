@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

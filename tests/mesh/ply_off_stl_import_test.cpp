@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/importers.hpp"
 #include "tests/test_util.hpp"
 

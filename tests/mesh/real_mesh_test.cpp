@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/mesh_report.hpp"
 #include "tests/test_util.hpp"
 

@@ -22,8 +22,8 @@
 #include <set>
 #include <unordered_map>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"

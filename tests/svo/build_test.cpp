@@ -12,10 +12,10 @@
 #include <map>
 #include <set>
 
-#include "formats/mesh_import.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 

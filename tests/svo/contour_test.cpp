@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/validate/contour_surface.hpp"
 #include "svokit/voxelize/voxelize.hpp"

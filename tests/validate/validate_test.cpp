@@ -14,10 +14,10 @@
 
 #include <fmt/format.h>
 
-#include "formats/mesh_import.hpp"
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/voxelize/voxel_space.hpp"

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "formats/mesh_import.hpp"
-#include "formats/vfrag/vfrag.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "formats/mesh_import.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/mesh_report.hpp"
 #include "svokit/voxelize/triangle_voxel_test.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/validate/report.hpp"

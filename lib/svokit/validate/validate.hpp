@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "formats/svo/svo_file.hpp"
 #include "svokit/core/progress.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/validate/report.hpp"
 

@@ -1,12 +1,12 @@
-#include "formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 
 #include <bit>
 #include <cstring>
 #include <map>
 
-#include "formats/container/grid_section.hpp"
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/container/grid_section.hpp"
 
 namespace svokit {
 namespace {

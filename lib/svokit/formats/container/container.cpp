@@ -1,4 +1,4 @@
-#include "formats/container/container.hpp"
+#include "svokit/formats/container/container.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>

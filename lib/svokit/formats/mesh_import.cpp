@@ -1,9 +1,9 @@
-#include "formats/mesh_import.hpp"
+#include "svokit/formats/mesh_import.hpp"
 
 #include <unistd.h>
 
-#include "formats/svm/svm.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/importers.hpp"
 
 namespace svokit {

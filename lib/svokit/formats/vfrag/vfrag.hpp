@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "formats/container/container.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/container/container.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {

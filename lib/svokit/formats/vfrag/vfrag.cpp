@@ -1,4 +1,4 @@
-#include "formats/vfrag/vfrag.hpp"
+#include "svokit/formats/vfrag/vfrag.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -7,13 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "formats/container/grid_section.hpp"
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
+#include "svokit/formats/container/grid_section.hpp"
 
 namespace svokit {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "formats/container/container.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/container/container.hpp"
 #include "svokit/mesh/mesh.hpp"
 
 namespace svokit {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "formats/container/container.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/container/container.hpp"
 #include "svokit/svo/svo.hpp"
 
 namespace svokit {

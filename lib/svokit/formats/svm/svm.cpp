@@ -1,4 +1,4 @@
-#include "formats/svm/svm.hpp"
+#include "svokit/formats/svm/svm.hpp"
 
 #include <nlohmann/json.hpp>
 
