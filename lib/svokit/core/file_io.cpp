@@ -121,7 +121,7 @@ Status AtomicFileWriter::WriteAt(std::uint64_t offset, std::span<const std::uint
 
 // An existing target is swapped with the temporary (one atomic step, as a rename over it) and
 // then unlinked: ext4 starts writing back a file renamed over another one (auto_da_alloc) inside
-// the rename, ~0.1 s for 300 MB here; the swap does not. Plain rename where there is no target
+// the rename, which then waits on the disk; the swap does not. Plain rename where there is no target
 // or the file system cannot swap, and for a directory (which a swap would move).
 bool AtomicFileWriter::ReplaceWithTemporary() const {
   struct stat target {};

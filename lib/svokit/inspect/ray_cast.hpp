@@ -1,9 +1,9 @@
 #pragma once
 // A CPU ray caster over the sparse voxel octree, showing what an ESVO-style renderer would:
 // orthographic views fitted to the grid, ordered front-to-back child traversal with the ray
-// mirrored into the positive octant (seed 001 §1.4.4; Laine & Karras 2010), and contour slabs
-// narrowing each node's t-span (a node's slab ∩ its cube ∩ its ancestors' slabs). A leaf (a node
-// of the render level) whose narrowed span is non-empty is hit at the span's entry.
+// mirrored into the positive octant (Laine & Karras 2010, "Efficient Sparse Voxel Octrees"), and
+// contour slabs narrowing each node's t-span (a node's slab ∩ its cube ∩ its ancestors' slabs).
+// A leaf (a node of the render level) whose narrowed span is non-empty is hit at the span's entry.
 
 #include <array>
 #include <cstdint>

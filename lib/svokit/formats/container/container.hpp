@@ -84,7 +84,7 @@ class Writer {
 /// temporary file mapped in memory (from any threads), and Commit() lays the sections out,
 /// checksums them and renames the file into place. Nothing is copied into the file afterwards,
 /// and no second set of fresh pages is touched: the bytes are written once, where the file keeps
-/// them (a 290 MB .vfrag: the page-cache copy of Writer::WriteFile was ~0.3 s of 1.6 here).
+/// them.
 /// Region sizes need not be known up front: rooms are planned, and Commit() moves each region's
 /// used part to its final place.
 class MappedWriter {
