@@ -65,7 +65,7 @@ MeshReport AnalyzeMesh(const Mesh& mesh, const std::string& source, const Report
                        Progress& progress = Progress::Silent());
 
 std::string FormatReportText(const MeshReport& report);
-/// Stable keys, documented in README ("svo-import --json").
+/// Stable keys, documented in docs/tools/svo-import.md.
 std::string FormatReportJson(const MeshReport& report);
 
 namespace detail {

@@ -1,6 +1,6 @@
 #pragma once
 // The checks svo-validate runs on a decoded file, one CheckResult each (report.hpp). Finding
-// kinds are stable keys, listed in the README's svo-validate section.
+// kinds are stable keys, listed in docs/tools/svo-validate.md.
 
 #include <cstdint>
 #include <vector>

@@ -1,7 +1,7 @@
 #pragma once
 // svo-validate's findings: one CheckResult per check (structure, bricks, contours, occupancy,
 // contour_surface), each with counts per finding kind, the first few findings, and statistics;
-// rendered as text or as JSON with stable keys (README, "svo-validate").
+// rendered as text or as JSON with stable keys (docs/tools/svo-validate.md).
 
 #include <array>
 #include <cstdint>
