@@ -22,7 +22,8 @@ struct Plugin {
 };
 
 // Candidates, in order: $SVOKIT_PLUGIN_DIR, the running executable's ../lib and its own folder,
-// the build tree this library was built in, then the dynamic loader's search path.
+// the build tree this library was built in, the configured install prefix's lib (for programs of
+// other projects linking the installed library), then the dynamic loader's search path.
 const Plugin& LoadPlugin() {
   static Plugin plugin;
   static std::once_flag once;
@@ -40,6 +41,9 @@ const Plugin& LoadPlugin() {
     }
 #ifdef SVOKIT_PLUGIN_BUILD_DIR
     candidates.push_back(std::string(SVOKIT_PLUGIN_BUILD_DIR) + "/" + kPluginName);
+#endif
+#ifdef SVOKIT_PLUGIN_INSTALL_DIR
+    candidates.push_back(std::string(SVOKIT_PLUGIN_INSTALL_DIR) + "/" + kPluginName);
 #endif
     candidates.push_back(kPluginName);
     for (const std::string& path : candidates) {
