@@ -43,6 +43,7 @@ struct CommonOptions {
 /// "conservative|thin": the option text every tool sets), and its default after the description.
 class HelpFormatter : public CLI::Formatter {
  public:
+  // The names alone: CLI11 marks a negated flag's names with "{false}".
   std::string make_option_name(const CLI::Option* opt, bool positional) const override {
     if (positional) return opt->get_name(true, false);
     std::string names;

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
   app::AddFile(cli, "-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
   cli.add_option("--level", level,
-                 "Export the nodes of this octree level (0 = root) as voxels of its node size; "
-                 "default: the voxels")
+                 "Export the nodes of this octree level (0 = root) as voxels of its node size "
+                 "(default: the voxels)")
       ->option_text("L");
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
