@@ -12,10 +12,12 @@
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <new>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -37,11 +39,52 @@ struct CommonOptions {
   }
 };
 
-inline void AddCommonOptions(CLI::App& cli, CommonOptions& options) {
+/// --help that reads well: each option's value as a word or a list of choices ("N", "FILE",
+/// "conservative|thin": the option text every tool sets), and its default after the description.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  // The names alone: CLI11 marks a negated flag's names with "{false}".
+  std::string make_option_name(const CLI::Option* opt, bool positional) const override {
+    if (positional) return opt->get_name(true, false);
+    std::string names;
+    for (const std::string& s : opt->get_snames()) names += (names.empty() ? "-" : ",-") + s;
+    for (const std::string& l : opt->get_lnames()) names += (names.empty() ? "--" : ",--") + l;
+    return names;
+  }
+  std::string make_option_opts(const CLI::Option* opt) const override {
+    std::string out;
+    if (opt->get_type_size() != 0) {
+      out += " " + (opt->get_option_text().empty() ? opt->get_type_name() : opt->get_option_text());
+      if (opt->get_required()) out += " REQUIRED";
+    }
+    for (const CLI::Option* other : opt->get_excludes())
+      out += " (not with " + other->get_name() + ")";
+    return out;
+  }
+  std::string make_option_desc(const CLI::Option* opt) const override {
+    const std::string default_value = opt->get_default_str();
+    return default_value.empty() ? opt->get_description()
+                                 : opt->get_description() + " (default: " + default_value + ")";
+  }
+};
+
+/// What every tool's command line has: --version, --quiet, --threads, the help's layout and, at
+/// its end, `example`: one command line that shows the tool at work.
+inline void AddCommonOptions(CLI::App& cli, CommonOptions& options, std::string_view example) {
+  cli.formatter(std::make_shared<HelpFormatter>());
+  cli.footer(fmt::format("Example:\n  {}", example));
   cli.set_version_flag("--version", std::string("svokit ") + SVOKIT_VERSION);
   cli.add_flag("-q,--quiet", options.quiet, "No progress output on stderr");
-  cli.add_option("-j,--threads", options.threads, "Worker threads (0 = all cores)")
+  cli.add_option("-j,--threads", options.threads, "Worker threads; 0 = all cores")
+      ->option_text("N")
+      ->capture_default_str()
       ->check(CLI::Range(0, 4096));
+}
+
+/// An option naming a file (`flags` "input" for the positional one), shown as FILE in --help.
+inline CLI::Option* AddFile(CLI::App& cli, const std::string& flags, std::filesystem::path& path,
+                            const std::string& description) {
+  return cli.add_option(flags, path, description)->option_text("FILE");
 }
 
 /// Checks an output path before any work is done: its extension is one of `extensions` and its
@@ -62,25 +105,39 @@ inline Status CheckOutputPath(const std::filesystem::path& path,
   return Status::Ok();
 }
 
-/// Imports `input` as the "import" stage of `progress` (no "done" line when it fails).
-inline StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& input) {
-  Progress::Stage stage(progress, "import", 1);
-  StatusOr<Mesh> mesh = ImportMesh(input);
-  if (mesh.ok()) {
-    stage.SetSummary(fmt::format("{} triangles", mesh->triangle_count()));
+/// Runs `work` as the stage `name` of `progress` and returns what it returns. A result that is
+/// not ok (a Status or StatusOr) cancels the stage: no "done" line.
+template <class Work>
+auto RunStage(Progress& progress, std::string name, const Work& work) -> decltype(work()) {
+  Progress::Stage stage(progress, std::move(name), 1);
+  auto result = work();
+  if constexpr (requires { result.ok(); }) {
+    if (!result.ok()) stage.Cancel();
+  }
+  return result;
+}
+
+/// The same, with `summarize(result)` appended to the "done" line of a stage that succeeds.
+template <class Work, class Summarize>
+auto RunStage(Progress& progress, std::string name, const Work& work, const Summarize& summarize)
+    -> decltype(work()) {
+  Progress::Stage stage(progress, std::move(name), 1);
+  auto result = work();
+  if (result.ok()) {
+    stage.SetSummary(summarize(result));
   } else {
     stage.Cancel();
   }
-  return mesh;
+  return result;
 }
 
-/// Runs `read` (returning a StatusOr) as the "read" stage of `progress`.
-template <class Read>
-auto ReadStage(Progress& progress, const Read& read) -> decltype(read()) {
-  Progress::Stage stage(progress, "read", 1);
-  auto result = read();
-  if (!result.ok()) stage.Cancel();
-  return result;
+/// Imports `input` as the "import" stage of `progress`.
+inline StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& input) {
+  return RunStage(
+      progress, "import", [&] { return ImportMesh(input); },
+      [](const StatusOr<Mesh>& mesh) {
+        return fmt::format("{} triangles", mesh->triangle_count());
+      });
 }
 
 /// Reads levels 0..`level` of an octree (all of them without `level`; the deeper ones stay on
@@ -88,7 +145,7 @@ auto ReadStage(Progress& progress, const Read& read) -> decltype(read()) {
 /// bad input.
 inline StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& input,
                                   std::optional<std::uint32_t> level) {
-  StatusOr<Svo> svo = ReadStage(progress, [&] { return ReadSvo(input, level); });
+  StatusOr<Svo> svo = RunStage(progress, "read", [&] { return ReadSvo(input, level); });
   if (svo.ok() && level && *level > svo->depth) {
     return Status::BadInput("{}: --level {} exceeds the octree's depth {}", input.string(), *level,
                             svo->depth);
@@ -107,6 +164,11 @@ inline StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem
                             mesh_path.string(), input.string(), made);
   }
   return mesh;
+}
+
+/// Prints each of `warnings` as one line on stderr.
+inline void Warn(const std::string& tool, const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
 }
 
 /// Prints `status` as one line on stderr and returns its exit code.

@@ -14,48 +14,87 @@
 
 namespace svokit::app {
 
+/// The command line's names of the voxel modes and methods.
+inline const std::map<std::string, VoxelMode> kVoxelModes = {
+    {"conservative", VoxelMode::kConservative}, {"thin", VoxelMode::kThin}};
+inline const std::map<std::string, VoxelMethod> kVoxelMethods = {
+    {"triangle", VoxelMethod::kTriangle},
+    {"fragment", VoxelMethod::kFragment},
+    {"hybrid", VoxelMethod::kHybrid}};
+
+/// The name of `value` in `names` ("" for none).
+template <class Enum>
+std::string NameOf(const std::map<std::string, Enum>& names, Enum value) {
+  for (const auto& [name, v] : names) {
+    if (v == value) return name;
+  }
+  return "";
+}
+
+/// An option taking one of `names` (any case), shown as "a|b|c" in --help with its default.
+template <class Enum>
+CLI::Option* AddChoice(CLI::App& cli, const std::string& flags, Enum& value,
+                       const std::map<std::string, Enum>& names, const std::string& order,
+                       const std::string& description) {
+  return cli.add_option(flags, value, description)
+      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case).description(""))
+      ->option_text(order)
+      ->default_str(NameOf(names, value));
+}
+
 struct VoxelizeCli {
   std::uint32_t resolution = 0, pad = 0;
   double voxel_size = 0;
   std::string attributes = "color,normal";
-  VoxelizeOptions options;
+  /// Mode, method and cutoff as given; Options() adds the attributes.
+  VoxelizeOptions parsed;
 
   void Add(CLI::App& cli) {
-    auto* res = cli.add_option("-r,--resolution", resolution, "Voxels along the longest axis")
+    auto* res = cli.add_option("-r,--resolution", resolution,
+                               "Voxels along the longest axis; this or --voxel-size is required")
+                    ->option_text("N")
                     ->check(CLI::Range(1u, 1u << 20));
     auto* size = cli.add_option("--voxel-size", voxel_size, "Voxel edge length in world units")
+                     ->option_text("SIZE")
                      ->check(CLI::PositiveNumber);
     res->excludes(size);
     size->excludes(res);
-    cli.add_option("--pad", pad, "Empty voxels added on every side")->check(CLI::Range(0u, 1024u));
-    cli.add_option("--mode", options.mode, "conservative (26-separating) or thin (6-separating)")
-        ->transform(CLI::CheckedTransformer(
-            std::map<std::string, VoxelMode>{{"conservative", VoxelMode::kConservative},
-                                             {"thin", VoxelMode::kThin}},
-            CLI::ignore_case));
-    cli.add_option("--method", options.method, "triangle, fragment or hybrid (same voxels)")
-        ->transform(CLI::CheckedTransformer(
-            std::map<std::string, VoxelMethod>{{"triangle", VoxelMethod::kTriangle},
-                                               {"fragment", VoxelMethod::kFragment},
-                                               {"hybrid", VoxelMethod::kHybrid}},
-            CLI::ignore_case));
+    cli.add_option("--pad", pad, "Empty voxels added on every side")
+        ->option_text("N")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1024u));
+    AddChoice(cli, "--mode", parsed.mode, kVoxelModes, "conservative|thin",
+              "Conservative voxels are 26-separating, thin ones 6-separating");
+    AddChoice(cli, "--method", parsed.method, kVoxelMethods, "triangle|fragment|hybrid",
+              "How the work is split; every method gives the same voxels");
     cli.add_option("--attributes", attributes,
-                   "Per-voxel attributes: color,normal (area-weighted, textures filtered), color, "
-                   "normal, or none (geometry only)")
-        ->check(CLI::IsMember({"color,normal", "normal,color", "color", "normal", "none"}));
-    cli.add_option("--hybrid-cutoff", options.hybrid_cutoff,
+                   "Per-voxel attributes: colour and normal (area-weighted, textures filtered), "
+                   "one of them, or none (geometry only)")
+        ->check(CLI::IsMember({"color,normal", "normal,color", "color", "normal", "none"})
+                    .description(""))
+        ->option_text("color,normal|color|normal|none")
+        ->capture_default_str();
+    cli.add_option("--hybrid-cutoff", parsed.hybrid_cutoff,
                    "Hybrid: projected area (voxel²) above which a triangle takes the fragment path")
+        ->option_text("AREA")
+        ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
   }
 
-  /// After parsing: the grid option is present; the attribute flags are set.
-  Status Finish() {
+  /// The grid is given, by --resolution or --voxel-size.
+  Status Check() const {
     if (resolution == 0 && voxel_size == 0) {
       return Status::BadInput("give the grid as --resolution N or --voxel-size S");
     }
-    options.colors = attributes.find("color") != std::string::npos;
-    options.normals = attributes.find("normal") != std::string::npos;
     return Status::Ok();
+  }
+
+  /// The voxelizer's options: those given and the attributes asked for.
+  VoxelizeOptions Options() const {
+    VoxelizeOptions o = parsed;
+    o.colors = attributes.find("color") != std::string::npos;
+    o.normals = attributes.find("normal") != std::string::npos;
+    return o;
   }
 
   StatusOr<GridTransform> Grid(const Box3d& bounds) const {
@@ -63,12 +102,13 @@ struct VoxelizeCli {
                           : GridTransform::FitVoxelSize(bounds, voxel_size, pad);
   }
 
+  std::string ModeName() const { return NameOf(kVoxelModes, parsed.mode); }
+
   /// What shapes the voxels, as the command line spells it (methods and threads do not).
   std::string Recorded() const {
     const std::string grid = resolution > 0 ? fmt::format("--resolution {}", resolution)
                                             : fmt::format("--voxel-size {}", voxel_size);
-    return fmt::format("{} --pad {} --mode {} --attributes {}", grid, pad,
-                       options.mode == VoxelMode::kThin ? "thin" : "conservative", attributes);
+    return fmt::format("{} --pad {} --mode {} --attributes {}", grid, pad, ModeName(), attributes);
   }
 };
 
@@ -80,9 +120,11 @@ struct BuildCli {
     cli.add_option("--bricks", bricks,
                    "Brick samples per node: 3 (3x3x3: corners, edges, faces, centre), 2 (corners) "
                    "or none")
-        ->check(CLI::IsMember({"3", "2", "none"}));
+        ->check(CLI::IsMember({"3", "2", "none"}).description(""))
+        ->option_text("3|2|none")
+        ->capture_default_str();
     cli.add_flag("--contours,!--no-contours", contours,
-                 "ESVO contour slabs fitted to the surface (default on; needs the mesh)");
+                 "ESVO contour slabs fitted to the surface; they need the mesh (default: on)");
   }
 
   BuildOptions Options() const {

@@ -3,8 +3,6 @@
 
 #include <filesystem>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
 #include "svokit/core/parallel.hpp"
@@ -21,15 +19,15 @@ int main(int argc, char** argv) {
   app::VoxelizeCli voxelize;
   app::BuildCli build;
   app::CommonOptions common;
-  cli.add_option("input", input, "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
+  app::AddFile(cli, "input", input, "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
       ->required();
-  cli.add_option("-o,--output", output, "Output .svo")->required();
+  app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
   voxelize.Add(cli);
   build.Add(cli);
-  app::AddCommonOptions(cli, common);
+  app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, [&] {
-    if (Status s = voxelize.Finish(); !s.ok()) return app::Fail(tool, s);
+    if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
     if (Status s = app::CheckOutputPath(output, {"svo"}); !s.ok()) return app::Fail(tool, s);
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
@@ -38,31 +36,22 @@ int main(int argc, char** argv) {
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
     StatusOr<GridTransform> grid = voxelize.Grid(mesh->Bounds());
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
-    StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.options, progress);
+    StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.Options(), progress);
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
-    for (const std::string& w : voxels->warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
+    app::Warn(tool, voxels->warnings);
 
-    // The same metadata svo-voxelize + svo-build record, so both routes give the same file.
-    const nlohmann::json meta = {{"source", input.filename().string()},
-                                 {"voxelize", voxelize.Recorded()},
-                                 {"build", build.Recorded()},
-                                 {"generator", "svokit " SVOKIT_VERSION}};
-    StatusOr<Svo> svo = BuildSvo(*voxels, &*mesh, build.Options(), meta.dump(), progress);
+    const std::string meta =
+        SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
+    StatusOr<Svo> svo = BuildSvo(*voxels, &*mesh, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
-    Status written;
-    {
-      Progress::Stage stage(progress, "write", 1);
-      written = WriteSvo(*svo, output);
-      if (!written.ok()) stage.Cancel();
-    }
+    const Status written = app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output); });
     if (!written.ok()) return app::Fail(tool, written);
 
     const auto& d = grid->dims();
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
                grid->voxel_size(), svo->depth);
-    fmt::print("voxels      {} ({})\n", voxels->size(),
-               voxelize.options.mode == VoxelMode::kThin ? "thin" : "conservative");
+    fmt::print("voxels      {} ({})\n", voxels->size(), voxelize.ModeName());
     fmt::print("{}", LevelTable(*svo));
     std::string times;
     double total = 0;

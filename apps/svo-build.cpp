@@ -3,8 +3,6 @@
 
 #include <filesystem>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
 #include "svokit/core/parallel.hpp"
@@ -22,12 +20,12 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output, mesh_path;
   app::BuildCli build;
   app::CommonOptions common;
-  cli.add_option("input", input, "Voxel fragment list (.vfrag from svo-voxelize)")->required();
-  cli.add_option("-o,--output", output, "Output .svo")->required();
-  cli.add_option("--mesh", mesh_path,
-                 "The mesh that was voxelized (.svm or any mesh file), for the contours");
+  app::AddFile(cli, "input", input, "Voxel fragment list (.vfrag from svo-voxelize)")->required();
+  app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
+  app::AddFile(cli, "--mesh", mesh_path,
+               "The mesh that was voxelized (.svm or any mesh file), for the contours");
   build.Add(cli);
-  app::AddCommonOptions(cli, common);
+  app::AddCommonOptions(cli, common, "svo-build bunny.vfrag --mesh bunny.svm -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, [&] {
     if (Status s = app::CheckOutputPath(output, {"svo"}); !s.ok()) return app::Fail(tool, s);
@@ -39,7 +37,8 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     VfragMetadata source;
-    StatusOr<VoxelSet> voxels = app::ReadStage(progress, [&] { return ReadVfrag(input, &source); });
+    StatusOr<VoxelSet> voxels =
+        app::RunStage(progress, "read", [&] { return ReadVfrag(input, &source); });
     if (!voxels.ok()) return app::Fail(tool, voxels.status());
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
@@ -48,19 +47,10 @@ int main(int argc, char** argv) {
       if (!m.ok()) return app::Fail(tool, m.status());
       mesh = std::move(*m);
     }
-    const nlohmann::json meta = {{"source", source.source},
-                                 {"voxelize", source.options},
-                                 {"build", build.Recorded()},
-                                 {"generator", "svokit " SVOKIT_VERSION}};
-    StatusOr<Svo> svo =
-        BuildSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta.dump(), progress);
+    const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
+    StatusOr<Svo> svo = BuildSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
-    Status written;
-    {
-      Progress::Stage stage(progress, "write", 1);
-      written = WriteSvo(*svo, output);
-      if (!written.ok()) stage.Cancel();
-    }
+    const Status written = app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output); });
     if (!written.ok()) return app::Fail(tool, written);
     fmt::print("input       {} ({} voxels)\n", input.string(), voxels->size());
     fmt::print("octree      depth {}, bricks {}, contours {}\n", svo->depth, build.bricks,

@@ -19,12 +19,13 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
-  cli.add_option("input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
-  cli.add_option("-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
+  app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
+  app::AddFile(cli, "-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
   cli.add_option("--level", level,
-                 "Export the nodes of this octree level (0 = root) as voxels of its node size; "
-                 "default: the voxels");
-  app::AddCommonOptions(cli, common);
+                 "Export the nodes of this octree level (0 = root) as voxels of its node size "
+                 "(default: the voxels)")
+      ->option_text("L");
+  app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
   return app::Run(tool, cli, argc, argv, [&] {
     if (Status s = app::CheckOutputPath(output, ExportExtensions()); !s.ok()) {
@@ -38,12 +39,8 @@ int main(int argc, char** argv) {
 
     ExportOptions options;
     options.level = level;
-    Status written;
-    {
-      Progress::Stage stage(progress, "export", 1);
-      written = ExportSvo(*svo, output, options);
-      if (!written.ok()) stage.Cancel();
-    }
+    const Status written =
+        app::RunStage(progress, "export", [&] { return ExportSvo(*svo, output, options); });
     if (!written.ok()) return app::Fail(tool, written);
 
     const std::uint32_t exported = level.value_or(svo->depth);

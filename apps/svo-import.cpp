@@ -20,12 +20,12 @@ int main(int argc, char** argv) {
   bool json = false;
   ReportOptions report_options;
   app::CommonOptions common;
-  cli.add_option("input", input, "Mesh file")->required();
-  cli.add_option("-o,--output", output, "Normalized mesh to write (.svm)");
+  app::AddFile(cli, "input", input, "Mesh file")->required();
+  app::AddFile(cli, "-o,--output", output, "Normalized mesh to write (.svm)");
   cli.add_flag("--json", json, "Print the report as JSON (stable keys, see README)");
   cli.add_flag("--self-intersections", report_options.self_intersections,
                "Also count self-intersecting triangle pairs (exact, slower)");
-  app::AddCommonOptions(cli, common);
+  app::AddCommonOptions(cli, common, "svo-import bunny.obj -o bunny.svm");
 
   return app::Run(tool, cli, argc, argv, [&] {
     if (!output.empty()) {
@@ -39,13 +39,9 @@ int main(int argc, char** argv) {
 
     const MeshReport report = AnalyzeMesh(*mesh, input.string(), report_options, progress);
     if (!output.empty()) {
-      Status written;
-      {
-        Progress::Stage stage(progress, "write", 1);
-        written = WriteSvm(*mesh, input.filename().string(), output);
-        if (!written.ok()) stage.Cancel();
-        stage.SetSummary(output.string());
-      }
+      const Status written = app::RunStage(
+          progress, "write", [&] { return WriteSvm(*mesh, input.filename().string(), output); },
+          [&](const Status&) { return output.string(); });
       if (!written.ok()) return app::Fail(tool, written);
     }
     const std::string text = json ? FormatReportJson(report) : FormatReportText(report);

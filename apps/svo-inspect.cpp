@@ -5,8 +5,6 @@
 #include <optional>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/app.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
@@ -27,23 +25,31 @@ int main(int argc, char** argv) {
   std::vector<std::string> slice_args;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
-  cli.add_option("input", input, "Octree (.svo)")->required();
+  app::AddFile(cli, "input", input, "Octree (.svo)")->required();
   cli.add_flag("--json", json, "Print the statistics as one JSON object (stable keys)");
   cli.add_flag("--levels", levels, "Add the per-level table");
   cli.add_flag("--histograms", histograms,
                "Add histograms: children per node, brick opacity, contour extent");
-  cli.add_option("--render", render_path, "Render the octree to this PNG");
-  cli.add_option("--view", view_name, "front, back, left, right, top, bottom or iso")
+  app::AddFile(cli, "--render", render_path, "Render the octree to this PNG");
+  cli.add_option("--view", view_name, "The side the render looks from")
+      ->option_text("front|back|left|right|top|bottom|iso")
       ->capture_default_str();
-  cli.add_option("--size", size_text, "Render size WxH in pixels")->capture_default_str();
-  cli.add_option("--shade", shade_name, "color, normal or depth")->capture_default_str();
+  cli.add_option("--size", size_text, "Render size in pixels")
+      ->option_text("WxH")
+      ->capture_default_str();
+  cli.add_option("--shade", shade_name, "What the render's pixels show")
+      ->option_text("color|normal|depth")
+      ->capture_default_str();
   cli.add_flag("--no-contours", no_contours, "Render leaves as full cubes, ignoring contours");
-  cli.add_option("--slice", slice_args, "AXIS=K OUT.png: one slice of the grid (x, y or z)")
+  cli.add_option("--slice", slice_args, "Write slice K across axis x, y or z of the grid as PNG")
+      ->option_text("AXIS=K FILE")
       ->expected(2);
   cli.add_option("--level", level,
                  "Read levels 0..L only: statistics cover them, renders and slices show level "
-                 "L's nodes as leaves");
-  app::AddCommonOptions(cli, common);
+                 "L's nodes as leaves")
+      ->option_text("L");
+  app::AddCommonOptions(cli, common,
+                        "svo-inspect bunny.svo --levels --render bunny.png --view iso");
 
   return app::Run(tool, cli, argc, argv, [&] {
     // Every option is checked before the file is read, so a typo costs nothing.
@@ -75,8 +81,11 @@ int main(int argc, char** argv) {
     StatusOr<Svo> svo = app::ReadSvoStage(progress, input, level);
     if (!svo.ok()) return app::Fail(tool, svo.status());
 
-    nlohmann::ordered_json pictures = {{"render", nullptr}, {"slice", nullptr}};
-    std::string picture_lines;
+    InspectReport report;
+    report.file = input.string();
+    report.file_bytes = std::filesystem::file_size(input);
+    report.levels = levels;
+    report.histograms = histograms;
     if (!render_path.empty()) {
       RenderOptions options;
       options.view = *view;
@@ -84,71 +93,45 @@ int main(int argc, char** argv) {
       options.height = (*size)[1];
       options.shade = *shade;
       options.contours = !no_contours;
-      StatusOr<RenderResult> rendered = [&]() -> StatusOr<RenderResult> {
-        Progress::Stage stage(progress, "render", 1);
-        StatusOr<RenderResult> r = RenderSvo(*svo, options);
-        if (r.ok()) {
-          if (Status s = WriteRgbaImage(r->image, render_path); !s.ok()) r = s;
-        }
-        if (!r.ok()) stage.Cancel();
-        return r;
-      }();
+      const StatusOr<RenderResult> rendered =
+          app::RunStage(progress, "render", [&]() -> StatusOr<RenderResult> {
+            StatusOr<RenderResult> r = RenderSvo(*svo, options);
+            if (!r.ok()) return r;
+            SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(r->image, render_path));
+            return r;
+          });
       if (!rendered.ok()) return app::Fail(tool, rendered.status().WithContext(input.string()));
-      const bool with_contours = options.contours && svo->has_contours;
-      pictures["render"] = {
-          {"path", render_path.string()},      {"width", options.width},
-          {"height", options.height},          {"view", ViewName(options.view)},
-          {"shade", ShadeName(options.shade)}, {"level", rendered->level},
-          {"contours", with_contours},         {"pixel_size", rendered->camera.pixel_size},
-          {"hit_pixels", rendered->hits}};
-      picture_lines +=
-          fmt::format("{:<19}{} ({}x{}, {} view, {} shading, level {}{}, {:.6g} per pixel)\n",
-                      "render", render_path.string(), options.width, options.height,
-                      ViewName(options.view), ShadeName(options.shade), rendered->level,
-                      with_contours ? ", contours" : "", rendered->camera.pixel_size);
+      report.render = RenderedPicture{.path = render_path.string(),
+                                      .width = options.width,
+                                      .height = options.height,
+                                      .view = options.view,
+                                      .shade = options.shade,
+                                      .level = rendered->level,
+                                      .contours = options.contours && svo->has_contours,
+                                      .pixel_size = rendered->camera.pixel_size,
+                                      .hit_pixels = rendered->hits};
     }
     if (slice) {
       SliceOptions options;
       options.level = level;
-      StatusOr<RgbaImage> image = [&]() -> StatusOr<RgbaImage> {
-        Progress::Stage stage(progress, "slice", 1);
-        StatusOr<RgbaImage> r = RenderSlice(*svo, *slice, options);
-        if (r.ok()) {
-          if (Status s = WriteRgbaImage(*r, slice_path); !s.ok()) r = s;
-        }
-        if (!r.ok()) stage.Cancel();
-        return r;
-      }();
+      const StatusOr<RgbaImage> image =
+          app::RunStage(progress, "slice", [&]() -> StatusOr<RgbaImage> {
+            StatusOr<RgbaImage> r = RenderSlice(*svo, *slice, options);
+            if (!r.ok()) return r;
+            SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(*r, slice_path));
+            return r;
+          });
       if (!image.ok()) return app::Fail(tool, image.status().WithContext(input.string()));
-      pictures["slice"] = {{"path", slice_path.string()},
-                           {"axis", std::string(1, "xyz"[slice->axis])},
-                           {"index", slice->index},
-                           {"width", image->width},
-                           {"height", image->height}};
-      picture_lines +=
-          fmt::format("{:<19}{} ({}={}, {}x{})\n", "slice", slice_path.string(), "xyz"[slice->axis],
-                      slice -> index, image -> width, image -> height);
+      report.slice = SlicePicture{.path = slice_path.string(),
+                                  .axis = slice->axis,
+                                  .index = slice->index,
+                                  .width = image->width,
+                                  .height = image->height};
     }
 
-    SvoStats stats;
-    {
-      Progress::Stage stage(progress, "statistics", 1);
-      stats = ComputeSvoStats(*svo);
-    }
-    InspectReportOptions report;
-    report.file = input.string();
-    report.file_bytes = std::filesystem::file_size(input);
-    report.levels = levels;
-    report.histograms = histograms;
-    if (json) {
-      nlohmann::ordered_json out =
-          nlohmann::ordered_json::parse(FormatStatsJson(*svo, stats, report));
-      out["render"] = pictures["render"];
-      out["slice"] = pictures["slice"];
-      fmt::print("{}\n", out.dump(2));
-    } else {
-      fmt::print("{}{}", FormatStatsText(*svo, stats, report), picture_lines);
-    }
+    const SvoStats stats =
+        app::RunStage(progress, "statistics", [&] { return ComputeSvoStats(*svo); });
+    fmt::print("{}", json ? FormatStatsJson(stats, report) : FormatStatsText(stats, report));
     return 0;
   });
 }

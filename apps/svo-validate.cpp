@@ -20,17 +20,18 @@ int main(int argc, char** argv) {
   std::filesystem::path input, mesh_path;
   bool json = false;
   app::CommonOptions common;
-  cli.add_option("input", input, "Octree (.svo)")->required();
-  cli.add_option("--mesh", mesh_path,
-                 "The mesh the octree was built from (.svm or any mesh file): enables the "
-                 "occupancy and contour-surface checks");
+  app::AddFile(cli, "input", input, "Octree (.svo)")->required();
+  app::AddFile(cli, "--mesh", mesh_path,
+               "The mesh the octree was built from (.svm or any mesh file): enables the "
+               "occupancy and contour-surface checks");
   cli.add_flag("--json", json, "Print the report as one JSON object");
-  app::AddCommonOptions(cli, common);
+  app::AddCommonOptions(cli, common, "svo-validate bunny.svo --mesh bunny.svm");
 
   return app::Run(tool, cli, argc, argv, [&] {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-    StatusOr<LenientSvo> file = app::ReadStage(progress, [&] { return ReadSvoLenient(input); });
+    StatusOr<LenientSvo> file =
+        app::RunStage(progress, "read", [&] { return ReadSvoLenient(input); });
     if (!file.ok()) return app::Fail(tool, file.status());
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {

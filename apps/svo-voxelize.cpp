@@ -22,13 +22,13 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output;
   app::VoxelizeCli voxelize;
   app::CommonOptions common;
-  cli.add_option("input", input, "Mesh (.svm from svo-import, or any mesh file)")->required();
-  cli.add_option("-o,--output", output, "Output: .vfrag, .xyz or .ply")->required();
+  app::AddFile(cli, "input", input, "Mesh (.svm from svo-import, or any mesh file)")->required();
+  app::AddFile(cli, "-o,--output", output, "Output: .vfrag, .xyz or .ply")->required();
   voxelize.Add(cli);
-  app::AddCommonOptions(cli, common);
+  app::AddCommonOptions(cli, common, "svo-voxelize bunny.svm -r 1024 -o bunny.vfrag");
 
   return app::Run(tool, cli, argc, argv, [&] {
-    if (Status s = voxelize.Finish(); !s.ok()) return app::Fail(tool, s);
+    if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
     if (Status s = app::CheckOutputPath(output, {"vfrag", "xyz", "ply"}); !s.ok()) {
       return app::Fail(tool, s);
     }
@@ -44,15 +44,6 @@ int main(int argc, char** argv) {
 
     const std::string ext = LowerExtension(output);
     std::size_t voxel_count = 0;
-    // The "write" stage of `voxels` (its warnings first): write().
-    auto write_stage = [&](const VoxelAttributes& voxels, std::size_t count, const auto& write) {
-      for (const std::string& w : voxels.warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
-      voxel_count = count;
-      Progress::Stage stage(progress, "write", 1);
-      Status status = write();
-      if (!status.ok()) stage.Cancel();
-      return status;
-    };
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
     if (ext == "vfrag") {
@@ -61,14 +52,17 @@ int main(int argc, char** argv) {
       // recorded.
       VfragFileWriter file(output, meta);
       StatusOr<PackedVoxelization> voxels =
-          VoxelizePacked(*mesh, *grid, voxelize.options, file, progress);
+          VoxelizePacked(*mesh, *grid, voxelize.Options(), file, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
-      written =
-          write_stage(voxels->attributes, voxels->count, [&] { return file.Commit(*voxels); });
+      app::Warn(tool, voxels->attributes.warnings);
+      voxel_count = voxels->count;
+      written = app::RunStage(progress, "write", [&] { return file.Commit(*voxels); });
     } else {
-      StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.options, progress);
+      StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.Options(), progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
-      written = write_stage(*voxels, voxels->size(), [&] {
+      app::Warn(tool, voxels->warnings);
+      voxel_count = voxels->size();
+      written = app::RunStage(progress, "write", [&] {
         return ext == "xyz" ? WriteVoxelsXyz(*voxels, output) : WriteVoxelsPly(*voxels, output);
       });
     }
@@ -77,8 +71,7 @@ int main(int argc, char** argv) {
     const auto& d = grid->dims();
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}\n", d[0], d[1], d[2], grid->voxel_size());
-    fmt::print("voxels      {} ({})\n", voxel_count,
-               voxelize.options.mode == VoxelMode::kThin ? "thin" : "conservative");
+    fmt::print("voxels      {} ({})\n", voxel_count, voxelize.ModeName());
     fmt::print("output      {}\n", output.string());
     return 0;
   });

@@ -4,8 +4,6 @@
 //
 //   import_bench FILE... [benchmark flags]
 
-#include <benchmark/benchmark.h>
-
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
@@ -13,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_main.hpp"
 #include "svokit/formats/mesh_import.hpp"
 
 namespace {
@@ -54,27 +53,12 @@ void OpenMeshRead(benchmark::State& state, const std::filesystem::path& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest = {argv[0]};
-  std::vector<std::filesystem::path> files;
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]).rfind("--", 0) == 0) {
-      rest.push_back(argv[i]);
-    } else {
-      files.emplace_back(argv[i]);
+  return svokit::bench::Main(argc, argv, false, [](const svokit::bench::Inputs& inputs) {
+    for (const std::filesystem::path f : inputs.files) {
+      const std::string name = f.filename().string();
+      svokit::bench::Register("svokit_import/" + name, SvokitImport, f);
+      svokit::bench::Register("openmesh_read/" + name, OpenMeshRead, f);
     }
-  }
-  for (const auto& f : files) {
-    const std::string name = f.filename().string();
-    benchmark::RegisterBenchmark(("svokit_import/" + name).c_str(), SvokitImport, f)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("openmesh_read/" + name).c_str(), OpenMeshRead, f)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-  }
-  int n = static_cast<int>(rest.size());
-  benchmark::Initialize(&n, rest.data());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+    return svokit::Status::Ok();
+  });
 }

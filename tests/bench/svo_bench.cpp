@@ -4,14 +4,10 @@
 //
 //   svo_bench --resolution N MESH... [benchmark flags]
 
-#include <benchmark/benchmark.h>
-
-#include <cstdio>
-#include <filesystem>
 #include <string>
 #include <vector>
 
-#include "svokit/formats/mesh_import.hpp"
+#include "bench_main.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
@@ -47,50 +43,25 @@ void Build(benchmark::State& state, const Scene* scene, std::uint32_t brick_side
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest = {argv[0]};
-  std::uint32_t resolution = 1024;
-  std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--resolution" && i + 1 < argc)
-      resolution = static_cast<std::uint32_t>(std::stoul(argv[++i]));
-    else if (a.rfind("--", 0) == 0)
-      rest.push_back(argv[i]);
-    else
-      files.push_back(a);
-  }
-  for (const std::string& f : files) {
-    auto mesh = svokit::ImportMesh(f);
-    if (!mesh.ok()) {
-      std::fprintf(stderr, "svo_bench: %s\n", mesh.status().message().c_str());
-      return 2;
+  return svokit::bench::Main(argc, argv, true, [](const svokit::bench::Inputs& inputs) {
+    for (const std::string& f : inputs.files) {
+      auto scene = svokit::bench::LoadScene(f, inputs.resolution);
+      if (!scene.ok()) return scene.status();
+      auto voxels = svokit::Voxelize(scene->mesh, scene->grid, svokit::VoxelizeOptions{});
+      if (!voxels.ok()) return voxels.status();
+      g_scenes.push_back({scene->name, std::move(scene->mesh), std::move(voxels).value()});
     }
-    auto grid = svokit::GridTransform::FitResolution(mesh->Bounds(), resolution);
-    auto voxels = svokit::Voxelize(*mesh, *grid, svokit::VoxelizeOptions{});
-    if (!voxels.ok()) {
-      std::fprintf(stderr, "svo_bench: %s\n", voxels.status().message().c_str());
-      return 2;
+    for (const Scene& s : g_scenes) {
+      const struct {
+        const char* name;
+        std::uint32_t brick_side;
+        bool contours;
+      } variants[] = {
+          {"octree", 0, false}, {"bricks", 3, false}, {"contours", 0, true}, {"full", 3, true}};
+      for (const auto& v : variants) {
+        svokit::bench::Register(s.name + "/" + v.name, Build, &s, v.brick_side, v.contours);
+      }
     }
-    g_scenes.push_back({std::filesystem::path(f).stem().string(), std::move(mesh).value(),
-                        std::move(voxels).value()});
-  }
-  for (const Scene& s : g_scenes) {
-    const struct {
-      const char* name;
-      std::uint32_t brick_side;
-      bool contours;
-    } variants[] = {
-        {"octree", 0, false}, {"bricks", 3, false}, {"contours", 0, true}, {"full", 3, true}};
-    for (const auto& v : variants) {
-      benchmark::RegisterBenchmark((s.name + "/" + v.name).c_str(), Build, &s, v.brick_side,
-                                   v.contours)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
-    }
-  }
-  int n = static_cast<int>(rest.size());
-  benchmark::Initialize(&n, rest.data());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+    return svokit::Status::Ok();
+  });
 }

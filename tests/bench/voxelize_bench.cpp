@@ -4,23 +4,15 @@
 //
 //   voxelize_bench --resolution N MESH... [benchmark flags]
 
-#include <benchmark/benchmark.h>
-
-#include <cstdio>
-#include <filesystem>
 #include <string>
 #include <vector>
 
-#include "svokit/formats/mesh_import.hpp"
+#include "bench_main.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {
 
-struct Scene {
-  std::string name;
-  svokit::Mesh mesh;
-  svokit::GridTransform grid;
-};
+using svokit::bench::Scene;
 std::vector<Scene> g_scenes;
 
 void Run(benchmark::State& state, const Scene* scene, svokit::VoxelMethod method, double cutoff) {
@@ -41,49 +33,22 @@ void Run(benchmark::State& state, const Scene* scene, svokit::VoxelMethod method
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest = {argv[0]};
-  std::uint32_t resolution = 1024;
-  std::vector<std::string> files;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--resolution" && i + 1 < argc)
-      resolution = static_cast<std::uint32_t>(std::stoul(argv[++i]));
-    else if (a.rfind("--", 0) == 0)
-      rest.push_back(argv[i]);
-    else
-      files.push_back(a);
-  }
-  for (const std::string& f : files) {
-    auto mesh = svokit::ImportMesh(f);
-    if (!mesh.ok()) {
-      std::fprintf(stderr, "voxelize_bench: %s\n", mesh.status().message().c_str());
-      return 2;
+  return svokit::bench::Main(argc, argv, true, [](const svokit::bench::Inputs& inputs) {
+    for (const std::string& f : inputs.files) {
+      auto scene = svokit::bench::LoadScene(f, inputs.resolution);
+      if (!scene.ok()) return scene.status();
+      g_scenes.push_back(std::move(scene).value());
     }
-    auto grid = svokit::GridTransform::FitResolution(mesh->Bounds(), resolution);
-    const std::string name = std::filesystem::path(f).stem().string();
-    g_scenes.push_back({name, std::move(mesh).value(), *grid});
-  }
-  for (const Scene& s : g_scenes) {
     using svokit::VoxelMethod;
-    benchmark::RegisterBenchmark((s.name + "/triangle").c_str(), Run, &s, VoxelMethod::kTriangle,
-                                 0.0)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark((s.name + "/fragment").c_str(), Run, &s, VoxelMethod::kFragment,
-                                 0.0)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    for (double cutoff : {64.0, 1024.0, 4096.0, 16384.0}) {
-      benchmark::RegisterBenchmark(
-          (s.name + "/hybrid_cutoff_" + std::to_string(int(cutoff))).c_str(), Run, &s,
-          VoxelMethod::kHybrid, cutoff)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
+    using svokit::bench::Register;
+    for (const Scene& s : g_scenes) {
+      Register(s.name + "/triangle", Run, &s, VoxelMethod::kTriangle, 0.0);
+      Register(s.name + "/fragment", Run, &s, VoxelMethod::kFragment, 0.0);
+      for (double cutoff : {64.0, 1024.0, 4096.0, 16384.0}) {
+        Register(s.name + "/hybrid_cutoff_" + std::to_string(int(cutoff)), Run, &s,
+                 VoxelMethod::kHybrid, cutoff);
+      }
     }
-  }
-  int n = static_cast<int>(rest.size());
-  benchmark::Initialize(&n, rest.data());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+    return svokit::Status::Ok();
+  });
 }

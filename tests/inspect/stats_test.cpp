@@ -56,17 +56,17 @@ TEST(SvoStats, TinyOctreeByHand) {
     EXPECT_EQ(s.grid_cells, cells[l]) << l;
     EXPECT_DOUBLE_EQ(s.occupancy, double(nodes[l]) / double(cells[l])) << l;
     EXPECT_DOUBLE_EQ(s.node_size, 0.25 * (1 << (2 - l))) << l;
-    EXPECT_EQ(s.node_bytes, l < 2 ? 12 * nodes[l] : 0) << l;
-    EXPECT_EQ(s.opacity_bytes, 27 * nodes[l]) << l;
-    EXPECT_EQ(s.color_bytes, 4 * 27 * nodes[l]) << l;
-    EXPECT_EQ(s.normal_bytes, 2 * 27 * nodes[l]) << l;
-    EXPECT_EQ(s.contour_bytes, 0u) << l;
+    EXPECT_EQ(s.bytes.nodes, l < 2 ? 12 * nodes[l] : 0) << l;
+    EXPECT_EQ(s.bytes.opacity, 27 * nodes[l]) << l;
+    EXPECT_EQ(s.bytes.color, 4 * 27 * nodes[l]) << l;
+    EXPECT_EQ(s.bytes.normal, 2 * 27 * nodes[l]) << l;
+    EXPECT_EQ(s.bytes.contours, 0u) << l;
   }
   EXPECT_DOUBLE_EQ(st.levels[0].branching, 2.0);
   EXPECT_DOUBLE_EQ(st.levels[1].branching, 1.5);
   EXPECT_DOUBLE_EQ(st.levels[2].branching, 0.0);
   // 3 node records (36 B) + 6 bricks of 27 samples × (1 + 4 + 2) B.
-  EXPECT_EQ(st.total_bytes, 36u + 6 * 189);
+  EXPECT_EQ(st.bytes.total(), 36u + 6 * 189);
   EXPECT_DOUBLE_EQ(st.bits_per_voxel, 8.0 * (36 + 6 * 189) / 3);
   EXPECT_EQ(st.histograms.children, (std::array<std::uint64_t, 8>{1, 2, 0, 0, 0, 0, 0, 0}));
   EXPECT_EQ(st.bricks.samples, 6u * 27);
@@ -88,10 +88,10 @@ TEST(SvoStats, TinyOctreeByHand) {
 TEST(SvoStats, JsonKeysAndValues) {
   const Svo svo = TinyOctree();
   const SvoStats st = ComputeSvoStats(svo);
-  InspectReportOptions options;
+  InspectReport options;
   options.file = "tiny.svo";
   options.file_bytes = 1234;
-  json j = json::parse(FormatStatsJson(svo, st, options));
+  json j = json::parse(FormatStatsJson(st, options));
   for (const char* key : {"file", "file_bytes", "grid", "bounds", "octree", "voxels", "bytes",
                           "bricks", "contours", "metadata", "levels", "histograms"}) {
     EXPECT_TRUE(j.contains(key)) << key;
@@ -120,7 +120,7 @@ TEST(SvoStats, JsonKeysAndValues) {
   EXPECT_TRUE(j["histograms"].is_null());
 
   options.levels = options.histograms = true;
-  j = json::parse(FormatStatsJson(svo, st, options));
+  j = json::parse(FormatStatsJson(st, options));
   ASSERT_EQ(j["levels"].size(), 3u);
   EXPECT_EQ(j["levels"][1]["nodes"], 2);
   EXPECT_EQ(j["levels"][1]["children"], 3);
@@ -132,7 +132,7 @@ TEST(SvoStats, JsonKeysAndValues) {
   EXPECT_EQ(j["histograms"]["children"], json({1, 2, 0, 0, 0, 0, 0, 0}));
   EXPECT_EQ(j["histograms"]["opacity"].size(), 11u);
 
-  const std::string text = FormatStatsText(svo, st, options);
+  const std::string text = FormatStatsText(st, options);
   for (const char* key :
        {"file               tiny.svo (1234 bytes)", "grid               4 x 4 x 4",
         "voxels             3", "contours           none", "source", "children per inner node",

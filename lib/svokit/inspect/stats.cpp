@@ -144,11 +144,6 @@ const char* ModeName(VoxelMode mode) {
   return mode == VoxelMode::kThin ? "thin" : "conservative";
 }
 
-Box3d RootBounds(const Svo& svo) {
-  const double size = svo.NodeSize(0);
-  return {svo.grid.origin(), svo.grid.origin() + Vec3d{size, size, size}};
-}
-
 double Share(std::uint64_t part, std::uint64_t whole) {
   return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
 }
@@ -157,7 +152,17 @@ double Share(std::uint64_t part, std::uint64_t whole) {
 
 SvoStats ComputeSvoStats(const Svo& svo) {
   SvoStats st;
+  st.grid = svo.grid;
+  st.mode = svo.mode;
   st.depth = svo.depth;
+  st.root_size = svo.NodeSize(0);
+  st.root_bounds = {svo.grid.origin(),
+                    svo.grid.origin() + Vec3d{st.root_size, st.root_size, st.root_size}};
+  st.brick_side = svo.brick_side;
+  st.has_color = svo.has_color;
+  st.has_normal = svo.has_normal;
+  st.has_contours = svo.has_contours;
+  st.metadata = svo.metadata;
   st.loaded_levels = static_cast<std::uint32_t>(svo.levels.size());
   st.voxels = svo.levels.empty() ? 0 : svo.levels.back().node_count;
   std::vector<std::vector<std::uint32_t>> words;
@@ -188,33 +193,33 @@ SvoStats ComputeSvoStats(const Svo& svo) {
     for (const std::uint32_t d : svo.grid.dims())
       s.grid_cells *= ((std::uint64_t{d} - 1) >> shift) + 1;
     s.occupancy = Share(s.nodes, s.grid_cells);
-    s.node_bytes = lv.nodes.size() * sizeof(SvoNode);
-    s.opacity_bytes = lv.opacity.size();
-    s.color_bytes = lv.color.size() * sizeof(std::uint32_t);
-    s.normal_bytes = lv.normal.size() * sizeof(std::uint16_t);
-    s.contour_bytes = lv.contours.size() * sizeof(std::uint32_t);
-    s.bits_per_voxel = 8.0 * Share(s.total_bytes(), st.voxels);
+    s.bytes.nodes = lv.nodes.size() * sizeof(SvoNode);
+    s.bytes.opacity = lv.opacity.size();
+    s.bytes.color = lv.color.size() * sizeof(std::uint32_t);
+    s.bytes.normal = lv.normal.size() * sizeof(std::uint16_t);
+    s.bytes.contours = lv.contours.size() * sizeof(std::uint32_t);
+    s.bits_per_voxel = 8.0 * Share(s.bytes.total(), st.voxels);
     s.contours = contour_stats[l];
     s.contours.nodes = lv.node_count;  // ComputeContourStats saw only the nodes with one
+    s.contour_share = Share(s.contours.with_contour, s.nodes);
     for (const std::uint32_t w : lv.contours) {
       const ContourSpan span = ClippedSpan(DecodeContour(w));
       const double fraction = (span.high - span.low) / span.l1;
       ++st.histograms.contour_extent[std::min<std::size_t>(
           9, static_cast<std::size_t>(std::max(0.0, fraction) * 10))];
     }
-    st.total_bytes += s.total_bytes();
+    st.bytes += s.bytes;
     st.contours += lv.contours.size();
     all_nodes += lv.node_count;
     st.levels.push_back(s);
   }
-  st.bits_per_voxel = 8.0 * Share(st.total_bytes, st.voxels);
+  st.bits_per_voxel = 8.0 * Share(st.bytes.total(), st.voxels);
   st.contour_share = Share(st.contours, all_nodes);
   st.bricks = ComputeBrickStats(svo, st.histograms);
   return st;
 }
 
-std::string FormatStatsText(const Svo& svo, const SvoStats& st,
-                            const InspectReportOptions& options) {
+std::string FormatStatsText(const SvoStats& st, const InspectReport& report) {
   std::string out;
   const auto line = [&](std::string_view key, const std::string& value) {
     fmt::format_to(std::back_inserter(out), "{:<19}{}\n", key, value);
@@ -222,40 +227,34 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
   const auto vec = [](const Vec3d& v) {
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z);
   };
-  const auto& dims = svo.grid.dims();
-  line("file", fmt::format("{} ({} bytes)", options.file, options.file_bytes));
+  const auto& dims = st.grid.dims();
+  line("file", fmt::format("{} ({} bytes)", report.file, report.file_bytes));
   line("grid", fmt::format("{} x {} x {} voxels of {:.6g}, {}", dims[0], dims[1], dims[2],
-                           svo.grid.voxel_size(), ModeName(svo.mode)));
-  const Box3d bounds = svo.grid.GridBounds();
+                           st.grid.voxel_size(), ModeName(st.mode)));
+  const Box3d bounds = st.grid.GridBounds();
   line("bounds", fmt::format("{} .. {}", vec(bounds.lo), vec(bounds.hi)));
-  const Box3d root = RootBounds(svo);
-  line("octree", fmt::format("depth {}, root cube {} .. {} ({} voxels)", svo.depth, vec(root.lo),
-                             vec(root.hi), std::uint64_t{1} << svo.depth));
-  if (st.loaded_levels != svo.depth + 1) {
-    line("levels read", fmt::format("0..{} of 0..{}", st.loaded_levels - 1, svo.depth));
+  line("octree",
+       fmt::format("depth {}, root cube {} .. {} ({} voxels)", st.depth, vec(st.root_bounds.lo),
+                   vec(st.root_bounds.hi), std::uint64_t{1} << st.depth));
+  if (st.loaded_levels != st.depth + 1) {
+    line("levels read", fmt::format("0..{} of 0..{}", st.loaded_levels - 1, st.depth));
   }
-  line(st.loaded_levels == svo.depth + 1 ? "voxels" : "finest nodes", fmt::format("{}", st.voxels));
-  std::uint64_t node_b = 0, brick_b = 0, contour_b = 0;
-  for (const SvoLevelStats& l : st.levels) {
-    node_b += l.node_bytes;
-    brick_b += l.opacity_bytes + l.color_bytes + l.normal_bytes;
-    contour_b += l.contour_bytes;
-  }
+  line(st.loaded_levels == st.depth + 1 ? "voxels" : "finest nodes", fmt::format("{}", st.voxels));
   const auto bits = [&](std::uint64_t bytes) { return 8.0 * Share(bytes, st.voxels); };
   line("size", fmt::format("{} bytes, {:.2f} bits per voxel (nodes {:.2f}, bricks {:.2f}, "
                            "contours {:.2f})",
-                           st.total_bytes, st.bits_per_voxel, bits(node_b), bits(brick_b),
-                           bits(contour_b)));
-  if (svo.brick_side == 0) {
+                           st.bytes.total(), st.bits_per_voxel, bits(st.bytes.nodes),
+                           bits(st.bytes.bricks()), bits(st.bytes.contours)));
+  if (st.brick_side == 0) {
     line("bricks", "none");
   } else {
     const BrickStats& b = st.bricks;
-    line("bricks", fmt::format("{0}x{0}x{0}{1}{2}, {3} samples, {4:.1f} % empty", svo.brick_side,
-                               svo.has_color ? ", colour" : "", svo.has_normal ? ", normals" : "",
+    line("bricks", fmt::format("{0}x{0}x{0}{1}{2}, {3} samples, {4:.1f} % empty", st.brick_side,
+                               st.has_color ? ", colour" : "", st.has_normal ? ", normals" : "",
                                b.samples, 100.0 * Share(b.empty, b.samples)));
     line("opacity", fmt::format("{:.3f} .. {:.3f}, mean {:.3f}", b.opacity.min, b.opacity.max,
                                 b.opacity.mean));
-    if (svo.has_color) {
+    if (st.has_color) {
       std::string c;
       for (int ch = 0; ch < 4; ++ch) {
         fmt::format_to(std::back_inserter(c), "{}{} {:.3f} .. {:.3f} (mean {:.3f})", ch ? ", " : "",
@@ -263,7 +262,7 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
       }
       line("colour (linear)", c);
     }
-    if (svo.has_normal) {
+    if (st.has_normal) {
       std::string n = fmt::format("{} samples", b.with_normal);
       for (int a = 0; a < 3; ++a) {
         fmt::format_to(std::back_inserter(n), ", {} {:.3f} .. {:.3f}", "xyz"[a], b.normal[a].min,
@@ -272,7 +271,7 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
       line("normals", n);
     }
   }
-  if (!svo.has_contours) {
+  if (!st.has_contours) {
     line("contours", "none");
   } else {
     std::string thick;
@@ -284,15 +283,15 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
     line("contours", fmt::format("{} ({:.1f} % of nodes)", st.contours, 100.0 * st.contour_share));
     if (!thick.empty()) line("mean thickness", thick + " (node sizes)");
   }
-  const Json meta = Json::parse(svo.metadata, nullptr, false);
+  const Json meta = Json::parse(st.metadata, nullptr, false);
   if (meta.is_object()) {
     for (const auto& [key, value] : meta.items()) {
       line(key, value.is_string() ? value.get<std::string>() : value.dump());
     }
-  } else if (!svo.metadata.empty()) {
-    line("metadata", svo.metadata);
+  } else if (!st.metadata.empty()) {
+    line("metadata", st.metadata);
   }
-  if (options.levels) {
+  if (report.levels) {
     fmt::format_to(std::back_inserter(out),
                    "\n{:>5} {:>11} {:>10} {:>10} {:>6} {:>9} {:>9} {:>6} {:>6} {:>10} {:>11} "
                    "{:>9} {:>8}\n",
@@ -303,19 +302,17 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
                      "{:>5} {:>11.5g} {:>10} {:>10} {:>6.2f} {:>9.4g} {:>9} {:>6.3f} {:>6.3f} "
                      "{:>10} {:>11} {:>9} {:>8.3f}\n",
                      l.level, l.node_size, l.nodes, l.leaves, l.branching, l.occupancy,
-                     l.contours.with_contour, Share(l.contours.with_contour, l.nodes),
-                     l.contours.mean_relative_thickness, l.node_bytes,
-                     l.opacity_bytes + l.color_bytes + l.normal_bytes, l.contour_bytes,
-                     l.bits_per_voxel);
+                     l.contours.with_contour, l.contour_share, l.contours.mean_relative_thickness,
+                     l.bytes.nodes, l.bytes.bricks(), l.bytes.contours, l.bits_per_voxel);
     }
   }
-  if (options.histograms) {
+  if (report.histograms) {
     const SvoHistograms& h = st.histograms;
     out += "\nchildren per inner node\n";
     for (std::size_t k = 0; k < h.children.size(); ++k) {
       fmt::format_to(std::back_inserter(out), "  {:<12}{}\n", k + 1, h.children[k]);
     }
-    if (svo.brick_side != 0) {
+    if (st.brick_side != 0) {
       out += "brick sample opacity\n";
       fmt::format_to(std::back_inserter(out), "  {:<12}{}\n", "0", h.opacity[0]);
       for (std::size_t k = 1; k < h.opacity.size(); ++k) {
@@ -325,7 +322,7 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
                        h.opacity[k]);
       }
     }
-    if (svo.has_contours) {
+    if (st.has_contours) {
       out += "contour extent along n (fraction of the cube kept)\n";
       for (std::size_t k = 0; k < h.contour_extent.size(); ++k) {
         fmt::format_to(std::back_inserter(out), "  {:<12}{}\n",
@@ -336,59 +333,63 @@ std::string FormatStatsText(const Svo& svo, const SvoStats& st,
       }
     }
   }
+  if (report.render) {
+    const RenderedPicture& r = *report.render;
+    line("render", fmt::format("{} ({}x{}, {} view, {} shading, level {}{}, {:.6g} per pixel)",
+                               r.path, r.width, r.height, ViewName(r.view), ShadeName(r.shade),
+                               r.level, r.contours ? ", contours" : "", r.pixel_size));
+  }
+  if (report.slice) {
+    const SlicePicture& s = *report.slice;
+    line("slice",
+         fmt::format("{} ({}={}, {}x{})", s.path, "xyz"[s.axis], s.index, s.width, s.height));
+  }
   return out;
 }
 
-std::string FormatStatsJson(const Svo& svo, const SvoStats& st,
-                            const InspectReportOptions& options) {
+std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   using json = Json;
-  const auto& dims = svo.grid.dims();
-  const Box3d bounds = svo.grid.GridBounds(), root = RootBounds(svo);
+  const auto& dims = st.grid.dims();
+  const Box3d bounds = st.grid.GridBounds();
   json j;
-  j["file"] = options.file;
-  j["file_bytes"] = options.file_bytes;
-  j["grid"] = {{"origin", Vec(svo.grid.origin())},
-               {"voxel_size", svo.grid.voxel_size()},
+  j["file"] = report.file;
+  j["file_bytes"] = report.file_bytes;
+  j["grid"] = {{"origin", Vec(st.grid.origin())},
+               {"voxel_size", st.grid.voxel_size()},
                {"dims", {dims[0], dims[1], dims[2]}},
-               {"mode", ModeName(svo.mode)}};
+               {"mode", ModeName(st.mode)}};
   j["bounds"] = {{"min", Vec(bounds.lo)}, {"max", Vec(bounds.hi)}};
-  j["octree"] = {{"depth", svo.depth},
-                 {"root_size", svo.NodeSize(0)},
-                 {"root_bounds", {{"min", Vec(root.lo)}, {"max", Vec(root.hi)}}},
-                 {"loaded_levels", st.loaded_levels}};
+  j["octree"] = {
+      {"depth", st.depth},
+      {"root_size", st.root_size},
+      {"root_bounds", {{"min", Vec(st.root_bounds.lo)}, {"max", Vec(st.root_bounds.hi)}}},
+      {"loaded_levels", st.loaded_levels}};
   j["voxels"] = st.voxels;
-  std::uint64_t node_b = 0, op_b = 0, col_b = 0, nrm_b = 0, ct_b = 0;
-  for (const SvoLevelStats& l : st.levels) {
-    node_b += l.node_bytes;
-    op_b += l.opacity_bytes;
-    col_b += l.color_bytes;
-    nrm_b += l.normal_bytes;
-    ct_b += l.contour_bytes;
-  }
-  j["bytes"] = {{"total", st.total_bytes}, {"bits_per_voxel", st.bits_per_voxel},
-                {"nodes", node_b},         {"opacity", op_b},
-                {"color", col_b},          {"normal", nrm_b},
-                {"contours", ct_b}};
+  j["bytes"] = {{"total", st.bytes.total()},    {"bits_per_voxel", st.bits_per_voxel},
+                {"nodes", st.bytes.nodes},      {"opacity", st.bytes.opacity},
+                {"color", st.bytes.color},      {"normal", st.bytes.normal},
+                {"contours", st.bytes.contours}};
   const BrickStats& b = st.bricks;
-  j["bricks"] = {{"side", svo.brick_side},
-                 {"color", svo.has_color},
-                 {"normal", svo.has_normal},
+  const json normals = Ranges(b.normal);
+  j["bricks"] = {{"side", st.brick_side},
+                 {"color", st.has_color},
+                 {"normal", st.has_normal},
                  {"samples", b.samples},
                  {"empty", b.empty},
-                 {"opacity", svo.brick_side ? Range(b.opacity) : json(nullptr)},
-                 {"color_range", svo.has_color ? Ranges(b.color) : json(nullptr)},
-                 {"normals", svo.has_normal ? json{{"count", b.with_normal},
-                                                   {"min", Ranges(b.normal)["min"]},
-                                                   {"max", Ranges(b.normal)["max"]},
-                                                   {"mean", Ranges(b.normal)["mean"]}}
-                                            : json(nullptr)}};
+                 {"opacity", st.brick_side ? Range(b.opacity) : json(nullptr)},
+                 {"color_range", st.has_color ? Ranges(b.color) : json(nullptr)},
+                 {"normals", st.has_normal ? json{{"count", b.with_normal},
+                                                  {"min", normals["min"]},
+                                                  {"max", normals["max"]},
+                                                  {"mean", normals["mean"]}}
+                                           : json(nullptr)}};
   j["contours"] = {
-      {"fitted", svo.has_contours}, {"count", st.contours}, {"share", st.contour_share}};
-  json meta = json::parse(svo.metadata, nullptr, false);
+      {"fitted", st.has_contours}, {"count", st.contours}, {"share", st.contour_share}};
+  json meta = json::parse(st.metadata, nullptr, false);
   j["metadata"] =
-      meta.is_discarded() ? (svo.metadata.empty() ? json(nullptr) : json(svo.metadata)) : meta;
+      meta.is_discarded() ? (st.metadata.empty() ? json(nullptr) : json(st.metadata)) : meta;
   j["levels"] = nullptr;
-  if (options.levels) {
+  if (report.levels) {
     j["levels"] = json::array();
     for (const SvoLevelStats& l : st.levels) {
       j["levels"].push_back({{"level", l.level},
@@ -400,25 +401,47 @@ std::string FormatStatsJson(const Svo& svo, const SvoStats& st,
                              {"grid_cells", l.grid_cells},
                              {"occupancy", l.occupancy},
                              {"bytes",
-                              {{"nodes", l.node_bytes},
-                               {"opacity", l.opacity_bytes},
-                               {"color", l.color_bytes},
-                               {"normal", l.normal_bytes},
-                               {"contours", l.contour_bytes},
-                               {"total", l.total_bytes()}}},
+                              {{"nodes", l.bytes.nodes},
+                               {"opacity", l.bytes.opacity},
+                               {"color", l.bytes.color},
+                               {"normal", l.bytes.normal},
+                               {"contours", l.bytes.contours},
+                               {"total", l.bytes.total()}}},
                              {"bits_per_voxel", l.bits_per_voxel},
                              {"contours",
                               {{"count", l.contours.with_contour},
-                               {"share", Share(l.contours.with_contour, l.nodes)},
+                               {"share", l.contour_share},
                                {"mean_thickness", l.contours.mean_relative_thickness},
                                {"mean_extent", l.contours.mean_extent_fraction}}}});
     }
   }
   j["histograms"] = nullptr;
-  if (options.histograms) {
+  if (report.histograms) {
     j["histograms"] = {{"children", st.histograms.children},
                        {"opacity", st.histograms.opacity},
                        {"contour_extent", st.histograms.contour_extent}};
+  }
+  j["render"] = nullptr;
+  if (report.render) {
+    const RenderedPicture& r = *report.render;
+    j["render"] = {{"path", r.path},
+                   {"width", r.width},
+                   {"height", r.height},
+                   {"view", ViewName(r.view)},
+                   {"shade", ShadeName(r.shade)},
+                   {"level", r.level},
+                   {"contours", r.contours},
+                   {"pixel_size", r.pixel_size},
+                   {"hit_pixels", r.hit_pixels}};
+  }
+  j["slice"] = nullptr;
+  if (report.slice) {
+    const SlicePicture& s = *report.slice;
+    j["slice"] = {{"path", s.path},
+                  {"axis", std::string(1, "xyz"[s.axis])},
+                  {"index", s.index},
+                  {"width", s.width},
+                  {"height", s.height}};
   }
   return j.dump(2) + "\n";
 }

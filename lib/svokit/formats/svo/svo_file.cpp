@@ -4,6 +4,8 @@
 #include <cstring>
 #include <map>
 
+#include <nlohmann/json.hpp>
+
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/container/grid_section.hpp"
@@ -342,6 +344,15 @@ StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {
 }
 
 }  // namespace
+
+std::string SvoMetadataJson(const SvoMetadata& meta) {
+  // nlohmann::json orders the keys alphabetically; the files depend on that order.
+  const nlohmann::json json = {{"source", meta.source},
+                               {"voxelize", meta.voxelize},
+                               {"build", meta.build},
+                               {"generator", "svokit " SVOKIT_VERSION}};
+  return json.dump();
+}
 
 std::vector<std::uint8_t> EncodeSvo(const Svo& svo) {
   return MakeWriter(svo).Serialize();

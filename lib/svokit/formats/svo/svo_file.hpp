@@ -19,6 +19,16 @@ namespace svokit {
 inline constexpr container::FormatId kSvoFormat{
     {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 1, "svokit sparse voxel octree (.svo)"};
 
+/// Provenance stored with the octree (the `META` section): what svo-voxelize + svo-build and
+/// mesh2svo record alike, so both routes write the same file.
+struct SvoMetadata {
+  std::string source;    ///< the mesh's file name, without directories
+  std::string voxelize;  ///< the voxelization options, as the command line spells them
+  std::string build;     ///< the build options, likewise
+};
+/// The `META` section's JSON text (Svo::metadata; BuildSvo's `metadata`).
+std::string SvoMetadataJson(const SvoMetadata& meta);
+
 std::vector<std::uint8_t> EncodeSvo(const Svo& svo);
 Status WriteSvo(const Svo& svo, const std::filesystem::path& path);
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
