@@ -19,7 +19,7 @@
 #include "svokit/core/radix_sort.hpp"
 #include "svokit/core/release_pages.hpp"
 #include "svokit/voxelize/attributes.hpp"
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
 
 namespace svokit {
