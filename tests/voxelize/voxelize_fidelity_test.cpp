@@ -26,7 +26,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/mesh_report.hpp"
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "svokit/core/morton.hpp"
+#include "svokit/core/polygon_clip.hpp"
 
 namespace svokit {
 
@@ -108,22 +109,21 @@ struct Pieces {
 void ClipAxis(const std::vector<Vec3d>& in, int axis, double value, bool keep_low,
               std::vector<Vec3d>& out) {
   out.clear();
-  const std::size_t n = in.size();
+  if (in.empty()) return;
+  const int n = static_cast<int>(in.size());
   const auto dist = [&](const Vec3d& p) { return keep_low ? p[axis] - value : value - p[axis]; };
   const auto push = [&](const Vec3d& p) {
     if (out.empty() || !(out.back() == p)) out.push_back(p);
   };
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3d& a = in[i];
-    const Vec3d& b = in[(i + 1) % n];
-    const double da = dist(a), db = dist(b);
-    if (da <= 0) push(a);
-    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
-      Vec3d p = a + (b - a) * (da / (da - db));
+  // Each edge emits its start (when kept) and then its cut: the walk starts at the edge 0 → 1.
+  ForEachClipEdge(in.data(), n, n > 1 ? 1 : 0, dist, [&](const ClipEdge<Vec3d>& e) {
+    if (e.d_prev <= 0) push(e.prev);
+    if ((e.d_prev < 0 && e.d_cur > 0) || (e.d_prev > 0 && e.d_cur < 0)) {
+      Vec3d p = e.cut;
       p[axis] = value;
       push(p);
     }
-  }
+  });
   if (out.size() > 1 && out.front() == out.back()) out.pop_back();
 }
 
@@ -276,7 +276,7 @@ struct Offsets {
 const Offsets kOffsets;
 
 // Steepest descent over the 26 integer neighbours of n. Each step measures all 26 slabs in one
-// float pass over the points (vectorizes; 4× faster than 26 passes), then re-fits the winner
+// float pass over the points (it vectorizes, where 26 passes would not), then re-fits the winner
 // exactly in double, so rounding in the search can cost tightness but never conservativeness.
 Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, int max_steps) {
   uf.resize(u.size() * 3);

@@ -30,8 +30,8 @@ struct ContourOptions {
   /// a ray's path through the node to pay for its 4 bytes. Values ≥ 1 keep every fitted contour.
   double max_relative_thickness = 0.9;
   /// Hill-climbing steps over the integer normal for nodes with few pieces (most of them: the
-  /// finest levels); big nodes always climb to convergence. Tightness against time, measured in
-  /// scripts/bench svo.
+  /// finest levels); big nodes always climb to convergence. Trades tightness for time
+  /// (scripts/bench svo measures both).
   int small_node_search_steps = 0;
 };
 

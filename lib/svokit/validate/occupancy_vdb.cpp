@@ -14,7 +14,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/key_index.hpp"
 #include "svokit/validate/checks.hpp"
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
 
 namespace svokit::validate {

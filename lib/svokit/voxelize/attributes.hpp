@@ -35,8 +35,8 @@ struct Point2 {
 // non-convex and add more; the clipper caps the count at kMaxPolygon (dropping vertices of such a
 // sliver, never writing out of bounds).
 constexpr int kMaxPolygon = 16;
-// The branch-free clipper writes up to two vertices per input vertex before deciding to keep
-// them: buffers have room for that past kMaxPolygon.
+// The branch-free clipper (CutPolygon) writes up to two vertices per input vertex before deciding
+// to keep them: buffers have room for that past kMaxPolygon.
 constexpr int kClipCapacity = kMaxPolygon + 2;
 }  // namespace attributes_detail
 

@@ -70,9 +70,21 @@ class VoxelBitSet {
   std::uint64_t brick_key(std::size_t i) const { return keys_[i]; }
   const Brick& brick(std::size_t i) const { return bricks_[i]; }
 
-  /// The union of `sets` as sorted unique Morton keys (thread-count independent).
+  /// The union of `sets` as sorted unique Morton keys (thread-count independent), written to
+  /// allocate(count), which is called once and returns where to write them (null: nothing is
+  /// written). Returns the key count.
+  template <class Sets, class Allocate>
+  static std::uint64_t UnionKeys(const Sets& sets, const Allocate& allocate);
+  /// The same keys in a vector.
   template <class Sets>
-  static DefaultInitVector<std::uint64_t> UnionKeys(const Sets& sets);
+  static DefaultInitVector<std::uint64_t> UnionKeys(const Sets& sets) {
+    DefaultInitVector<std::uint64_t> keys;
+    UnionKeys(sets, [&](std::size_t count) {
+      keys.resize(count);
+      return keys.data();
+    });
+    return keys;
+  }
   /// The same keys packed as varint gaps (core/key_gaps.hpp) into allocate(bytes), which is
   /// called once with their size and returns where to write them (null: nothing is written).
   /// Returns the key count.
@@ -166,8 +178,8 @@ class VoxelBitSet::MergedBricks {
 
 // Each group is merged twice, to count and then to write at its prefix-sum offset: cheaper than
 // keeping a merged copy of every brick.
-template <class Sets>
-DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
+template <class Sets, class Allocate>
+std::uint64_t VoxelBitSet::UnionKeys(const Sets& sets, const Allocate& allocate) {
   const MergedBricks merged(sets);
   const std::size_t bricks = merged.size();
   std::vector<std::uint64_t> offset(bricks + 1, 0);
@@ -177,14 +189,15 @@ DefaultInitVector<std::uint64_t> VoxelBitSet::UnionKeys(const Sets& sets) {
     offset[b + 1] = count;
   });
   for (std::size_t b = 0; b < bricks; ++b) offset[b + 1] += offset[b];
-  DefaultInitVector<std::uint64_t> keys(offset[bricks]);  // first touched by the writes below
+  std::uint64_t* keys = allocate(offset[bricks]);  // first touched by the writes below
+  if (keys == nullptr) return offset[bricks];
   tbb::parallel_for(std::size_t{0}, bricks, [&](std::size_t b) {
-    std::uint64_t* out = keys.data() + offset[b];
+    std::uint64_t* out = keys + offset[b];
     const std::uint64_t base = merged.key(b) << kBrickBits;
     MergedBricks::ForEachVoxel(merged.Merge(b),
                                [&](std::uint32_t local) { *out++ = base | local; });
   });
-  return keys;
+  return offset[bricks];
 }
 
 // As UnionKeys(), the keys packed (key_gaps.hpp): a brick's gaps after its first voxel are

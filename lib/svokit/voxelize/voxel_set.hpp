@@ -1,6 +1,12 @@
 #pragma once
 // The voxelizer's output: the set of filled voxels as sorted, unique 64-bit Morton keys, with the
 // grid that maps them back to world space (and, when requested, per-voxel attributes).
+//   VoxelSet             the voxels as 64-bit keys, in its own vectors (Voxelize())
+//   PackedVoxelSet       the voxels with keys as varint gaps, in its own vectors (VoxelizePacked())
+//   PackedVoxelStorage   memory a caller provides for the packed arrays instead (a .vfrag file)
+//   PackedVoxelContents  which of those arrays a packed voxelization fills
+//   PackedVoxelArrays    those arrays, as spans into the caller's memory
+//   PackedVoxelization   what a voxelization into a PackedVoxelStorage returns besides the arrays
 
 #include <cstdint>
 #include <span>

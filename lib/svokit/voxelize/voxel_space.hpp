@@ -2,7 +2,7 @@
 // Vertices in voxel space, snapped to a fixed-point grid of 2⁻¹⁶ voxel. Snapping is part of the
 // one mapping world → voxel (after GridTransform::WorldToVoxel): it moves a vertex by at most
 // 2⁻¹⁷ voxel, and makes every later overlap test an exact integer computation (edge functions fit
-// in 80 bits, plane tests in 118; see triangle_voxel_test.hpp). Snapped coordinates are exactly
+// in 80 bits, plane tests in 118; see triangle_voxelizer.hpp). Snapped coordinates are exactly
 // representable as doubles, so exact references (CGAL) can use the very same geometry.
 
 #include <cstdint>

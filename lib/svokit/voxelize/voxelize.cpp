@@ -1,30 +1,29 @@
 #include "svokit/voxelize/voxelize.hpp"
 
 #include <algorithm>
-#include <bit>
-#include <cassert>
 #include <cmath>
-#include <cstring>
-#include <functional>
 #include <limits>
-#include <memory>
 #include <optional>
+#include <span>
+#include <type_traits>
 
-#include <tbb/concurrent_queue.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_pipeline.h>
 
-#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/radix_sort.hpp"
 #include "svokit/core/release_pages.hpp"
-#include "svokit/voxelize/attributes.hpp"
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/attribute_pass.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
 
 namespace svokit {
 
 namespace {
+
+using voxelize_detail::Coord;
+using voxelize_detail::kTrianglesPerTask;
+using voxelize_detail::MeshVoxelizer;
+using voxelize_detail::OutputArrays;
+using voxelize_detail::VoxelOutput;
 
 // Snapped coordinates beyond ±2²² voxels could overflow the 128-bit plane test.
 constexpr std::int64_t kCoordinateLimit = std::int64_t{1} << (22 + kFixedPointBits);
@@ -32,532 +31,17 @@ constexpr std::int64_t kCoordinateLimit = std::int64_t{1} << (22 + kFixedPointBi
 constexpr double kMaxVoxels = 4294967296.0;
 // Fragment path: a triangle's footprint is cut into tiles of this many columns per side.
 constexpr std::int64_t kTileColumns = 32;
-constexpr std::size_t kTrianglesPerTask = 512;
 constexpr std::size_t kTilesPerTask = 16;
-
-// Voxel coordinates inside the grid fit 21 bits (Morton keys).
-std::uint32_t Coord(std::int64_t c) {
-  return static_cast<std::uint32_t>(c);
-}
 
 struct Tile {
   std::uint32_t triangle;
   std::int32_t u0, v0;  // first column of the tile
 };
 
-class MeshVoxelizer {
- public:
-  MeshVoxelizer(const Mesh& mesh, const std::vector<FixedPoint3>& vertices,
-                const GridTransform& grid, VoxelMode mode)
-      : mesh_(mesh), vertices_(vertices), box_(grid.IndexBox()), mode_(mode) {}
-
-  TriangleVoxelizer Triangle(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
-    return TriangleVoxelizer(vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]], mode_, box_);
-  }
-
-  /// Asks for triangle t's corner indices (kCorners) or corners (kVertices) to be brought into
-  /// the cache: the brick pass sets triangles up in brick order, far apart in memory.
-  enum PrefetchWhat { kCorners, kVertices };
-  void Prefetch(std::size_t t, PrefetchWhat what) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
-    if (what == kCorners) {
-      __builtin_prefetch(&tri);
-    } else {
-      for (int k = 0; k < 3; ++k) __builtin_prefetch(&vertices_[tri[k]]);
-    }
-  }
-
-  /// The snapped corners in voxel coordinates (exact in doubles).
-  std::array<Vec3d, 3> Corners(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
-    return {FixedToVoxel(vertices_[tri[0]]), FixedToVoxel(vertices_[tri[1]]),
-            FixedToVoxel(vertices_[tri[2]])};
-  }
-
-  // Projected dominant-axis area in voxel², in doubles: only a scheduling decision.
-  double ProjectedArea(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
-    const Vec3d a = FixedToVoxel(vertices_[tri[0]]), b = FixedToVoxel(vertices_[tri[1]]),
-                c = FixedToVoxel(vertices_[tri[2]]);
-    const Vec3d n = Cross(b - a, c - a);
-    return 0.5 * std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
-  }
-
- private:
-  const Mesh& mesh_;
-  const std::vector<FixedPoint3>& vertices_;
-  IBox3 box_;
-  VoxelMode mode_;
-};
-
-// The attribute pass's bricks: its unit of work and of accumulation. Each (brick, triangle) pair
-// costs a triangle set-up and a walk of the brick's columns, so bricks larger than the bit sets'
-// 16³ pay off: armadillo at 4096³ had 607 k pairs of 16³ bricks, 40 % of whose column runs lay
-// in another brick along the dominant axis (1.22 → 0.91 s whole process with 32³).
-using PassBrick = MortonBrick<5>;
-constexpr std::int64_t kPassSide = PassBrick::kSide;
-
-// Which triangles touch which pass brick: attributes are accumulated brick by brick, each voxel's
-// contributions summed in triangle order, so the result does not depend on threads or method.
-struct BrickTriangle {
-  std::uint64_t brick;
-  std::uint32_t triangle;
-};
-
-// Appends (brick, triangle) for the pass bricks the triangle may have voxels in: a superset,
-// which is all the brick pass needs (a brick the triangle misses costs a walk of its columns
-// there). Per brick-sized window of dominant-axis columns its candidate box spans: none when the
-// projected triangle stays over a voxel away from the window, else the bricks along w between
-// the plane's lowest and highest point over the window's part of the box, widened by the voxels
-// a closed box can touch and one more for rounding. Doubles are exact on the snapped vertices'
-// differences, and rounding elsewhere is far below those one-voxel margins.
-void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std::uint32_t triangle,
-                 std::vector<BrickTriangle>& out) {
-  if (tv.empty()) return;
-  const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
-  double pu[3], pv[3];
-  for (int k = 0; k < 3; ++k) pu[k] = p[k][u], pv[k] = p[k][v];
-  const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0];
-  const Vec3d normal = Cross(e1, e2);
-  // (u, v, w) is a cyclic permutation of (x, y, z): normal[w] is the projection's doubled area.
-  const double nu = normal[u], nv = normal[v], nw = normal[w];
-  // A (nearly) degenerate triangle, whose rounded normal may point anywhere: its whole box.
-  const bool plane = std::abs(nw) > 1e-9 * Length(e1) * Length(e2);
-  const std::int64_t lo_u = tv.lo(u), hi_u = tv.hi(u), lo_v = tv.lo(v), hi_v = tv.hi(v);
-  constexpr int kB = std::countr_zero(PassBrick::kSide);
-  constexpr std::int64_t kS = kPassSide;
-  for (std::int64_t bv = lo_v >> kB; bv <= (hi_v - 1) >> kB; ++bv) {
-    for (std::int64_t bu = lo_u >> kB; bu <= (hi_u - 1) >> kB; ++bu) {
-      const double u0 = static_cast<double>(std::max(bu * kS, lo_u));
-      const double u1 = static_cast<double>(std::min(bu * kS + kS, hi_u));
-      const double v0 = static_cast<double>(std::max(bv * kS, lo_v));
-      const double v1 = static_cast<double>(std::min(bv * kS + kS, hi_v));
-      std::int64_t w_lo = tv.lo(w), w_hi = tv.hi(w) - 1;
-      if (plane) {
-        bool apart = false;  // an edge separates the triangle from the window grown by a voxel
-        for (int k = 0; k < 3; ++k) {
-          const int j = (k + 1) % 3;
-          const double sign = nw > 0 ? 1.0 : -1.0;  // inward normal of edge k→j
-          const double eu = -(pv[j] - pv[k]) * sign, ev = (pu[j] - pu[k]) * sign;
-          const double x = eu > 0 ? u1 + 1 : u0 - 1, y = ev > 0 ? v1 + 1 : v0 - 1;
-          apart |= eu * (x - pu[k]) + ev * (y - pv[k]) < 0;
-        }
-        if (apart) continue;
-        double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
-        for (const double x : {u0, u1}) {
-          for (const double y : {v0, v1}) {
-            const double h = p[0][w] - (nu * (x - pu[0]) + nv * (y - pv[0])) / nw;
-            h_lo = std::min(h_lo, h);
-            h_hi = std::max(h_hi, h);
-          }
-        }
-        w_lo = std::max(w_lo, static_cast<std::int64_t>(std::floor(h_lo)) - 2);
-        w_hi = std::min(w_hi, static_cast<std::int64_t>(std::floor(h_hi)) + 1);
-      }
-      for (std::int64_t bw = w_lo >> kB; bw <= w_hi >> kB && w_lo <= w_hi; ++bw) {
-        std::uint32_t c[3];
-        c[u] = Coord(bu), c[v] = Coord(bv), c[w] = Coord(bw);
-        out.push_back({MortonEncode(c[0], c[1], c[2]), triangle});
-      }
-    }
-  }
-}
-
-// A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
-// triangle spans a few bricks and a task's bricks are Morton neighbours (armadillo: 16 % of the
-// 91 k (brick, triangle) pairs hit at 1024³, 55 % of 258 k at 4096³).
-// Both are functions of the triangle alone, so hits change only the time.
-class TriangleCache {
- public:
-  struct Entry {
-    std::uint32_t triangle = ~0u;
-    std::optional<TriangleVoxelizer> tv;
-    AttributeSampler::Prepared prepared;
-  };
-  const Entry& Get(std::uint32_t t, const MeshVoxelizer& voxelizer,
-                   const AttributeSampler& sampler) {
-    Entry& e = entries_[t % kEntries];
-    if (e.triangle != t) {
-      e.triangle = t;
-      e.tv.emplace(voxelizer.Triangle(t));
-      e.prepared = sampler.Prepare(t);
-    }
-    return e;
-  }
-
- private:
-  static constexpr std::size_t kEntries = 256;
-  std::array<Entry, kEntries> entries_;
-};
-
-// The voxels of some consecutive bricks, in key order, with their attributes.
-struct VoxelRun {
-  DefaultInitVector<std::uint64_t> keys;
-  DefaultInitVector<std::uint8_t> gaps;  // packed output: keys[1..]'s varint gaps
-  DefaultInitVector<HalfRgba> colors;
-  DefaultInitVector<OctNormal> normals;
-  DefaultInitVector<Half> coverage;
-  void clear() { keys.clear(), gaps.clear(), colors.clear(), normals.clear(), coverage.clear(); }
-};
-
-// What the brick pass fills: 64-bit keys (a VoxelSet) or their varint gaps (packed), and the
-// per-voxel attributes asked for.
-struct OutputArrays {
-  std::span<std::uint64_t> keys;
-  std::span<std::uint8_t> gaps;
-  std::span<HalfRgba> colors;
-  std::span<OctNormal> normals;
-  std::span<Half> coverage;
-};
-// Arrays with room for (voxels, key bytes), keeping what the previous ones held.
-using ReserveOutput = std::function<StatusOr<OutputArrays>(std::size_t, std::size_t)>;
-
-// Where the brick pass puts its runs: arrays sized for an estimate up front, without a write;
-// runs are placed in key order (serial) and copied in parallel, so both threads first-touch the
-// fresh pages; runs past the room are appended after, in order, once the room is grown.
-class BrickOutput {
- public:
-  BrickOutput(ReserveOutput reserve, bool packed) : reserve_(std::move(reserve)), packed_(packed) {}
-  bool packed() const { return packed_; }
-
-  struct Slot {
-    std::size_t voxel = 0, byte = 0;
-    std::uint8_t head[kMaxVarintBytes];  // packed: the run's first key's varint
-    std::uint8_t head_size = 0;
-  };
-
-  Status Reserve(std::size_t voxels, std::size_t bricks) {
-    room_voxels_ = voxels;
-    // Gaps inside a brick take a byte; a brick's first key's may take up to ten.
-    room_bytes_ = packed_ ? voxels + kMaxVarintBytes * bricks : 0;
-    StatusOr<OutputArrays> arrays = reserve_(room_voxels_, room_bytes_);
-    if (!arrays.ok()) return arrays.status();
-    arrays_ = *arrays;
-    return Status::Ok();
-  }
-  // Serial, in key order: `slot` is where `run` goes; false when past the room (then Append it
-  // after, in order).
-  bool Place(const VoxelRun& run, Slot& slot) {
-    const std::size_t n = run.keys.size();
-    if (n == 0) return true;
-    if (aside_) return false;
-    std::size_t bytes = 0;
-    if (packed_) {
-      slot.head_size = static_cast<std::uint8_t>(PutVarint(run.keys[0] - last_ - 1, slot.head));
-      bytes = slot.head_size + run.gaps.size();
-    }
-    if (placed_voxels_ + n > room_voxels_ || placed_bytes_ + bytes > room_bytes_) {
-      aside_ = true;
-      return false;
-    }
-    slot.voxel = placed_voxels_, slot.byte = placed_bytes_;
-    placed_voxels_ += n, placed_bytes_ += bytes;
-    last_ = run.keys.back();
-    return true;
-  }
-  // Parallel.
-  void Copy(const VoxelRun& run, const Slot& slot) {
-    if (run.keys.empty()) return;
-    if (packed_) {
-      std::uint8_t* out = arrays_.gaps.data() + slot.byte;
-      std::memcpy(out, slot.head, slot.head_size);
-      std::memcpy(out + slot.head_size, run.gaps.data(), run.gaps.size());
-    } else {
-      std::copy(run.keys.begin(), run.keys.end(), arrays_.keys.begin() + slot.voxel);
-    }
-    CopyAttributes(run, slot.voxel);
-  }
-  // After the pass: grows the room for the runs set `aside` and appends them in order.
-  Status Finish(const std::vector<VoxelRun>& aside) {
-    std::size_t voxels = placed_voxels_, bytes = placed_bytes_;
-    std::uint64_t last = last_;
-    std::vector<Slot> slots(aside.size());
-    for (std::size_t i = 0; i < aside.size(); ++i) {
-      const VoxelRun& run = aside[i];
-      if (run.keys.empty()) continue;
-      slots[i].voxel = voxels, slots[i].byte = bytes;
-      voxels += run.keys.size();
-      if (packed_) {
-        slots[i].head_size =
-            static_cast<std::uint8_t>(PutVarint(run.keys[0] - last - 1, slots[i].head));
-        bytes += slots[i].head_size + run.gaps.size();
-      }
-      last = run.keys.back();
-    }
-    if (voxels > room_voxels_ || bytes > room_bytes_) {
-      StatusOr<OutputArrays> arrays = reserve_(voxels, bytes);
-      if (!arrays.ok()) return arrays.status();
-      arrays_ = *arrays;
-    }
-    for (std::size_t i = 0; i < aside.size(); ++i) Copy(aside[i], slots[i]);
-    count_ = voxels;
-    bytes_ = bytes;
-    return Status::Ok();
-  }
-  std::size_t count() const { return count_; }
-  std::size_t bytes() const { return bytes_; }
-
- private:
-  void CopyAttributes(const VoxelRun& run, std::size_t at) {
-    auto copy = [at](const auto& values, auto out) {
-      if (!out.empty()) std::copy(values.begin(), values.end(), out.begin() + at);
-    };
-    copy(run.coverage, arrays_.coverage);
-    copy(run.colors, arrays_.colors);
-    copy(run.normals, arrays_.normals);
-  }
-
-  ReserveOutput reserve_;
-  bool packed_;
-  OutputArrays arrays_;
-  std::size_t room_voxels_ = 0, room_bytes_ = 0, placed_voxels_ = 0, placed_bytes_ = 0;
-  std::size_t count_ = 0, bytes_ = 0;
-  std::uint64_t last_ = kNoPreviousKey;
-  bool aside_ = false;
-};
-
-// One pass brick's voxels (a bit set) and their area-weighted sums, indexed by local Morton code.
-// Colours are summed only when they differ between voxels (else the set holds the shared one),
-// in an array of their own that is otherwise never touched.
-class BrickAccumulator {
- public:
-  BrickAccumulator(bool colors, bool normals)
-      : color_sums_(colors ? kVoxels : 0), colors_(colors), normals_(normals) {}
-  static constexpr std::size_t kVoxels = PassBrick::kVoxels;
-  // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
-  // only that way still averages its contacts.
-  static constexpr double kMinWeight = 1.0 / (1 << 20);
-
-  void Add(std::uint32_t local, double area, const Rgba& color, const Vec3f& normal) {
-    bits_[local >> 6] |= std::uint64_t{1} << (local & 63);
-    Sum& sum = sums_[local];
-    const double w = area + kMinWeight;
-    sum.area += area;
-    if (colors_) {
-      ColorSum& c = color_sums_[local];
-      c.weight += w;
-      c.r += color.r * w, c.g += color.g * w, c.b += color.b * w, c.a += color.a * w;
-    }
-    sum.nx += normal.x * w, sum.ny += normal.y * w, sum.nz += normal.z * w;
-  }
-  // Appends the brick's voxels (bits set in local Morton order = key order) to `out`, and
-  // clears the brick.
-  void Finish(std::uint64_t brick, VoxelRun& out) {
-    std::uint16_t* locals = locals_.data();
-    std::size_t n = 0;
-    for (std::size_t word = 0; word < bits_.size(); ++word) {
-      for (std::uint64_t bits = bits_[word]; bits != 0; bits &= bits - 1) {
-        locals[n++] = static_cast<std::uint16_t>(word * 64 + std::countr_zero(bits));
-      }
-      bits_[word] = 0;
-    }
-    const std::size_t at = out.keys.size();
-    const std::uint64_t base = brick << PassBrick::kCodeBits;
-    out.keys.resize(at + n);
-    out.coverage.resize(at + n);
-    for (std::size_t i = 0; i < n; ++i) {
-      Sum& sum = sums_[locals[i]];
-      out.keys[at + i] = base | locals[i];
-      out.coverage[at + i] = static_cast<float>(sum.area);
-    }
-    if (colors_) {
-      out.colors.resize(at + n);
-      for (std::size_t i = 0; i < n; ++i) {
-        ColorSum& c = color_sums_[locals[i]];
-        const double inv = 1.0 / c.weight;  // ≥ kMinWeight
-        out.colors[at + i] = Rgba{static_cast<float>(c.r * inv), static_cast<float>(c.g * inv),
-                                  static_cast<float>(c.b * inv), static_cast<float>(c.a * inv)};
-        c = {};
-      }
-    }
-    if (normals_) {
-      // Octahedral codes keep the direction only: the sum's point on the octahedron, scaled in
-      // double whatever the sum's size (one division a voxel; a zero sum is "no normal").
-      out.normals.resize(at + n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const Sum& sum = sums_[locals[i]];
-        const double l1 = std::abs(sum.nx) + std::abs(sum.ny) + std::abs(sum.nz);
-        const double scale = 1.0 / l1;
-        out.normals[at + i] = OctNormal::FromCode(
-            l1 > 0 ? OctahedralEncodePoint<16>(static_cast<float>(sum.nx * scale),
-                                               static_cast<float>(sum.ny * scale),
-                                               static_cast<float>(sum.nz))
-                   : 0);
-      }
-    }
-    for (std::size_t i = 0; i < n; ++i) sums_[locals[i]] = {};
-  }
-
- private:
-  // A normal's weights need no sum (only its direction is kept): a voxel's sums fill half a
-  // cache line, and the colours' (with their weights) an array of their own.
-  struct alignas(32) Sum {
-    double area = 0, nx = 0, ny = 0, nz = 0;
-  };
-  struct ColorSum {
-    double weight = 0, r = 0, g = 0, b = 0, a = 0;
-  };
-  std::array<std::uint64_t, kVoxels / 64> bits_{};
-  std::array<std::uint16_t, kVoxels> locals_;
-  std::array<Sum, kVoxels> sums_{};
-  std::vector<ColorSum> color_sums_;
-  bool colors_, normals_;
-};
-
-// Voxels with attributes, brick by brick: every triangle of a brick's bin, in index order, walks
-// the brick's columns, marks its voxels and adds its samples; each voxel's sums thus have one
-// fixed order, and one walk finds both the voxels and what they hold. Groups of bricks are
-// filled in parallel and appended in key order.
-class BrickPass {
- public:
-  BrickPass(const MeshVoxelizer& voxelizer, const AttributeSampler& sampler, bool colors,
-            bool normals)
-      : voxelizer_(voxelizer), sampler_(sampler), colors_(colors), normals_(normals) {}
-
-  /// `bins`: the (brick, triangle) pairs BinToBricks listed, per chunk of triangles in index
-  /// order (each brick of a triangle once); `reserve`: room for the voxels to reserve up front
-  /// (more only costs a reallocation).
-  Status Run(std::vector<std::vector<BrickTriangle>>& bins, std::size_t reserve,
-             BrickOutput& output, Progress& progress) {
-    std::vector<BrickTriangle> pairs;
-    std::uint64_t last_brick = 0;
-    for (auto& b : bins) {
-      pairs.insert(pairs.end(), b.begin(), b.end());
-      for (const BrickTriangle& p : b) last_brick = std::max(last_brick, p.brick);
-      std::vector<BrickTriangle>().swap(b);
-    }
-    // In triangle order already: a stable sort by brick orders them by (brick, triangle).
-    RadixSortByKey(pairs, KeyBits(last_brick), [](const BrickTriangle& p) { return p.brick; });
-    std::vector<std::size_t> starts;  // first pair of each brick, and the end
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
-    }
-    starts.push_back(pairs.size());
-    const std::size_t bricks = starts.size() - 1;
-
-    SVOKIT_RETURN_IF_ERROR(output.Reserve(reserve, bricks));
-    Progress::Stage stage(progress, "attributes", bricks);
-    tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
-        [&] { return std::make_unique<BrickAccumulator>(colors_, normals_); });
-    tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
-        [] { return std::make_unique<TriangleCache>(); });
-    // Groups of kGroupBricks bricks: numbered in order, filled in parallel into a free buffer,
-    // placed in order and copied into the output in parallel.
-    const std::size_t groups = (bricks + kGroupBricks - 1) / kGroupBricks;
-    const std::size_t tokens =
-        4 * std::max<std::size_t>(1, tbb::this_task_arena::max_concurrency());
-    std::vector<VoxelRun> buffers(tokens);
-    tbb::concurrent_queue<std::size_t> free_buffers;  // at most `tokens` groups are in flight
-    for (std::size_t b = 0; b < tokens; ++b) free_buffers.push(b);
-    struct Group {
-      std::size_t index, buffer;
-      bool placed;
-      BrickOutput::Slot slot;
-    };
-    std::size_t next = 0;
-    std::vector<VoxelRun> aside;
-    auto number = [&](tbb::flow_control& fc) -> std::size_t {
-      if (next == groups) fc.stop();
-      return next++;
-    };
-    auto fill = [&](std::size_t g) {
-      Group group{g, 0, false, {}};
-      [[maybe_unused]] const bool popped = free_buffers.try_pop(group.buffer);
-      assert(popped);
-      VoxelRun& run = buffers[group.buffer];
-      const std::size_t end = std::min(bricks, (g + 1) * kGroupBricks);
-      for (std::size_t b = g * kGroupBricks; b < end; ++b) {
-        FillBrick(pairs, starts[b], starts[b + 1], *accumulators.local(), *caches.local(), run);
-      }
-      if (output.packed() && !run.keys.empty()) {
-        AppendKeyGaps(std::span<const std::uint64_t>(run.keys).subspan(1), run.keys[0], run.gaps);
-      }
-      return group;
-    };
-    auto place = [&](Group group) {
-      VoxelRun& run = buffers[group.buffer];
-      group.placed = output.Place(run, group.slot);
-      if (!group.placed) {
-        aside.push_back(std::move(run));
-        run = VoxelRun{};
-      }
-      stage.Advance(std::min(kGroupBricks, bricks - group.index * kGroupBricks));
-      return group;
-    };
-    auto copy = [&](const Group& group) {
-      VoxelRun& run = buffers[group.buffer];
-      if (group.placed) output.Copy(run, group.slot);
-      run.clear();
-      free_buffers.push(group.buffer);
-    };
-    tbb::parallel_pipeline(
-        tokens, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, number) &
-                    tbb::make_filter<std::size_t, Group>(tbb::filter_mode::parallel, fill) &
-                    tbb::make_filter<Group, Group>(tbb::filter_mode::serial_in_order, place) &
-                    tbb::make_filter<Group, void>(tbb::filter_mode::parallel, copy));
-    SVOKIT_RETURN_IF_ERROR(output.Finish(aside));
-    stage.SetSummary(fmt::format("{} voxels", output.count()));
-    return Status::Ok();
-  }
-
- private:
-  static constexpr std::size_t kGroupBricks = 4;
-
-  void FillBrick(const std::vector<BrickTriangle>& pairs, std::size_t first, std::size_t last,
-                 BrickAccumulator& acc, TriangleCache& cache, VoxelRun& out) const {
-    const std::uint64_t brick = pairs[first].brick;
-    const MortonCoord bc = MortonDecode(brick);
-    const std::int64_t lo[3] = {bc.x * kPassSide, bc.y * kPassSide, bc.z * kPassSide};
-    AttributeSample samples[kPassSide];  // one run's samples (built once: a run is often one voxel)
-    double areas[kPassSide];
-    for (std::size_t i = first; i < last; ++i) {
-      if (i + 2 < pairs.size()) voxelizer_.Prefetch(pairs[i + 2].triangle, MeshVoxelizer::kCorners);
-      if (i + 1 < pairs.size())
-        voxelizer_.Prefetch(pairs[i + 1].triangle, MeshVoxelizer::kVertices);
-      const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
-      const TriangleVoxelizer& tv = *entry.tv;
-      const AttributeSampler::Prepared& p = entry.prepared;
-      const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
-      // A uniform triangle's samples differ only in area (most meshes: scans, CAD, STL).
-      const bool uniform = p.uniform && p.axis == w;
-      AttributeSampler::ColumnSampler columns(sampler_, p);
-      tv.RunsAlongAxis(
-          lo[u], lo[u] + kPassSide, lo[v], lo[v] + kPassSide, lo[w], lo[w] + kPassSide,
-          [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
-              bool interior) {
-            const std::int64_t c[3] = {x, y, z};
-            const int count = static_cast<int>(k);  // ≤ kPassSide: the runs are the brick's
-            std::uint32_t local = PassBrick::LocalCode(Coord(c[0]), Coord(c[1]), Coord(c[2]));
-            if (uniform) {
-              columns.Areas(c[0], c[1], c[2], count, interior, areas);
-              for (int s = 0; s < count; ++s, local = PassBrick::NextLocal(local, axis)) {
-                acc.Add(local, areas[s], p.color, p.unit_normal);
-              }
-            } else {
-              columns.Sample(c[0], c[1], c[2], axis, count, interior, samples);
-              for (int s = 0; s < count; ++s, local = PassBrick::NextLocal(local, axis)) {
-                acc.Add(local, samples[s].area, samples[s].color, samples[s].normal);
-              }
-            }
-          });
-    }
-    acc.Finish(brick, out);
-  }
-
-  const MeshVoxelizer& voxelizer_;
-  const AttributeSampler& sampler_;
-  bool colors_, normals_;
-};
-
-}  // namespace
-
-namespace {
-
 // `array` resized to `n` without zeroing; an array big enough for malloc to map it on its own
 // (≥ 32 MiB, its largest threshold) on small pages: written once, in order, then read once by the
-// file writer, and small pages are cheaper to fault in than fresh 2 MB ones (armadillo 4096³,
-// whole process: 1.65 → 1.52 s). Heap pages would keep the advice for whatever reuses them.
+// file writer, and small pages are cheaper to fault in than fresh 2 MB ones. Heap pages would
+// keep the advice for whatever reuses them.
 template <class T>
 std::span<T> ResizeFresh(DefaultInitVector<T>& array, std::size_t n) {
   array.resize(n);
@@ -565,123 +49,80 @@ std::span<T> ResizeFresh(DefaultInitVector<T>& array, std::size_t n) {
   return array;
 }
 
-// A PackedVoxelSet's vectors as the storage of a packed voxelization.
-class PackedSetStorage final : public PackedVoxelStorage {
+// A VoxelSet (64-bit keys) or a PackedVoxelSet (key gaps), in its own vectors.
+template <class Set>
+class SetOutput final : public VoxelOutput {
  public:
-  explicit PackedSetStorage(PackedVoxelSet& set) : set_(set) {}
-  StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
-                                      std::size_t key_bytes) override {
-    PackedVoxelArrays arrays;
-    arrays.key_gaps = ResizeFresh(set_.key_gaps, key_bytes);
+  static constexpr bool kPacked = std::is_same_v<Set, PackedVoxelSet>;
+  explicit SetOutput(Set& set) : set_(set) {}
+  bool packed() const override { return kPacked; }
+  StatusOr<OutputArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
+                                 std::size_t key_bytes) override {
+    OutputArrays arrays;
+    if constexpr (kPacked) {
+      arrays.key_gaps = ResizeFresh(set_.key_gaps, key_bytes);
+    } else {
+      arrays.keys = ResizeFresh(set_.keys, voxels);
+    }
     if (contents.colors) arrays.colors = ResizeFresh(set_.colors, voxels);
     if (contents.normals) arrays.normals = ResizeFresh(set_.normals, voxels);
     if (contents.coverage) arrays.coverage = ResizeFresh(set_.coverage, voxels);
     return arrays;
   }
+  // The arrays cut to what holds voxels; grid, mode, warnings and a shared colour beside them.
+  void Finish(VoxelAttributes attributes, const PackedVoxelContents& contents, std::uint64_t count,
+              std::size_t key_bytes) override {
+    if constexpr (kPacked) {
+      set_.key_gaps.resize(key_bytes);
+      set_.count = count;
+    } else {
+      set_.keys.resize(count);
+    }
+    if (contents.colors) set_.colors.resize(count);
+    if (contents.normals) set_.normals.resize(count);
+    if (contents.coverage) set_.coverage.resize(count);
+    set_.grid = attributes.grid;
+    set_.mode = attributes.mode;
+    set_.warnings = std::move(attributes.warnings);
+    if (!contents.colors) set_.colors = std::move(attributes.colors);
+  }
 
  private:
-  PackedVoxelSet& set_;
+  Set& set_;
 };
 
-// Where VoxelizeInto() puts the voxels: 64-bit keys and attribute arrays into `set`, or packed
-// into `storage`, with `packed` told the counts.
-struct Destination {
-  VoxelSet* set = nullptr;
-  PackedVoxelStorage* storage = nullptr;
-  PackedVoxelization* packed = nullptr;
+// Arrays a PackedVoxelStorage provides (e.g. a file's sections), the counts into `result`.
+class StorageOutput final : public VoxelOutput {
+ public:
+  StorageOutput(PackedVoxelStorage& storage, PackedVoxelization& result)
+      : storage_(storage), result_(result) {}
+  bool packed() const override { return true; }
+  StatusOr<OutputArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
+                                 std::size_t key_bytes) override {
+    StatusOr<PackedVoxelArrays> arrays = storage_.Reserve(contents, voxels, key_bytes);
+    if (!arrays.ok()) return arrays.status();
+    OutputArrays out;
+    static_cast<PackedVoxelArrays&>(out) = *arrays;
+    return out;
+  }
+  void Finish(VoxelAttributes attributes, const PackedVoxelContents& contents, std::uint64_t count,
+              std::size_t key_bytes) override {
+    result_ = {std::move(attributes), contents, count, key_bytes};
+  }
+
+ private:
+  PackedVoxelStorage& storage_;
+  PackedVoxelization& result_;
 };
 
-// Voxelize() and VoxelizePacked().
-Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
-                    Progress& progress, const Destination& to) {
-  VoxelAttributes& out = to.set ? *to.set : to.packed->attributes;
-  if (mesh.triangles.empty()) return Status::BadInput("the mesh has no triangles to voxelize");
-  const std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
-  for (const FixedPoint3& v : vertices) {
-    for (int a = 0; a < 3; ++a) {
-      if (v[a] <= -kCoordinateLimit || v[a] >= kCoordinateLimit) {
-        return Status::BadInput("the mesh reaches {} voxels outside the grid (limit ±2^22)",
-                                FixedToVoxel(v)[a]);
-      }
-    }
-  }
-  const MeshVoxelizer voxelizer(mesh, vertices, grid, options.mode);
-  const std::size_t n = mesh.triangles.size();
-
-  // A surface of area A voxel² fills roughly 1.5·A voxels (at most ~3·A): refuse, up front, grids
-  // whose output could not be held rather than run for hours into an out-of-memory failure.
-  const double projected_area = OrderedReduce(
-      n, 1 << 14, 0.0,
-      [&](std::size_t begin, std::size_t end) {
-        double area = 0;
-        for (std::size_t t = begin; t < end; ++t) area += voxelizer.ProjectedArea(t);
-        return area;
-      },
-      [](double& acc, double part) { acc += part; });
-  const double estimate = 3.0 * projected_area + static_cast<double>(n);
-  if (estimate > kMaxVoxels) {
-    return Status::BadInput(
-        "this grid would hold about {:.3g} voxels (limit {:.3g}); use a coarser resolution",
-        estimate, kMaxVoxels);
-  }
-
-  out.grid = grid;
-  out.mode = options.mode;
-  if (options.colors || options.normals) {
-    // Voxels and attributes come out of one walk per brick (BrickPass), whatever the method:
-    // first the bricks each triangle may touch.
-    std::vector<std::vector<BrickTriangle>> bins((n + kTrianglesPerTask - 1) / kTrianglesPerTask);
-    {
-      Progress::Stage stage(progress, "voxelize", n);
-      ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-        std::vector<BrickTriangle>& pairs = bins[begin / kTrianglesPerTask];
-        for (std::size_t t = begin; t < end; ++t) {
-          BinToBricks(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
-                      pairs);
-        }
-        stage.Advance(end - begin);
-      });
-    }
-    const AttributeSampler sampler(mesh, vertices, options.colors, options.normals);
-    out.warnings = sampler.warnings();
-    const std::optional<Rgba> shared_color = sampler.SharedColor();
-    if (shared_color) out.colors.assign(1, *shared_color);
-    const bool colors = options.colors && !shared_color;
-    const PackedVoxelContents contents{colors, options.normals, true, shared_color.has_value()};
-    ReserveOutput reserve;
-    if (to.set) {
-      reserve = [&](std::size_t voxels, std::size_t) -> StatusOr<OutputArrays> {
-        OutputArrays arrays;
-        arrays.keys = ResizeFresh(to.set->keys, voxels);
-        if (colors) arrays.colors = ResizeFresh(to.set->colors, voxels);
-        if (options.normals) arrays.normals = ResizeFresh(to.set->normals, voxels);
-        arrays.coverage = ResizeFresh(to.set->coverage, voxels);
-        return arrays;
-      };
-    } else {
-      reserve = [&](std::size_t voxels, std::size_t bytes) -> StatusOr<OutputArrays> {
-        StatusOr<PackedVoxelArrays> a = to.storage->Reserve(contents, voxels, bytes);
-        if (!a.ok()) return a.status();
-        return OutputArrays{{}, a->key_gaps, a->colors, a->normals, a->coverage};
-      };
-    }
-    BrickPass pass(voxelizer, sampler, colors, options.normals);
-    BrickOutput output(std::move(reserve), to.set == nullptr);
-    // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-    SVOKIT_RETURN_IF_ERROR(
-        pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, output, progress));
-    if (to.set) {
-      VoxelSet& set = *to.set;
-      set.keys.resize(output.count());
-      if (colors) set.colors.resize(output.count());
-      if (options.normals) set.normals.resize(output.count());
-      set.coverage.resize(output.count());
-    } else {
-      *to.packed = {std::move(out), contents, output.count(), output.bytes()};
-    }
-    return Status::Ok();
-  }
-
+// The voxels alone: every triangle's exact runs into per-thread bit sets, by the triangle path,
+// the fragment path or both (VoxelMethod); their union is the result.
+Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& grid,
+                        const VoxelizeOptions& options, VoxelAttributes attributes,
+                        VoxelOutput& output, Progress& progress) {
+  const Mesh& mesh = voxelizer.mesh();
+  const std::vector<FixedPoint3>& vertices = voxelizer.vertices();
+  const std::size_t n = voxelizer.size();
   // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
   if (options.method == VoxelMethod::kHybrid) {
@@ -779,12 +220,12 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
     stage->Advance(large.size());
   }
 
-  std::uint64_t count = 0;
-  if (to.storage) {
-    Status reserved;
-    std::size_t key_bytes = 0;
+  Status reserved;
+  std::size_t key_bytes = 0;
+  std::uint64_t count;
+  if (output.packed()) {
     count = VoxelBitSet::UnionPacked(parts, [&](std::size_t bytes) -> std::uint8_t* {
-      StatusOr<PackedVoxelArrays> arrays = to.storage->Reserve({}, 0, bytes);
+      StatusOr<OutputArrays> arrays = output.Reserve({}, 0, bytes);
       if (!arrays.ok()) {
         reserved = arrays.status();
         return nullptr;
@@ -792,14 +233,63 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
       key_bytes = bytes;
       return arrays->key_gaps.data();
     });
-    SVOKIT_RETURN_IF_ERROR(reserved);
-    *to.packed = {std::move(out), {}, count, key_bytes};
   } else {
-    to.set->keys = VoxelBitSet::UnionKeys(parts);
-    count = to.set->keys.size();
+    count = VoxelBitSet::UnionKeys(parts, [&](std::size_t voxels) -> std::uint64_t* {
+      StatusOr<OutputArrays> arrays = output.Reserve({}, voxels, 0);
+      if (!arrays.ok()) {
+        reserved = arrays.status();
+        return nullptr;
+      }
+      return arrays->keys.data();
+    });
   }
+  SVOKIT_RETURN_IF_ERROR(reserved);
+  output.Finish(std::move(attributes), {}, count, key_bytes);
   stage->SetSummary(fmt::format("{} voxels", count));
   return Status::Ok();
+}
+
+// Voxelize() and VoxelizePacked(): checks, then the geometry or the attribute pass.
+Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
+                    Progress& progress, VoxelOutput& output) {
+  if (mesh.triangles.empty()) return Status::BadInput("the mesh has no triangles to voxelize");
+  const std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
+  for (const FixedPoint3& v : vertices) {
+    for (int a = 0; a < 3; ++a) {
+      if (v[a] <= -kCoordinateLimit || v[a] >= kCoordinateLimit) {
+        return Status::BadInput("the mesh reaches {} voxels outside the grid (limit ±2^22)",
+                                FixedToVoxel(v)[a]);
+      }
+    }
+  }
+  const MeshVoxelizer voxelizer(mesh, vertices, grid, options.mode);
+  const std::size_t n = mesh.triangles.size();
+
+  // A surface of area A voxel² fills roughly 1.5·A voxels (at most ~3·A): refuse, up front, grids
+  // whose output could not be held rather than run for hours into an out-of-memory failure.
+  const double projected_area = OrderedReduce(
+      n, 1 << 14, 0.0,
+      [&](std::size_t begin, std::size_t end) {
+        double area = 0;
+        for (std::size_t t = begin; t < end; ++t) area += voxelizer.ProjectedArea(t);
+        return area;
+      },
+      [](double& acc, double part) { acc += part; });
+  const double estimate = 3.0 * projected_area + static_cast<double>(n);
+  if (estimate > kMaxVoxels) {
+    return Status::BadInput(
+        "this grid would hold about {:.3g} voxels (limit {:.3g}); use a coarser resolution",
+        estimate, kMaxVoxels);
+  }
+
+  VoxelAttributes attributes;
+  attributes.grid = grid;
+  attributes.mode = options.mode;
+  if (options.colors || options.normals) {
+    return voxelize_detail::VoxelizeWithAttributes(voxelizer, options, projected_area,
+                                                   std::move(attributes), output, progress);
+  }
+  return VoxelizeGeometry(voxelizer, grid, options, std::move(attributes), output, progress);
 }
 
 }  // namespace
@@ -807,7 +297,8 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
 StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                             const VoxelizeOptions& options, Progress& progress) {
   VoxelSet set;
-  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, {&set, nullptr, nullptr}));
+  SetOutput<VoxelSet> output(set);
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, output));
   return set;
 }
 
@@ -815,27 +306,16 @@ StatusOr<PackedVoxelization> VoxelizePacked(const Mesh& mesh, const GridTransfor
                                             const VoxelizeOptions& options,
                                             PackedVoxelStorage& storage, Progress& progress) {
   PackedVoxelization packed;
-  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, {nullptr, &storage, &packed}));
+  StorageOutput output(storage, packed);
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, output));
   return packed;
 }
 
 StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& grid,
                                         const VoxelizeOptions& options, Progress& progress) {
   PackedVoxelSet set;
-  PackedSetStorage storage(set);
-  StatusOr<PackedVoxelization> packed = VoxelizePacked(mesh, grid, options, storage, progress);
-  if (!packed.ok()) return packed.status();
-  // The arrays cut to what holds voxels; grid, mode, warnings and a shared colour beside them.
-  const PackedVoxelization& p = *packed;
-  set.key_gaps.resize(p.key_bytes);
-  if (p.contents.colors) set.colors.resize(p.count);
-  if (p.contents.normals) set.normals.resize(p.count);
-  if (p.contents.coverage) set.coverage.resize(p.count);
-  set.count = p.count;
-  set.grid = p.attributes.grid;
-  set.mode = p.attributes.mode;
-  set.warnings = p.attributes.warnings;
-  if (!p.contents.colors) set.colors = p.attributes.colors;
+  SetOutput<PackedVoxelSet> output(set);
+  SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, output));
   return set;
 }
 

@@ -2,7 +2,7 @@
 // Surface voxelization of a mesh into a VoxelSet: conservative (26-separating) or thin
 // (6-separating), by the triangle-parallel, fragment-parallel or hybrid method. All methods and
 // all thread counts produce the identical set: they only split the same exact per-column work
-// differently (see triangle_voxel_test.hpp).
+// differently (see triangle_voxelizer.hpp).
 
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"

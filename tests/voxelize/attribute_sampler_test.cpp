@@ -19,7 +19,7 @@
 #include <tbb/parallel_for.h>
 
 #include "svokit/core/file_io.hpp"
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {

@@ -1,4 +1,4 @@
-#include "svokit/voxelize/triangle_voxel_test.hpp"
+#include "svokit/voxelize/triangle_voxelizer.hpp"
 
 #include <cmath>
 #include <cstdlib>

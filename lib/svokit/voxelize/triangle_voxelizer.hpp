@@ -193,4 +193,4 @@ class TriangleVoxelizer {
 
 }  // namespace svokit
 
-#include "svokit/voxelize/triangle_voxel_test_impl.hpp"
+#include "svokit/voxelize/triangle_voxelizer_impl.hpp"

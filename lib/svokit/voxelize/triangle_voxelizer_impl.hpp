@@ -1,6 +1,6 @@
 #pragma once
 // Inline part of TriangleVoxelizer: the per-column walk, templated on the emitter so the inner
-// loop has no indirect calls. Included by triangle_voxel_test.hpp only.
+// loop has no indirect calls. Included by triangle_voxelizer.hpp only.
 
 #include <algorithm>
 
