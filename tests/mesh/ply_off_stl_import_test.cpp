@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <initializer_list>
+#include <numbers>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -228,7 +229,7 @@ TEST(PlyOffStlRealFiles, AssimpPlyFiles) {
 
   // Point clouds (no faces) are refused with a clear message.
   for (const char* name : {"points.ply", "issue623.ply", "pond.0.ply"}) {
-    ExpectBadInput(detail::ImportPly(dir / name), dir / name, {"no 'face' element"});
+    ExpectBadInput(detail::ImportPly(dir / name), dir / name, {"no 'face' or 'tristrips' element"});
   }
 }
 
@@ -617,6 +618,165 @@ TEST(PlyImport, HugeCountsFailFast) {
       "empty-element.ply", "ply\nformat ascii 1.0\nelement nothing 999999999999999\nend_header\n");
   ExpectBadInput(detail::ImportPly(empty_element), empty_element, {"no properties"});
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs that cost super-linear time. Complexity guards, the one kind of timing assert allowed
+// here: a linear parser reads the 100,000-property header in well under a second (bound 5 s) and
+// the million-corner face in 1-2 s on a loaded 2-core machine (bound 30 s); the quadratic steps
+// took over a minute and many minutes, so the bounds separate the two by more than 10x either way.
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+TEST(InputComplexity, PlyHeaderWithHundredThousandProperties) {
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "element extra 0\n";
+  for (int k = 0; k < 100000; ++k) ply += fmt::format("property float p{}\n", k);
+  ply += "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const fs::path path = WriteFile("many-properties.ply", ply);
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh mesh = ExpectImports(detail::ImportPly(path));
+  EXPECT_LT(SecondsSince(start), 5.0);
+  EXPECT_EQ(mesh.triangle_count(), 1u);
+}
+
+// One face of a million corners on a circle, written in each text format.
+constexpr int kHugeFaceCorners = 1000000;
+std::string CircleVertices(const char* prefix) {
+  std::string out;
+  for (int i = 0; i < kHugeFaceCorners; ++i) {
+    const double a = 2 * std::numbers::pi * i / kHugeFaceCorners;
+    out += fmt::format("{}{} {} 0\n", prefix, std::cos(a), std::sin(a));
+  }
+  return out;
+}
+std::string Indices(int base) {
+  std::string out;
+  for (int i = 0; i < kHugeFaceCorners; ++i) out += fmt::format(" {}", i + base);
+  return out;
+}
+void ExpectHugeFaceImportsFast(const fs::path& path, StatusOr<Mesh> (*import)(const fs::path&)) {
+  SCOPED_TRACE(path.string());
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh mesh = ExpectImports(import(path));
+  const double seconds = SecondsSince(start);
+  ::testing::Test::RecordProperty(path.extension().string().substr(1) + "_seconds",
+                                  std::to_string(seconds));
+  EXPECT_LT(seconds, 30.0);
+  EXPECT_EQ(mesh.triangle_count(), static_cast<std::size_t>(kHugeFaceCorners - 2));
+  double area = 0;
+  for (const Triangle& t : mesh.triangles) area += TriangleArea(mesh, t);
+  EXPECT_NEAR(area, std::numbers::pi, 1e-3);
+}
+
+TEST(InputComplexity, OneFaceOfAMillionCorners) {
+  ExpectHugeFaceImportsFast(
+      WriteFile("huge-face.obj", CircleVertices("v ") + "f" + Indices(1) + "\n"),
+      &detail::ImportObj);
+  ExpectHugeFaceImportsFast(
+      WriteFile("huge-face.off", fmt::format("OFF\n{} 1 0\n", kHugeFaceCorners) +
+                                     CircleVertices("") +
+                                     fmt::format("{}{}\n", kHugeFaceCorners, Indices(0))),
+      &detail::ImportOff);
+  ExpectHugeFaceImportsFast(
+      WriteFile("huge-face.ply",
+                fmt::format("ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\n"
+                            "property float y\nproperty float z\nelement face 1\n"
+                            "property list int int vertex_indices\nend_header\n",
+                            kHugeFaceCorners) +
+                    CircleVertices("") + fmt::format("{}{}\n", kHugeFaceCorners, Indices(0))),
+      &detail::ImportPly);
+}
+
+// ---------------------------------------------------------------------------------------------
+// PLY triangle strips (Stanford scans such as Igea)
+
+// A 4 x 2 grid of vertices: bottom row 0..3 at y = 0, top row 4..7 at y = 1.
+constexpr std::string_view kGridVertices =
+    "0 0 0\n1 0 0\n2 0 0\n3 0 0\n0 1 0\n1 1 0\n2 1 0\n3 1 0\n";
+constexpr std::string_view kGridHeader =
+    "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n";
+
+// Triangles as a set, each rotated to start at its smallest index so orientation still counts.
+std::vector<Triangle> TriangleSet(const Mesh& mesh) {
+  std::vector<Triangle> out;
+  for (Triangle t : mesh.triangles) {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    out.push_back(t);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The grid's six triangles written as a face list, the reference the strips must match.
+std::vector<Triangle> GridAsFaces() {
+  const fs::path path = WriteFile(
+      "grid-faces.ply",
+      fmt::format("ply\nformat ascii 1.0\n{}element face 6\nproperty list uchar int "
+                  "vertex_indices\nend_header\n{}3 0 4 1\n3 1 4 5\n3 1 5 2\n3 2 5 6\n3 2 6 3\n"
+                  "3 3 6 7\n",
+                  kGridHeader, kGridVertices));
+  const Mesh mesh = ExpectImports(detail::ImportPly(path));
+  return TriangleSet(mesh);
+}
+
+TEST(PlyImport, TristripsAsciiAndBinaryMatchTheFaceList) {
+  const std::vector<Triangle> faces = GridAsFaces();
+  ASSERT_EQ(faces.size(), 6u);
+  const std::vector<int> strip = {0, 4, 1, 5, 2, 6, 3, 7};
+  std::string ascii = fmt::format(
+      "ply\nformat ascii 1.0\n{}element tristrips 1\nproperty list int int vertex_indices\n"
+      "end_header\n{}{}",
+      kGridHeader, kGridVertices, strip.size());
+  for (int v : strip) ascii += fmt::format(" {}", v);
+  const fs::path ascii_path = WriteFile("strip-ascii.ply", ascii + "\n");
+  const Mesh from_ascii = ExpectImports(detail::ImportPly(ascii_path));
+  ExpectConsistent(from_ascii);
+  EXPECT_EQ(TriangleSet(from_ascii), faces);
+  for (const bool big_endian : {false, true}) {
+    Packer p(big_endian);
+    p.Text(
+        fmt::format("ply\nformat binary_{}_endian 1.0\n{}element tristrips 1\n"
+                    "property list int int vertex_indices\nend_header\n",
+                    big_endian ? "big" : "little", kGridHeader));
+    for (const int v : {0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0, 3, 1, 0}) {
+      p.Put(static_cast<float>(v));
+    }
+    p.Put(static_cast<std::int32_t>(strip.size()));
+    for (int v : strip) p.Put(static_cast<std::int32_t>(v));
+    const fs::path path = WriteFile(big_endian ? "strip-be.ply" : "strip-le.ply", p.bytes());
+    const Mesh mesh = ExpectImports(detail::ImportPly(path));
+    ExpectConsistent(mesh);
+    EXPECT_EQ(TriangleSet(mesh), faces) << path;
+  }
+}
+
+TEST(PlyImport, TristripsRestartsAndDegenerates) {
+  // -1 restarts a strip and its parity; (6, 6, 3) style triangles are dropped; a strip too short
+  // for a triangle yields none. The three strips cover the same six triangles as the face list.
+  const fs::path path = WriteFile("strip-restarts.ply",
+                                  fmt::format("ply\nformat ascii 1.0\n{}element tristrips 2\n"
+                                              "property list int int vertex_indices\nend_header\n{}"
+                                              "17 0 4 1 5 -1 1 5 2 6 6 3 -1 -1 2 6 3 7\n2 3 7\n",
+                                              kGridHeader, kGridVertices));
+  const Mesh mesh = ExpectImports(detail::ImportPly(path));
+  ExpectConsistent(mesh);
+  EXPECT_EQ(mesh.triangle_count(), 6u);
+  EXPECT_EQ(TriangleSet(mesh), GridAsFaces());
+}
+
+TEST(PlyImport, TristripsIndexErrorsNameTheFile) {
+  for (const std::string_view bad : {"3 0 4 8", "3 0 -2 4"}) {
+    const fs::path path = WriteFile(
+        "strip-bad.ply", fmt::format("ply\nformat ascii 1.0\n{}element tristrips 1\n"
+                                     "property list int int vertex_indices\nend_header\n{}{}\n",
+                                     kGridHeader, kGridVertices, bad));
+    ExpectBadInput(detail::ImportPly(path), path, {"tristrips 0", "out of range"});
+  }
 }
 
 TEST(PlyImport, FaceColoursAndExtraElements) {

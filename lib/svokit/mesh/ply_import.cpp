@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <unordered_set>
 
 #include "svokit/mesh/importers.hpp"
 #include "svokit/mesh/mesh_builder.hpp"
@@ -160,6 +161,11 @@ Role FaceRole(std::string_view n) {
   return ColorRole(n);
 }
 
+// Stanford scans (e.g. Igea) store triangle strips instead of faces.
+Role StripRole(std::string_view n) {
+  return n == "vertex_indices" || n == "vertex_index" ? kIndices : kIgnore;
+}
+
 struct PlyProperty {
   std::string name;
   PlyType type = PlyType::kFloat32;  // the item type for lists
@@ -173,8 +179,9 @@ struct PlyElement {
   std::string name;
   std::uint64_t count = 0;
   std::vector<PlyProperty> properties;
-  std::array<bool, kRoleCount> has{};      // which roles a property fills
-  std::array<double, kRoleCount> scale{};  // colour channel scale per role
+  std::unordered_set<std::string> property_names;  // a header may declare very many properties
+  std::array<bool, kRoleCount> has{};              // which roles a property fills
+  std::array<double, kRoleCount> scale{};          // colour channel scale per role
   std::size_t line = 0;
 
   bool Has(std::initializer_list<Role> roles) const {
@@ -376,6 +383,13 @@ struct FaceSoup {
   std::vector<std::uint32_t> materials;  // one per face when texnumber selects a TextureFile
 };
 
+// Triangle strips as read: vertex indices of all strips, kRestart where a strip restarts.
+struct StripSoup {
+  static constexpr std::uint32_t kRestart = UINT32_MAX;
+  std::vector<std::uint32_t> indices;
+  std::vector<std::size_t> ends;  // end of strip element s in `indices`
+};
+
 enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
 
 class PlyImporter {
@@ -479,8 +493,8 @@ class PlyImporter {
     if (element.name.empty()) return scan_.Error("'element' without a name");
     SVOKIT_RETURN_IF_ERROR(scan_.Number(element.count, "an element count"));
     if (!scan_.AtLineEnd()) return scan_.Error("unexpected text after the element count");
-    for (const PlyElement& e : elements_) {
-      if (e.name == element.name) return scan_.Error("element '{}' is declared twice", e.name);
+    if (!element_names_.insert(element.name).second) {
+      return scan_.Error("element '{}' is declared twice", element.name);
     }
     elements_.push_back(std::move(element));
     return Status::Ok();
@@ -512,10 +526,8 @@ class PlyImporter {
     p.name = std::string(scan_.Token());
     if (p.name.empty()) return scan_.Error("property without a name");
     if (!scan_.AtLineEnd()) return scan_.Error("unexpected text after property '{}'", p.name);
-    for (const PlyProperty& q : element.properties) {
-      if (q.name == p.name) {
-        return scan_.Error("element '{}' declares property '{}' twice", element.name, p.name);
-      }
+    if (!element.property_names.insert(p.name).second) {
+      return scan_.Error("element '{}' declares property '{}' twice", element.name, p.name);
     }
     element.properties.push_back(std::move(p));
     return Status::Ok();
@@ -529,15 +541,19 @@ class PlyImporter {
   // Finds the vertex and face elements and decides what each of their properties feeds.
   Status AssignRoles() {
     for (PlyElement& e : elements_) {
-      const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
+      const bool is_vertex = e.name == "vertex", is_face = e.name == "face",
+                 is_strips = e.name == "tristrips";
       if (e.count > 0 && e.properties.empty()) {
         return LineError(e.line, "element '{}' has no properties", e.name);
       }
       if (is_vertex) vertex_ = &e;
       if (is_face) face_ = &e;
-      if (!is_vertex && !is_face) continue;
+      if (is_strips) strips_ = &e;
+      if (!is_vertex && !is_face && !is_strips) continue;
       for (PlyProperty& p : e.properties) {
-        const Role role = is_vertex ? VertexRole(p.name) : FaceRole(p.name);
+        const Role role = is_vertex ? VertexRole(p.name)
+                          : is_face ? FaceRole(p.name)
+                                    : StripRole(p.name);
         if (role == kIgnore || e.has[role]) continue;  // unknown, or an alias already seen
         const bool wants_list = role == kIndices || role == kTexcoord;
         if (p.is_list != wants_list) {
@@ -561,14 +577,20 @@ class PlyImporter {
       return LineError(vertex_->line, "{} vertices; at most 2^32 - 1 are supported",
                        vertex_->count);
     }
-    if (!face_) {
+    if (!face_ && !strips_) {
       return Status::BadInput(
-          "{}: the PLY file has no 'face' element (a point cloud?); svokit needs triangles", name_);
+          "{}: the PLY file has no 'face' or 'tristrips' element (a point cloud?); svokit needs "
+          "triangles",
+          name_);
     }
-    if (!face_->has[kIndices]) {
-      return LineError(face_->line, "element 'face' has no 'vertex_indices' list");
+    for (const PlyElement* e : {face_, strips_}) {
+      if (e && !e->has[kIndices]) {
+        return LineError(e->line, "element '{}' has no 'vertex_indices' list", e->name);
+      }
     }
-    if (face_->count == 0) return LineError(face_->line, "the PLY file declares 0 faces");
+    if ((face_ ? face_->count : 0) + (strips_ ? strips_->count : 0) == 0) {
+      return LineError((face_ ? face_ : strips_)->line, "the PLY file declares 0 faces");
+    }
     const PlyElement& v = *vertex_;
     auto incomplete = [&](std::initializer_list<Role> roles, const char* what) {
       const bool any = std::any_of(roles.begin(), roles.end(), [&](Role r) { return v.has[r]; });
@@ -606,6 +628,8 @@ class PlyImporter {
       }
       needed += e.count * per_element;
     }
+    mesh_.positions.reserve(vertex_->count);
+    if (!face_) return Status::Ok();
     // Faces with fewer than 3 corners are errors, so a valid face needs room for 3 indices.
     std::uint64_t face_bytes = MinElementBytes(*face_);
     for (const PlyProperty& p : face_->properties) {
@@ -613,7 +637,6 @@ class PlyImporter {
     }
     const std::uint64_t face_capacity =
         std::min<std::uint64_t>(face_->count, available / face_bytes);
-    mesh_.positions.reserve(vertex_->count);
     soup_.ends.reserve(face_capacity);
     soup_.corners.reserve(3 * face_capacity);
     return Status::Ok();
@@ -627,7 +650,7 @@ class PlyImporter {
 
   template <class Reader>
   Status ReadElement(Reader& in, const PlyElement& e) {
-    const bool is_vertex = &e == vertex_, is_face = &e == face_;
+    const bool is_vertex = &e == vertex_, is_face = &e == face_, is_strips = &e == strips_;
     const bool normals = is_vertex && e.Has({kNx, kNy, kNz});
     const bool uvs = is_vertex && e.Has({kU, kV});
     const bool colors = e.Has({kRed, kGreen, kBlue});
@@ -654,7 +677,9 @@ class PlyImporter {
         if (n < 0)
           return in.Error("element '{}' {}: list '{}' has length {}", e.name, i, p.name, n);
         const auto length = static_cast<std::uint64_t>(n);
-        if (p.role == kIndices) {
+        if (p.role == kIndices && is_strips) {
+          SVOKIT_RETURN_IF_ERROR(ReadStrip(in, {e, i, &p}, length));
+        } else if (p.role == kIndices) {
           SVOKIT_RETURN_IF_ERROR(ReadCorners(in, {e, i, &p}, length));
         } else if (p.role == kTexcoord) {
           SVOKIT_RETURN_IF_ERROR(ReadTexcoords(in, {e, i, &p}, length));
@@ -690,6 +715,8 @@ class PlyImporter {
           }
           soup_.materials.push_back(static_cast<std::uint32_t>(t));
         }
+      } else if (is_strips) {
+        strips_soup_.ends.push_back(strips_soup_.indices.size());
       }
     }
     return Status::Ok();
@@ -710,6 +737,53 @@ class PlyImporter {
       soup_.corners.push_back(static_cast<std::uint32_t>(v));
     }
     return Status::Ok();
+  }
+
+  // A strip of any length; -1 restarts it.
+  template <class Reader>
+  Status ReadStrip(Reader& in, const PlyCursor& at, std::uint64_t n) {
+    if (!in.CanHold(at.property->type, n)) return in.Failure(at);
+    const std::int64_t vertex_count = static_cast<std::int64_t>(vertex_->count);
+    for (std::uint64_t k = 0; k < n; ++k) {
+      std::int64_t v = 0;
+      if (!in.Integer(at.property->type, v)) return in.Failure(at);
+      if (v == -1) {
+        strips_soup_.indices.push_back(StripSoup::kRestart);
+        continue;
+      }
+      if (v < 0 || v >= vertex_count) {
+        return in.Error(
+            "tristrips {}: vertex index {} is out of range (the file has {} vertices; -1 restarts "
+            "a strip)",
+            at.index, v, vertex_count);
+      }
+      strips_soup_.indices.push_back(static_cast<std::uint32_t>(v));
+    }
+    return Status::Ok();
+  }
+
+  // Triangle i of a strip is (v[i], v[i+1], v[i+2]) for even i and (v[i+1], v[i], v[i+2]) for
+  // odd i, so the winding stays consistent; -1 starts a new strip (and a new parity), as in
+  // VCG/MeshLab. Degenerate triangles, which strips use to turn or join, are dropped.
+  void AppendStrips(PolygonAppender& out) const {
+    const std::span<const std::uint32_t> all = strips_soup_.indices;
+    std::size_t begin = 0;
+    for (const std::size_t end : strips_soup_.ends) {
+      std::size_t start = begin;
+      for (std::size_t k = begin; k + 2 < end; ++k) {
+        const std::uint32_t a = all[k], b = all[k + 1], c = all[k + 2];
+        if (a == StripSoup::kRestart) {
+          start = k + 1;
+          continue;
+        }
+        if (b == StripSoup::kRestart || c == StripSoup::kRestart) continue;
+        if (a == b || b == c || a == c) continue;
+        const std::array<std::uint32_t, 3> tri =
+            (k - start) % 2 == 0 ? std::array{a, b, c} : std::array{b, a, c};
+        out.Append(tri);
+      }
+      begin = end;
+    }
   }
 
   template <class Reader>
@@ -747,7 +821,7 @@ class PlyImporter {
     }
     PolygonAppender out(mesh_, vertex_attributes_);
     // Triangulating an n-gon always yields n - 2 triangles.
-    out.Reserve(soup_.corners.size() - 2 * soup_.ends.size());
+    out.Reserve(soup_.corners.size() - 2 * soup_.ends.size() + strips_soup_.indices.size());
     const std::span<const std::uint32_t> corners = soup_.corners;
     const std::span<const Vec2f> corner_uvs = soup_.corner_uvs;
     std::size_t begin = 0;
@@ -759,6 +833,7 @@ class PlyImporter {
                  soup_.materials.empty() ? 0 : soup_.materials[f]);
       begin = soup_.ends[f];
     }
+    AppendStrips(out);
     return Status::Ok();
   }
 
@@ -768,10 +843,13 @@ class PlyImporter {
   TextScanner scan_;
   PlyFormat format_ = PlyFormat::kAscii;
   std::vector<PlyElement> elements_;
+  std::unordered_set<std::string> element_names_;
   std::vector<std::string> texture_files_;
   std::size_t data_offset_ = 0;
   const PlyElement* vertex_ = nullptr;
   const PlyElement* face_ = nullptr;
+  const PlyElement* strips_ = nullptr;
+  StripSoup strips_soup_;
   VertexAttributes vertex_attributes_;
   FaceSoup soup_;
   Mesh mesh_;
