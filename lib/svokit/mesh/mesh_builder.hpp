@@ -55,10 +55,10 @@ struct VertexAttributes {
   std::vector<Rgba> colors;
 };
 
-/// Appends polygons to a mesh as triangles (ear clipping for more than 3 corners), copying vertex
-/// attributes to the corners. Per-face overrides (corner UVs, a face colour) switch their channel
-/// on at the first face that has one; earlier corners are backfilled (zero UV, opaque white), so
-/// every per-corner array stays either empty or full.
+/// Appends polygons to a mesh as triangles (ear clipping up to 64 corners, a constrained Delaunay
+/// triangulation beyond), copying vertex attributes to the corners. Per-face overrides (corner UVs,
+/// a face colour) switch their channel on at the first face that has one; earlier corners are
+/// backfilled (zero UV, opaque white), so every per-corner array stays either empty or full.
 class PolygonAppender {
  public:
   /// `mesh.positions` must already hold every vertex; `vertex` must outlive the appender.
