@@ -8,6 +8,7 @@
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/utf8.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 
 int main(int argc, char** argv) {
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
     for (const std::string& w : voxels->warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
 
     // The same metadata svo-voxelize + svo-build record, so both routes give the same file.
-    const nlohmann::json meta = {{"source", input.filename().string()},
+    const nlohmann::json meta = {{"source", EscapeInvalidUtf8(input.filename().string())},
                                  {"voxelize", voxelize.Recorded()},
                                  {"build", build.Recorded()},
                                  {"generator", "svokit " SVOKIT_VERSION}};

@@ -9,6 +9,7 @@
 
 #include "apps/app.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/utf8.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/slice.hpp"
@@ -101,6 +102,7 @@ int main(int argc, char** argv) {
           {"shade", ShadeName(options.shade)}, {"level", rendered->level},
           {"contours", with_contours},         {"pixel_size", rendered->camera.pixel_size},
           {"hit_pixels", rendered->hits}};
+      pictures["render"]["path"] = EscapeInvalidUtf8(render_path.string());  // JSON needs UTF-8
       picture_lines +=
           fmt::format("{:<19}{} ({}x{}, {} view, {} shading, level {}{}, {:.6g} per pixel)\n",
                       "render", render_path.string(), options.width, options.height,
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
                            {"index", slice->index},
                            {"width", image->width},
                            {"height", image->height}};
+      pictures["slice"]["path"] = EscapeInvalidUtf8(slice_path.string());
       picture_lines +=
           fmt::format("{:<19}{} ({}={}, {}x{})\n", "slice", slice_path.string(), "xyz"[slice->axis],
                       slice -> index, image -> width, image -> height);

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
+#include "svokit/core/utf8.hpp"
 #include "svokit/svo/sample_codec.hpp"
 
 namespace svokit {
@@ -345,7 +346,7 @@ std::string FormatStatsJson(const Svo& svo, const SvoStats& st,
   const auto& dims = svo.grid.dims();
   const Box3d bounds = svo.grid.GridBounds(), root = RootBounds(svo);
   json j;
-  j["file"] = options.file;
+  j["file"] = EscapeInvalidUtf8(options.file);
   j["file_bytes"] = options.file_bytes;
   j["grid"] = {{"origin", Vec(svo.grid.origin())},
                {"voxel_size", svo.grid.voxel_size()},
