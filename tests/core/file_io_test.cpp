@@ -1,7 +1,10 @@
 #include "svokit/core/file_io.hpp"
 
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
+#include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -103,6 +106,28 @@ TEST(LowerExtension, Basics) {
   EXPECT_EQ(LowerExtension("a/b/Model.OBJ"), "obj");
   EXPECT_EQ(LowerExtension("x.tar.GZ"), "gz");
   EXPECT_EQ(LowerExtension("noext"), "");
+}
+
+// Devices and FIFOs are refused on the open descriptor, before any read: /dev/zero would be read
+// without end and opening a FIFO without a writer would wait forever.
+TEST(ReadFileBytes, RefusesDevicesAndFifosWithoutReading) {
+  TempDir dir;
+  const auto fifo = dir / "fifo.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string failure = test::RunBounded([&]() -> std::string {
+    const std::vector<std::pair<std::filesystem::path, std::string>> cases = {
+        {"/dev/zero", "/dev/zero: is a character device, not a regular file"},
+        {"/dev/urandom", "/dev/urandom: is a character device, not a regular file"},
+        {fifo, fifo.string() + ": is a FIFO, not a regular file"},
+        {dir.path(), dir.path().string() + ": is a directory, not a file"}};
+    for (const auto& [path, expected] : cases) {
+      auto r = ReadFileBytes(path);
+      if (r.ok()) return path.string() + " was read";
+      if (r.status().message() != expected) return "'" + r.status().message() + "'";
+    }
+    return "";
+  });
+  EXPECT_EQ(failure, "");
 }
 
 }  // namespace

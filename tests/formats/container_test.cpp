@@ -1,9 +1,12 @@
 #include "svokit/formats/container/container.hpp"
 
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include <cstring>
 
+#include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit::container {
@@ -220,6 +223,26 @@ TEST(MappedWriter, FailuresLeaveNothing) {
   EXPECT_FALSE(other.Commit({{MakeTag("OTHR"), {}, 0, 10}}).ok());  // another tag
   EXPECT_TRUE(dir.Files().empty());
   EXPECT_FALSE(MappedWriter(kTest, 7).Open(dir / "no" / "dir.bin", {}).ok());
+}
+
+// The descriptor is checked, not the name, and opening does not wait for a FIFO's writer (a FIFO
+// given as a .svo hung every reader).
+TEST(Reader, FifoAndDirectoryAreRefusedWithoutWaiting) {
+  test::TempDir dir;
+  const auto fifo = dir / "fifo.svo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string failure = test::RunBounded(
+      [&]() -> std::string {
+        auto r = Reader::Open(fifo, kTest);
+        if (r.ok()) return "opened";
+        if (r.status().message() != fifo.string() + ": is a FIFO, not a regular file") {
+          return r.status().message();
+        }
+        auto d = Reader::Open(dir.path(), kTest);
+        return d.ok() ? "opened a directory" : "";
+      },
+      20);
+  EXPECT_EQ(failure, "");
 }
 
 }  // namespace

@@ -116,5 +116,14 @@ TEST(Svm, InconsistentSectionSizesAreRejected) {
   EXPECT_NE(r.status().message().find("MTID"), std::string::npos);
 }
 
+// The source name goes into the META JSON: one that is not UTF-8 is escaped, not thrown on.
+TEST(Svm, NonUtf8SourceNameIsEscaped) {
+  std::vector<std::uint8_t> bytes;
+  ASSERT_NO_THROW(bytes = EncodeSvm(RichMesh(), "\xFF.obj"));
+  const std::string text(bytes.begin(), bytes.end());
+  EXPECT_NE(text.find(R"("source":"\\xFF.obj")"), std::string::npos);
+  EXPECT_TRUE(DecodeSvm(bytes, "mem.svm").ok());
+}
+
 }  // namespace
 }  // namespace svokit

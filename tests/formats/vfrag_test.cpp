@@ -415,5 +415,14 @@ TEST(Vfrag, PlyPointsAreVoxelCentres) {
   EXPECT_FLOAT_EQ(p[2], static_cast<float>(want.z));
 }
 
+// The source name goes into the META JSON: one that is not UTF-8 is escaped, not thrown on.
+TEST(Vfrag, NonUtf8SourceNameIsEscaped) {
+  std::vector<std::uint8_t> bytes;
+  ASSERT_NO_THROW(bytes = EncodeVfrag(Sample(), {"\xFF.svm", "--resolution 7"}));
+  VfragMetadata meta;
+  ASSERT_TRUE(DecodeVfrag(bytes, "mem.vfrag", &meta).ok());
+  EXPECT_EQ(meta.source, "\\xFF.svm");
+}
+
 }  // namespace
 }  // namespace svokit

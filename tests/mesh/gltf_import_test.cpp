@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "svokit/mesh/importers.hpp"
+#include "tests/bounded_run.hpp"
 
 namespace svokit {
 namespace {
@@ -805,6 +806,52 @@ TEST(DracoImport, GarbageAndTruncatedFilesAreRejected) {
     }
   }
   ExpectFileError(ImportDracoFile(dir.path() / "absent.drc"), dir.path() / "absent.drc", "");
+}
+
+// A buffer reads the bytes it declares and no more: a small glTF naming a 6 GiB (sparse) file
+// read all of it. The import runs with 1 GiB of address space.
+TEST(GltfImport, BufferReadsOnlyItsDeclaredBytes) {
+  TempDir dir;
+  const fs::path path = TriangleGltf{}.Write(dir.path());
+  fs::resize_file(dir.path() / "tri.bin", std::uint64_t{6} << 30);
+  const std::string failure = test::RunBounded(
+      [&]() -> std::string {
+        StatusOr<Mesh> mesh = ImportGltf(path);
+        if (!mesh.ok()) return mesh.status().message();
+        return mesh->triangle_count() == 1 ? "" : "wrong triangle count";
+      },
+      20, std::uint64_t{1} << 30);
+  EXPECT_EQ(failure, "");
+}
+
+TEST(GltfImport, BufferShorterThanDeclaredIsRejected) {
+  TempDir dir;
+  const fs::path path = TriangleGltf{}.Write(dir.path());
+  fs::resize_file(dir.path() / "tri.bin", 40);
+  ExpectFileError(ImportGltf(path), path, "tri.bin : is 40 bytes, fewer than the 80 expected");
+}
+
+TEST(GltfImport, ImageThatIsADeviceIsAWarning) {
+  TempDir dir;
+  fs::create_symlink("/dev/zero", dir.path() / "zero.png");
+  TriangleGltf gltf;
+  gltf.primitive_extra = R"(, "material": 0)";
+  gltf.extra = R"(
+  "materials": [{"name": "m", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+  "textures": [{"source": 0}],
+  "images": [{"uri": "zero.png"}],)";
+  const fs::path path = gltf.Write(dir.path());
+  const std::string failure = test::RunBounded([&]() -> std::string {
+    StatusOr<Mesh> mesh = ImportGltf(path);
+    if (!mesh.ok()) return mesh.status().message();
+    if (mesh->warnings.size() != 1) return "warnings: " + std::to_string(mesh->warnings.size());
+    return mesh->warnings[0] ==
+                   "material 'm': texture 'zero.png' is a character device, not a regular file, "
+                   "using base colour"
+               ? ""
+               : mesh->warnings[0];
+  });
+  EXPECT_EQ(failure, "");
 }
 
 }  // namespace

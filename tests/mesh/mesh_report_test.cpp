@@ -133,5 +133,23 @@ TEST(MeshReport, SampleMeshesAndJson) {
   EXPECT_NE(text.find("uv-torus.png (64x64"), std::string::npos);
 }
 
+// Paths and names are bytes: a file name or material name that is not UTF-8 is shown with \xNN
+// escapes instead of making the JSON writer throw.
+TEST(MeshReport, NonUtf8NamesAreEscapedInJson) {
+  Mesh m = SplitCube();
+  m.materials[0].name =
+      "r\xE9"
+      "d";
+  m.warnings.push_back("texture 'caf\xE9.png' not found");
+  const MeshReport r = AnalyzeMesh(m, "dir/\xFF.obj", {});
+  std::string text;
+  ASSERT_NO_THROW(text = FormatReportJson(r));
+  const nlohmann::json j = nlohmann::json::parse(text);
+  EXPECT_EQ(j["source"], "dir/\\xFF.obj");
+  EXPECT_EQ(j["materials"][0]["name"], "r\\xE9d");
+  EXPECT_EQ(j["warnings"][0], "texture 'caf\\xE9.png' not found");
+  EXPECT_NE(FormatReportText(r).find("dir/\\xFF.obj"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace svokit

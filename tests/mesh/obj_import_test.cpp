@@ -1,8 +1,11 @@
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "svokit/formats/mesh_import.hpp"
+#include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -231,6 +234,41 @@ TEST(ObjImport, AssimpInvalidFiles) {
             std::string::npos);
   EXPECT_NE(ImportError(test::AssimpModels() / "OBJ" / "point_cloud.obj").find("no triangles"),
             std::string::npos);
+}
+
+// A material library or texture that is a device or a FIFO is a warning naming why (the materials
+// fall back as for a missing file), found without reading it: /dev/zero was read without end and a
+// FIFO waited for a writer.
+TEST(ObjImport, DeviceAndFifoLibrariesAndTexturesAreWarnings) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo((dir / "fifo.png").c_str(), 0600), 0);
+  std::filesystem::create_symlink("/dev/urandom", dir / "noise.png");
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.mtl");
+  dir.Write("a.mtl", "newmtl f\nKd 1 0 0\nmap_Kd fifo.png\nnewmtl n\nKd 0 1 0\nmap_Kd noise.png\n");
+  const auto p = dir.Write("a.obj",
+                           "mtllib a.mtl\nmtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                           "usemtl f\nf 1 2 3\nusemtl n\nf 1 3 2\n");
+  const std::string failure = test::RunBounded(
+      [&]() -> std::string {
+        auto m = ImportMesh(p);
+        if (!m.ok()) return m.status().message();
+        const std::vector<std::string> expected = {
+            "material 'f': texture 'fifo.png' is a FIFO, not a regular file, using base colour",
+            "material 'n': texture 'noise.png' is a character device, not a regular file, using "
+            "base "
+            "colour",
+            "material library 'zero.mtl' is a character device, not a regular file; its materials "
+            "are "
+            "white"};
+        if (m->warnings != expected) {
+          std::string got;
+          for (const std::string& w : m->warnings) got += "[" + w + "]";
+          return got;
+        }
+        return m->materials[0].base_color == Rgba{1, 0, 0, 1} ? "" : "base colour lost";
+      },
+      20);
+  EXPECT_EQ(failure, "");
 }
 
 }  // namespace

@@ -11,31 +11,106 @@
 
 namespace svokit {
 
-StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    return Status::BadInput("{}: is a directory, not a file", path.string());
-  }
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return Status::BadInput("{}: cannot open ({})", path.string(), std::strerror(errno));
-  // One allocation of the file's size, read into directly (growing by 64 KB chunks copied the
-  // bytes ~2× and faulted in twice the pages); the loop still serves pipes and growing files.
-  std::vector<std::uint8_t> bytes;
-  std::error_code size_error;
-  const std::uintmax_t expected = std::filesystem::file_size(path, size_error);
-  bytes.resize(size_error ? std::size_t{1} << 16 : static_cast<std::size_t>(expected) + 1);
+namespace {
+
+const char* FileKind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "a special file";
+}
+
+std::string SizeText(std::uint64_t bytes) {
+  if (bytes % (std::uint64_t{1} << 30) == 0) return fmt::format("{} GiB", bytes >> 30);
+  return fmt::format("{} bytes", bytes);
+}
+
+// Reads `size` bytes from `fd` (which it closes).
+StatusOr<std::vector<std::uint8_t>> ReadAndClose(int fd, std::uint64_t size,
+                                                 const std::filesystem::path& path) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
   std::size_t used = 0;
-  for (;;) {
-    if (used == bytes.size()) bytes.resize(2 * bytes.size());
-    const std::size_t n = std::fread(bytes.data() + used, 1, bytes.size() - used, f);
-    if (n == 0) break;
-    used += n;
+  int err = 0;
+  while (used < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + used, bytes.size() - used);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) err = errno;
+    if (n <= 0) break;
+    used += static_cast<std::size_t>(n);
   }
-  bytes.resize(used);
-  const bool failed = std::ferror(f);
-  std::fclose(f);
-  if (failed) return Status::BadInput("{}: read error", path.string());
+  ::close(fd);
+  if (err != 0) return Status::BadInput("{}: read error ({})", path.string(), std::strerror(err));
+  bytes.resize(used);  // the file shrank while being read
   return bytes;
+}
+
+}  // namespace
+
+StatusOr<int> OpenRegularFile(const std::filesystem::path& path, std::uint64_t& size,
+                              ReadLimit limit) {
+  // O_NONBLOCK: opening a FIFO without a writer would wait for one; it has no effect on files.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) return Status::BadInput("{}: cannot open ({})", path.string(), std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return Status::BadInput("{}: cannot open ({})", path.string(), std::strerror(err));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    if (S_ISDIR(st.st_mode))
+      return Status::BadInput("{}: is a directory, not a file", path.string());
+    return Status::BadInput("{}: is {}, not a regular file", path.string(), FileKind(st.st_mode));
+  }
+  size = static_cast<std::uint64_t>(st.st_size);
+  if (size > limit.max_bytes) {
+    ::close(fd);
+    return Status::BadInput("{}: is {} bytes, more than the {} limit for {}", path.string(), size,
+                            SizeText(limit.max_bytes), limit.what);
+  }
+  return fd;
+}
+
+StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path,
+                                                  ReadLimit limit) {
+  std::uint64_t size = 0;
+  StatusOr<int> fd = OpenRegularFile(path, size, limit);
+  if (!fd.ok()) return fd.status();
+  return ReadAndClose(*fd, size, path);
+}
+
+StatusOr<std::vector<std::uint8_t>> ReadFilePrefix(const std::filesystem::path& path,
+                                                   std::uint64_t bytes, ReadLimit limit) {
+  if (bytes > limit.max_bytes) {
+    return Status::BadInput("{}: {} bytes wanted, more than the {} limit for {}", path.string(),
+                            bytes, SizeText(limit.max_bytes), limit.what);
+  }
+  std::uint64_t size = 0;
+  // The file itself may be larger than the limit: only its first `bytes` are read.
+  StatusOr<int> fd = OpenRegularFile(path, size, {~std::uint64_t{0}, limit.what});
+  if (!fd.ok()) return fd.status();
+  if (size < bytes) {
+    ::close(*fd);
+    return Status::BadInput("{}: is {} bytes, fewer than the {} expected", path.string(), size,
+                            bytes);
+  }
+  StatusOr<std::vector<std::uint8_t>> read = ReadAndClose(*fd, bytes, path);
+  if (read.ok() && read->size() < bytes) {
+    return Status::BadInput("{}: is {} bytes, fewer than the {} expected", path.string(),
+                            read->size(), bytes);
+  }
+  return read;
+}
+
+std::string UnreadableReason(const Status& status, const std::filesystem::path& path) {
+  std::string_view m = status.message();
+  const std::string prefix = path.string() + ": ";
+  if (m.starts_with(prefix)) m.remove_prefix(prefix.size());
+  if (m.starts_with("cannot open")) return {};
+  return std::string(m);
 }
 
 std::string LowerExtension(const std::filesystem::path& path) {
@@ -121,8 +196,8 @@ Status AtomicFileWriter::WriteAt(std::uint64_t offset, std::span<const std::uint
 
 // An existing target is swapped with the temporary (one atomic step, as a rename over it) and
 // then unlinked: ext4 starts writing back a file renamed over another one (auto_da_alloc) inside
-// the rename, which then waits on the disk; the swap does not. Plain rename where there is no target
-// or the file system cannot swap, and for a directory (which a swap would move).
+// the rename, which then waits on the disk; the swap does not. Plain rename where there is no
+// target or the file system cannot swap, and for a directory (which a swap would move).
 bool AtomicFileWriter::ReplaceWithTemporary() const {
   struct stat target {};
   const bool swappable = ::lstat(path_.c_str(), &target) == 0 && !S_ISDIR(target.st_mode);

@@ -12,8 +12,37 @@
 
 namespace svokit {
 
-/// Reads a whole file. Errors name the file: "PATH: cannot open (No such file or directory)".
-StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path);
+/// How many bytes a read may take, and what the file is, for the message when it is larger.
+struct ReadLimit {
+  std::uint64_t max_bytes;
+  const char* what;
+};
+/// Mesh files, glTF buffers and svokit's own files: far beyond any real scan, small enough that a
+/// mistaken path fails at once instead of exhausting memory.
+inline constexpr ReadLimit kInputFileLimit{std::uint64_t{64} << 30, "an input file"};
+/// Textures and material libraries.
+inline constexpr ReadLimit kSideFileLimit{std::uint64_t{1} << 30, "a texture or material library"};
+
+/// Opens `path` for reading and checks, on the open descriptor, that it is a regular file (a FIFO,
+/// device or directory is refused; opening cannot block) of at most `limit` bytes. Returns the
+/// descriptor and fills `size`; errors name the file and why: "PATH: is a FIFO, not a regular
+/// file".
+StatusOr<int> OpenRegularFile(const std::filesystem::path& path, std::uint64_t& size,
+                              ReadLimit limit = kInputFileLimit);
+
+/// Reads a whole regular file (see OpenRegularFile). Errors name the file: "PATH: cannot open (No
+/// such file or directory)".
+StatusOr<std::vector<std::uint8_t>> ReadFileBytes(const std::filesystem::path& path,
+                                                  ReadLimit limit = kInputFileLimit);
+
+/// Reads the first `bytes` bytes of a regular file; a shorter file is an error.
+StatusOr<std::vector<std::uint8_t>> ReadFilePrefix(const std::filesystem::path& path,
+                                                   std::uint64_t bytes,
+                                                   ReadLimit limit = kInputFileLimit);
+
+/// Why a read of `path` failed, without the path, for a warning about an optional file (a texture);
+/// empty when it could not be opened (missing, no permission), which callers report as not found.
+std::string UnreadableReason(const Status& status, const std::filesystem::path& path);
 
 /// Lower-case extension without the dot ("obj" for "Model.OBJ").
 std::string LowerExtension(const std::filesystem::path& path);

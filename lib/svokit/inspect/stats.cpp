@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
+#include "svokit/core/utf8.hpp"
 #include "svokit/svo/sample_codec.hpp"
 
 namespace svokit {
@@ -352,7 +353,7 @@ std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   const auto& dims = st.grid.dims();
   const Box3d bounds = st.grid.GridBounds();
   json j;
-  j["file"] = report.file;
+  j["file"] = EscapeInvalidUtf8(report.file);
   j["file_bytes"] = report.file_bytes;
   j["grid"] = {{"origin", Vec(st.grid.origin())},
                {"voxel_size", st.grid.voxel_size()},
@@ -424,7 +425,7 @@ std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   j["render"] = nullptr;
   if (report.render) {
     const RenderedPicture& r = *report.render;
-    j["render"] = {{"path", r.path},
+    j["render"] = {{"path", EscapeInvalidUtf8(r.path)},
                    {"width", r.width},
                    {"height", r.height},
                    {"view", ViewName(r.view)},
@@ -437,7 +438,7 @@ std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   j["slice"] = nullptr;
   if (report.slice) {
     const SlicePicture& s = *report.slice;
-    j["slice"] = {{"path", s.path},
+    j["slice"] = {{"path", EscapeInvalidUtf8(s.path)},
                   {"axis", std::string(1, "xyz"[s.axis])},
                   {"index", s.index},
                   {"width", s.width},

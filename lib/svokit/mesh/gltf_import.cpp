@@ -4,6 +4,8 @@
 // KHR_draco_mesh_compression, or gathered from accessors) and goes through AppendDracoMesh; the
 // node's world transform is then applied to what was appended.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -160,8 +162,10 @@ std::size_t JsonDepth(const nlohmann::json& doc) {
 }
 
 // External buffers are looked up here first: tinygltf would also search the working directory,
-// and its message does not say which buffer is missing.
-Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::path& base_dir) {
+// and its message does not say which buffer is missing. Their declared byteLengths go to
+// `declared`, in order: tinygltf reads them in that order, and BufferReader reads only that much.
+Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::path& base_dir,
+                            std::vector<std::uint64_t>& declared) {
   const auto buffers = doc.find("buffers");
   if (buffers == doc.end() || !buffers->is_array()) return Status::Ok();
   for (std::size_t i = 0; i < buffers->size(); ++i) {
@@ -173,9 +177,44 @@ Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::pa
     if (!std::filesystem::is_regular_file(base_dir / PercentDecode(uri), ec)) {
       return Status::BadInput("buffer {} '{}' not found", i, uri);
     }
+    const auto length = buffer.find("byteLength");
+    declared.push_back(
+        length != buffer.end() && length->is_number_unsigned() ? length->get<std::uint64_t>() : 0);
   }
   return Status::Ok();
 }
+
+// tinygltf's file reader for external buffers. Its own reads a whole file and only then compares
+// the size with byteLength, so a short glTF naming a huge file would read all of it; this reads
+// the declared bytes and no more, and refuses a file that is not regular or shorter than declared.
+struct BufferReader {
+  std::vector<std::uint64_t> declared;  // per external buffer, in the order tinygltf reads them
+  std::size_t next = 0;
+
+  // tinygltf's own check opens the file, which waits forever on a FIFO.
+  static bool Exists(const std::string& path, void* /*user_data*/) {
+    return ::access(path.c_str(), R_OK) == 0;
+  }
+
+  static bool Read(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                   void* user_data) {
+    auto* self = static_cast<BufferReader*>(user_data);
+    if (self->next >= self->declared.size()) {
+      if (err) *err += "not a buffer this file declares";
+      return false;
+    }
+    StatusOr<std::vector<std::uint8_t>> bytes =
+        ReadFilePrefix(path, self->declared[self->next++], kInputFileLimit);
+    if (!bytes.ok()) {
+      std::string_view why = bytes.status().message();  // tinygltf names the file itself
+      if (why.starts_with(path + ": ")) why.remove_prefix(path.size() + 2);
+      if (err) *err += why;
+      return false;
+    }
+    *out = std::move(bytes).value();
+    return true;
+  }
+};
 
 // tinygltf passes an image's buffer view to the image loader without checking it against its
 // buffer (an out-of-range access that aborts builds with _GLIBCXX_ASSERTIONS), so image views are
@@ -240,14 +279,15 @@ bool DropDracoIndices(nlohmann::json& doc) {
 // CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if it had to change.
 // JSON that does not parse is left to tinygltf, whose message says where.
 StatusOr<std::optional<std::string>> Preflight(std::string_view text,
-                                               const std::filesystem::path& base_dir) {
+                                               const std::filesystem::path& base_dir,
+                                               std::vector<std::uint64_t>& declared_buffers) {
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return std::optional<std::string>();
   if (JsonDepth(doc) > kMaxJsonDepth) {
     return Status::BadInput("JSON nested deeper than {} levels", kMaxJsonDepth);
   }
   SVOKIT_RETURN_IF_ERROR(CheckVersion(doc));
-  SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, base_dir));
+  SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, base_dir, declared_buffers));
   SVOKIT_RETURN_IF_ERROR(CheckImageViews(doc));
   if (!DropDracoIndices(doc)) return std::optional<std::string>();
   return std::optional<std::string>(doc.dump());
@@ -280,7 +320,8 @@ StatusOr<tinygltf::Model> LoadModel(std::vector<std::uint8_t> file, bool binary,
   if (file.empty()) return Status::BadInput("empty file");
   StatusOr<std::string_view> json = JsonText(file, binary);
   if (!json.ok()) return json.status();
-  StatusOr<std::optional<std::string>> changed = Preflight(*json, base_dir);
+  BufferReader buffer_reader;
+  StatusOr<std::optional<std::string>> changed = Preflight(*json, base_dir, buffer_reader.declared);
   if (!changed.ok()) return changed.status();
   if (*changed) file = ReplaceJson(file, binary, std::move(**changed));
   if (file.size() > std::numeric_limits<std::uint32_t>::max()) {
@@ -289,6 +330,11 @@ StatusOr<tinygltf::Model> LoadModel(std::vector<std::uint8_t> file, bool binary,
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&KeepEncodedImage, nullptr);
+  loader.SetFsCallbacks({.FileExists = &BufferReader::Exists,
+                         .ExpandFilePath = &tinygltf::ExpandFilePath,
+                         .ReadWholeFile = &BufferReader::Read,
+                         .WriteWholeFile = nullptr,
+                         .user_data = &buffer_reader});
   tinygltf::Model model;
   std::string err, warn;
   const auto size = static_cast<unsigned int>(file.size());

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/utf8.hpp"
 
 namespace svokit {
 
@@ -154,7 +155,7 @@ std::string FormatReportText(const MeshReport& r) {
     s += fmt::format("{:<19}{}\n", key, value);
   };
   const Vec3d size = r.bounds.extent();
-  line("mesh", r.source);
+  line("mesh", EscapeInvalidUtf8(r.source));
   line("triangles", fmt::format("{}", r.triangles));
   line("vertices", fmt::format("{} ({} distinct positions)", r.vertices, r.distinct_positions));
   line("bounds",
@@ -202,7 +203,9 @@ std::string FormatReportText(const MeshReport& r) {
 std::string FormatReportJson(const MeshReport& r) {
   using nlohmann::json;
   json j;
-  j["source"] = r.source;
+  // Paths and names from files are bytes; JSON needs UTF-8.
+  const auto text = [](const std::string& s) { return EscapeInvalidUtf8(s); };
+  j["source"] = text(r.source);
   j["triangles"] = r.triangles;
   j["vertices"] = r.vertices;
   j["distinct_positions"] = r.distinct_positions;
@@ -212,22 +215,23 @@ std::string FormatReportJson(const MeshReport& r) {
   j["attributes"] = {{"normals", r.has_normals}, {"uvs", r.has_uvs}, {"colors", r.has_colors}};
   j["materials"] = json::array();
   for (const MaterialReport& m : r.materials) {
-    json jm = {{"name", m.name},
+    json jm = {{"name", text(m.name)},
                {"triangles", m.triangles},
                {"base_color", {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a}},
                {"texture", m.texture >= 0 ? json(m.texture) : json(nullptr)}};
-    jm["missing_texture"] = m.missing_texture.empty() ? json(nullptr) : json(m.missing_texture);
+    jm["missing_texture"] =
+        m.missing_texture.empty() ? json(nullptr) : json(text(m.missing_texture));
     j["materials"].push_back(jm);
   }
   j["textures"] = json::array();
   for (const TextureReport& t : r.textures) {
-    j["textures"].push_back({{"name", t.name},
+    j["textures"].push_back({{"name", text(t.name)},
                              {"bytes", t.bytes},
                              {"width", t.width},
                              {"height", t.height},
                              {"channels", t.channels},
                              {"format", t.format},
-                             {"error", t.error.empty() ? json(nullptr) : json(t.error)}});
+                             {"error", t.error.empty() ? json(nullptr) : json(text(t.error))}});
   }
   j["topology"] = {{"degenerate_triangles", r.degenerate_triangles},
                    {"edges", r.edges},
@@ -237,7 +241,8 @@ std::string FormatReportJson(const MeshReport& r) {
                    {"closed", r.closed()},
                    {"components", r.components}};
   j["self_intersections"] = r.self_intersections ? json(*r.self_intersections) : json(nullptr);
-  j["warnings"] = r.warnings;
+  j["warnings"] = json::array();
+  for (const std::string& w : r.warnings) j["warnings"].push_back(text(w));
   return j.dump(2) + "\n";
 }
 

@@ -224,10 +224,13 @@ class ObjParser {
 
   Status LoadMaterialLibrary(const std::string& file) {
     const std::filesystem::path mtl_path = base_dir_ / file;
-    StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(mtl_path);
+    StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(mtl_path, kSideFileLimit);
     if (!bytes.ok()) {
+      const std::string why = UnreadableReason(bytes.status(), mtl_path);
       mesh_.warnings.push_back(
-          fmt::format("material library '{}' not found; its materials are white", file));
+          why.empty()
+              ? fmt::format("material library '{}' not found; its materials are white", file)
+              : fmt::format("material library '{}' {}; its materials are white", file, why));
       return Status::Ok();
     }
     StatusOr<std::string_view> text = TextOf(*bytes, mtl_path.string());

@@ -68,11 +68,15 @@ void AttachTextureFile(const std::filesystem::path& base_dir, const std::string&
   std::replace(portable.begin(), portable.end(), '\\', '/');
   std::filesystem::path file = portable;
   if (file.is_relative()) file = base_dir / file;
-  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file);
+  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file, kSideFileLimit);
   if (!bytes.ok() || bytes->empty()) {
     material.missing_texture = uri;
-    mesh.warnings.push_back(fmt::format("material '{}': texture '{}' not found, using base colour",
-                                        material.name, uri));
+    const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), file);
+    mesh.warnings.push_back(
+        why.empty() ? fmt::format("material '{}': texture '{}' not found, using base colour",
+                                  material.name, uri)
+                    : fmt::format("material '{}': texture '{}' {}, using base colour",
+                                  material.name, uri, why));
     return;
   }
   // Several materials often share one image: embed it once.

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "svokit/core/utf8.hpp"
+
 namespace svokit::validate {
 
 void CheckResult::Add(Finding f) {
@@ -85,17 +87,20 @@ std::string Report::Json() const {
     for (const auto& [key, value] : c.stats) stats[key] = value;
     nlohmann::ordered_json examples = nlohmann::ordered_json::array();
     for (const Finding& f : c.examples) {
-      nlohmann::ordered_json e = {{"kind", f.kind}, {"message", f.message}};
+      nlohmann::ordered_json e = {{"kind", f.kind}, {"message", EscapeInvalidUtf8(f.message)}};
       e["voxel"] = f.voxel ? nlohmann::ordered_json(*f.voxel) : nlohmann::ordered_json();
       e["level"] = f.level ? nlohmann::ordered_json(*f.level) : nlohmann::ordered_json();
       e["distance"] = f.distance ? nlohmann::ordered_json(*f.distance) : nlohmann::ordered_json();
       examples.push_back(std::move(e));
     }
-    checks_json[c.name] = {
-        {"status", StateName(c.state)}, {"note", c.note}, {"findings", c.findings()},
-        {"counts", c.counts},           {"stats", stats}, {"examples", examples}};
+    checks_json[c.name] = {{"status", StateName(c.state)},
+                           {"note", EscapeInvalidUtf8(c.note)},
+                           {"findings", c.findings()},
+                           {"counts", c.counts},
+                           {"stats", stats},
+                           {"examples", examples}};
   }
-  const nlohmann::ordered_json j = {{"file", file},
+  const nlohmann::ordered_json j = {{"file", EscapeInvalidUtf8(file)},
                                     {"valid", ok()},
                                     {"findings", findings()},
                                     {"octree", summary},

@@ -332,15 +332,14 @@ struct Mapping {
 StatusOr<Frame> Frame::Open(const std::filesystem::path& path, const FormatId& format,
                             SectionFilter load, const void* context) {
   const std::string name = path.string();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::BadInput("{}: cannot open ({})", name, std::strerror(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    return Status::BadInput("{}: not a regular file", name);
-  }
+  // Mapped, not read: no size limit beyond the address space. The check is on the open
+  // descriptor, and opening a FIFO does not wait for a writer.
+  std::uint64_t size = 0;
+  StatusOr<int> opened = OpenRegularFile(path, size, {~std::uint64_t{0}, "a container"});
+  if (!opened.ok()) return opened.status();
+  const int fd = *opened;
   auto mapping = std::make_shared<Mapping>();
-  mapping->size = static_cast<std::size_t>(st.st_size);
+  mapping->size = static_cast<std::size_t>(size);
   if (mapping->size > 0) {
     void* p = ::mmap(nullptr, mapping->size, PROT_READ, MAP_PRIVATE, fd, 0);
     if (p == MAP_FAILED) {

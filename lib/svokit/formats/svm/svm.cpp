@@ -4,6 +4,7 @@
 
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/utf8.hpp"
 
 namespace svokit {
 
@@ -76,7 +77,8 @@ std::vector<std::uint8_t> EncodeSvm(const Mesh& mesh, const std::string& source)
   for (const std::string& w : mesh.warnings) warnings.PutString(w);
   file.AddSection(kWarnings, std::move(warnings.bytes()));
 
-  const nlohmann::json meta = {{"source", source}, {"generator", "svokit " SVOKIT_VERSION}};
+  const nlohmann::json meta = {{"source", EscapeInvalidUtf8(source)},
+                               {"generator", "svokit " SVOKIT_VERSION}};
   const std::string meta_text = meta.dump();
   file.AddSection(kMetadata, std::vector<std::uint8_t>(meta_text.begin(), meta_text.end()));
   return file.Serialize();

@@ -8,6 +8,7 @@
 
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/utf8.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 
 namespace svokit {
@@ -347,7 +348,7 @@ StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {
 
 std::string SvoMetadataJson(const SvoMetadata& meta) {
   // nlohmann::json orders the keys alphabetically; the files depend on that order.
-  const nlohmann::json json = {{"source", meta.source},
+  const nlohmann::json json = {{"source", EscapeInvalidUtf8(meta.source)},
                                {"voxelize", meta.voxelize},
                                {"build", meta.build},
                                {"generator", "svokit " SVOKIT_VERSION}};

@@ -13,6 +13,7 @@
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
+#include "svokit/core/utf8.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 
 namespace svokit {
@@ -193,8 +194,13 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
     if (const auto text = file->Find(kMetadata)) {
       const nlohmann::json j = nlohmann::json::parse(text->begin(), text->end(), nullptr, false);
       if (j.is_object()) {
-        meta->source = j.value("source", "");
-        meta->options = j.value("options", "");
+        // value() throws on a member of another type; such metadata is ignored, not fatal.
+        const auto text_of = [&](const char* key) {
+          const auto it = j.find(key);
+          return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+        };
+        meta->source = text_of("source");
+        meta->options = text_of("options");
       }
     }
   }
@@ -304,8 +310,9 @@ container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set) {
 }
 
 std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
-  const nlohmann::json j = {
-      {"source", meta.source}, {"options", meta.options}, {"generator", "svokit " SVOKIT_VERSION}};
+  const nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
+                            {"options", EscapeInvalidUtf8(meta.options)},
+                            {"generator", "svokit " SVOKIT_VERSION}};
   const std::string text = j.dump();
   return {text.begin(), text.end()};
 }

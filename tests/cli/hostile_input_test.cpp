@@ -1,0 +1,176 @@
+// The tools given hostile inputs as a user could: special files where files are expected, a glTF
+// naming a huge file, paths that are not UTF-8. Each tool runs with a time and memory bound, so a
+// hang or an unbounded read fails the test instead of blocking the suite.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/cli/run_tool.hpp"
+
+namespace svokit::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// RunTool with the tool limited to `seconds` of wall time (then killed: exit code 128 + 9) and
+// 4 GiB of address space.
+ToolResult RunToolBounded(const std::string& tool, const std::vector<std::string>& args,
+                          int seconds = 60) {
+  TempDir capture;
+  const std::string out_path = (capture / "stdout").string(),
+                    err_path = (capture / "stderr").string();
+  const std::string exe = std::string(SVOKIT_BIN_DIR) + "/" + tool;
+  std::vector<std::string> argv_storage = {exe};
+  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  ToolResult r;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const rlimit limit{std::uint64_t{4} << 30, std::uint64_t{4} << 30};
+    ::setrlimit(RLIMIT_AS, &limit);
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || err < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 ||
+        ::dup2(err, 2) < 0) {
+      ::_exit(127);
+    }
+    ::execv(exe.c_str(), argv.data());
+    ::_exit(127);
+  }
+  if (pid < 0) return r;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = ReadText(out_path);
+  r.err = ReadText(err_path);
+  return r;
+}
+
+// Exit 2 and one line on stderr that contains `needle`.
+void ExpectRefused(const ToolResult& r, const std::string& needle) {
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  ASSERT_EQ(r.ErrLines().size(), 1u) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+}
+
+// A FIFO given as the .svo hung every reader: opening it waited for a writer.
+TEST(HostileInput, FifoAsSvoIsRefusedAtOnce) {
+  TempDir dir;
+  const auto fifo = dir / "fifo.svo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string expected = fifo.string() + ": is a FIFO, not a regular file";
+  ExpectRefused(RunToolBounded("svo-inspect", {fifo.string(), "-q"}), expected);
+  ExpectRefused(RunToolBounded("svo-validate", {fifo.string(), "-q"}), expected);
+  ExpectRefused(RunToolBounded("svo-export", {fifo.string(), "-o", (dir / "o.xyz").string(), "-q"}),
+                expected);
+}
+
+TEST(HostileInput, FifoOrDirectoryAsMeshIsRefused) {
+  TempDir dir;
+  const auto fifo = dir / "fifo.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_directory(dir / "dir.obj");
+  for (const fs::path& input : {fifo, dir / "dir.obj"}) {
+    ExpectRefused(RunToolBounded("svo-import", {input.string(), "-q"}), input.string());
+    ExpectRefused(RunToolBounded("mesh2svo",
+                                 {input.string(), "-o", (dir / "o.svo").string(), "-r", "8", "-q"}),
+                  input.string());
+  }
+}
+
+// A texture that is /dev/zero was read without end (the reader doubled its buffer): now it is a
+// warning naming why, and the material keeps its base colour.
+TEST(HostileInput, TextureThatIsADeviceIsAWarning) {
+  TempDir dir;
+  fs::copy_file(DataDir() / "uv-torus.obj", dir / "uv-torus.obj");
+  fs::copy_file(DataDir() / "uv-torus.mtl", dir / "uv-torus.mtl");
+  fs::create_symlink("/dev/zero", dir / "uv-torus.png");
+  const ToolResult r =
+      RunToolBounded("svo-import", {(dir / "uv-torus.obj").string(), "--json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["warnings"][0],
+            "material 'torus': texture 'uv-torus.png' is a character device, not a regular file, "
+            "using base colour");
+}
+
+// A 300-byte glTF whose buffer declares 48 bytes but names a 6 GiB (sparse) file read all of it.
+TEST(HostileInput, GltfBufferReadsOnlyItsDeclaredBytes) {
+  TempDir dir;
+  std::string bin;
+  for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f})
+    bin.append(reinterpret_cast<char*>(&f), 4);
+  for (std::uint32_t i : {0u, 1u, 2u}) bin.append(reinterpret_cast<char*>(&i), 4);
+  ASSERT_EQ(bin.size(), 48u);
+  fs::resize_file(dir.Write("huge.bin", bin), std::uint64_t{6} << 30);
+  const auto gltf = dir.Write("small.gltf", R"({"asset": {"version": "2.0"},
+ "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+ "buffers": [{"uri": "huge.bin", "byteLength": 48}],
+ "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 12}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+               {"bufferView": 1, "componentType": 5125, "count": 3, "type": "SCALAR"}]})");
+  const ToolResult r = RunToolBounded("svo-import", {gltf.string(), "--json", "-q"}, 30);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["triangles"], 1);
+}
+
+// A path that is not UTF-8 made the JSON writers throw (exit 3, "invalid UTF-8 byte", the file not
+// named); it is now written with \xNN escapes wherever a path goes into JSON.
+TEST(HostileInput, NonUtf8PathsAreEscapedNotFatal) {
+  TempDir dir;
+  for (const char* ext : {".mtl", ".png"}) {
+    fs::copy_file(DataDir() / (std::string("uv-torus") + ext),
+                  dir / (std::string("uv-torus") + ext));
+  }
+  const std::string obj = (dir / "\xFF.obj").string(), svm = (dir / "\xFE.svm").string(),
+                    vfrag = (dir / "\xFD.vfrag").string(), svo = (dir / "\xFC.svo").string(),
+                    direct = (dir / "\xFB.svo").string();
+  fs::copy_file(DataDir() / "uv-torus.obj", obj);
+
+  ToolResult r = RunToolBounded("svo-import", {obj, "-o", svm, "--json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["source"], (dir / "\\xFF.obj").string());
+  r = RunToolBounded("svo-voxelize", {svm, "-o", vfrag, "-r", "16", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunToolBounded("svo-build", {vfrag, "-o", svo, "--mesh", svm, "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunToolBounded("mesh2svo", {obj, "-o", direct, "-r", "16", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const std::string& file : {svo, direct}) {
+    r = RunToolBounded("svo-inspect", {file, "--json", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto stats = nlohmann::json::parse(r.out);
+    EXPECT_NE(stats.dump().find("\\\\xF"), std::string::npos) << r.out;
+    r = RunToolBounded("svo-validate", {file, "--json", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(nlohmann::json::parse(r.out)["file"].get<std::string>().find("\\xF"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace svokit::test
