@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -82,6 +83,33 @@ inline void AddCommonOptions(CLI::App& cli, CommonOptions& options, std::string_
 }
 
 /// An option naming a file (`flags` "input" for the positional one), shown as FILE in --help.
+/// A number > 0 and finite; "nan", "inf" and out-of-range values are refused with the value as
+/// given (CLI11's own range checks print DBL_MAX in full).
+inline CLI::Validator PositiveFinite() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || !(v > 0) || !std::isfinite(v)) {
+          return "must be a positive finite number (got " + text + ")";
+        }
+        return {};
+      },
+      "");
+}
+
+/// A number ≥ 0, where "inf" means no limit; "nan" is refused.
+inline CLI::Validator NonNegativeOrInfinite() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || !(v >= 0)) {
+          return "must be a number >= 0, or inf (got " + text + ")";
+        }
+        return {};
+      },
+      "");
+}
+
 inline CLI::Option* AddFile(CLI::App& cli, const std::string& flags, std::filesystem::path& path,
                             const std::string& description) {
   return cli.add_option(flags, path, description)->option_text("FILE");

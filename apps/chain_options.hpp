@@ -56,7 +56,7 @@ struct VoxelizeCli {
                     ->check(CLI::Range(1u, 1u << 20));
     auto* size = cli.add_option("--voxel-size", voxel_size, "Voxel edge length in world units")
                      ->option_text("SIZE")
-                     ->check(CLI::PositiveNumber);
+                     ->check(PositiveFinite());
     res->excludes(size);
     size->excludes(res);
     cli.add_option("--pad", pad, "Empty voxels added on every side")
@@ -78,7 +78,7 @@ struct VoxelizeCli {
                    "Hybrid: projected area (voxel²) above which a triangle takes the fragment path")
         ->option_text("AREA")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(NonNegativeOrInfinite());
   }
 
   /// The grid is given, by --resolution or --voxel-size.

@@ -96,5 +96,37 @@ TEST(SvoVoxelizeCli, BadInputIsOneLineExitTwoAndNoOutput) {
   }
 }
 
+// Number options: nan is refused and inf is not, consistently; messages show the value as given,
+// never DBL_MAX or a 300-digit count in full.
+TEST(SvoVoxelizeCli, NumberOptionsAreRefusedWithShortMessages) {
+  TempDir dir;
+  const std::string mesh = (DataDir() / "uv-torus.obj").string();
+  const std::string out = (dir / "t.vfrag").string();
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+  };
+  const std::vector<Case> cases = {
+      {{"-r", "8", "--hybrid-cutoff", "nan"}, 2},
+      {{"-r", "8", "--hybrid-cutoff", "-1"}, 2},
+      {{"-r", "8", "--hybrid-cutoff", "inf"}, 0},
+      {{"--voxel-size", "-1"}, 2},
+      {{"--voxel-size", "inf"}, 2},
+      {{"--voxel-size", "nan"}, 2},
+      {{"--voxel-size", "1e-300"}, 2},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {mesh, "-o", out, "-q"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const ToolResult r = RunTool("svo-voxelize", args);
+    const std::string what = c.args[c.args.size() - 2] + " " + c.args.back();
+    EXPECT_EQ(r.exit_code, c.exit_code) << what << ": " << r.err;
+    if (c.exit_code == 0) continue;
+    ASSERT_EQ(r.ErrLines().size(), 1u) << what << ": " << r.err;
+    EXPECT_LT(r.err.size(), 200u) << what << ": " << r.err;
+    EXPECT_EQ(r.err.find("179769313486"), std::string::npos) << what << ": " << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace svokit::test

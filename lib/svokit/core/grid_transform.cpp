@@ -27,7 +27,7 @@ StatusOr<GridTransform> FitCentred(const Box3d& bounds, double h, std::uint32_t 
     // floor(e)+1 voxels always leave a positive margin on both sides of a centred extent e.
     const double cells = std::floor(extent[a] / h) + 1.0 + 2.0 * pad;
     if (cells >= static_cast<double>(kMortonAxisLimit)) {
-      return Status::BadInput("grid of {:.0f} voxels along an axis exceeds the limit of {}", cells,
+      return Status::BadInput("grid of {:.3g} voxels along an axis exceeds the limit of {}", cells,
                               kMortonAxisLimit - 1);
     }
     dims[a] = static_cast<std::uint32_t>(cells);
