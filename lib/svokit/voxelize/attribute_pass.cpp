@@ -180,8 +180,10 @@ class BrickOutput {
     if (run.keys.empty()) return;
     if (packed_) {
       std::uint8_t* out = arrays_.key_gaps.data() + slot.byte;
-      std::memcpy(out, slot.head, slot.head_size);
-      std::memcpy(out + slot.head_size, run.gaps.data(), run.gaps.size());
+      // std::copy, not memcpy: a one-voxel run has no gaps, and memcpy from an empty vector's
+      // null data() is undefined even for zero bytes.
+      std::copy(slot.head, slot.head + slot.head_size, out);
+      std::copy(run.gaps.begin(), run.gaps.end(), out + slot.head_size);
     } else {
       std::copy(run.keys.begin(), run.keys.end(), arrays_.keys.begin() + slot.voxel);
     }
