@@ -130,6 +130,13 @@ inline Status CheckOutputPath(const std::filesystem::path& path,
   if (!std::filesystem::is_directory(dir, ec)) {
     return Status::BadInput("{}: output directory does not exist", path.string());
   }
+  // Refused before any work: found at the final rename, these cost the whole run.
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::BadInput("{}: is a directory, not a file", path.string());
+  }
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    return Status::BadInput("{}: output directory is not writable", path.string());
+  }
   return Status::Ok();
 }
 

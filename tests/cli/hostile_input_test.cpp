@@ -172,5 +172,33 @@ TEST(HostileInput, NonUtf8PathsAreEscapedNotFatal) {
   }
 }
 
+// An output that is an existing directory is refused before the work, by every tool that writes.
+TEST(HostileInput, OutputThatIsADirectoryIsRefusedFirst) {
+  TempDir dir;
+  const std::string mesh = (DataDir() / "uv-torus.obj").string();
+  const std::string svo = (dir / "t.svo").string(), vfrag = (dir / "t.vfrag").string();
+  ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "16", "-o", svo, "-q"}).exit_code, 0);
+  ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", "16", "-o", vfrag, "-q"}).exit_code, 0);
+  for (const char* name : {"d.svo", "d.svm", "d.vfrag", "d.vox"}) {
+    std::filesystem::create_directory(dir / name);
+  }
+  const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
+      {"mesh2svo", {mesh, "-r", "16", "-o", (dir / "d.svo").string()}},
+      {"svo-import", {mesh, "-o", (dir / "d.svm").string()}},
+      {"svo-voxelize", {mesh, "-r", "16", "-o", (dir / "d.vfrag").string()}},
+      {"svo-build", {vfrag, "--no-contours", "-o", (dir / "d.svo").string()}},
+      {"svo-export", {svo, "-o", (dir / "d.vox").string()}},
+  };
+  for (const auto& [tool, args] : runs) {
+    std::vector<std::string> quiet = args;
+    quiet.push_back("-q");
+    const ToolResult r = RunTool(tool, quiet);
+    EXPECT_EQ(r.exit_code, 2) << tool << ": " << r.err;
+    ASSERT_EQ(r.ErrLines().size(), 1u) << tool << ": " << r.err;
+    EXPECT_NE(r.err.find("is a directory"), std::string::npos) << tool << ": " << r.err;
+    EXPECT_EQ(r.out, "") << tool << " worked before refusing";
+  }
+}
+
 }  // namespace
 }  // namespace svokit::test
