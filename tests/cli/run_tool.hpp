@@ -2,11 +2,15 @@
 // Runs one of svokit's command-line tools as a child process and captures what it printed.
 
 #include <fcntl.h>
-#include <spawn.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tests/test_util.hpp"
@@ -30,31 +34,54 @@ struct ToolResult {
   }
 };
 
-inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args) {
+/// Runs `tool` with stdin from /dev/null and its output captured. With `seconds` > 0 it is
+/// limited to that much wall time (then killed: exit code 128 + 9) and 4 GiB of address space, so
+/// a tool that would hang or read without end fails the test instead of blocking the suite.
+inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args,
+                          int seconds = 0) {
   TempDir capture;
   const std::string out_path = (capture / "stdout").string(),
                     err_path = (capture / "stderr").string();
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
-  posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
   const std::string exe = std::string(SVOKIT_BIN_DIR) + "/" + tool;
   std::vector<std::string> argv_storage = {exe};
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_storage) argv.push_back(a.data());
   argv.push_back(nullptr);
-  pid_t pid = 0;
   ToolResult r;
-  if (posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ) == 0) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  // The child makes only async-signal-safe calls between fork and exec.
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (seconds > 0) {
+      const rlimit limit{std::uint64_t{4} << 30, std::uint64_t{4} << 30};
+      ::setrlimit(RLIMIT_AS, &limit);
+    }
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || err < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 ||
+        ::dup2(err, 2) < 0) {
+      ::_exit(127);
+    }
+    ::execv(exe.c_str(), argv.data());
+    ::_exit(127);
   }
-  posix_spawn_file_actions_destroy(&actions);
+  if (pid < 0) return r;
+  int status = 0;
+  if (seconds <= 0) {
+    ::waitpid(pid, &status, 0);
+  } else {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+    while (::waitpid(pid, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.out = ReadText(out_path);
   r.err = ReadText(err_path);
   return r;
