@@ -1,8 +1,10 @@
 #pragma once
 // What every svokit tool shares: version text, the common options (--quiet, --threads), and the
-// exit protocol (0 ok, 1 check failed, 2 bad input or usage, 3 internal error; one line on
-// stderr per error). Tools stay thin: options → library calls → report.
+// exit protocol (StatusCode: 0 ok, 1 check failed, 2 bad input or usage, 3 internal error, 4
+// cannot write the output, 5 out of memory; one line on stderr per error). Tools stay thin:
+// options → library calls → report.
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -115,10 +117,12 @@ inline CLI::Option* AddFile(CLI::App& cli, const std::string& flags, std::filesy
   return cli.add_option(flags, path, description)->option_text("FILE");
 }
 
-/// Checks an output path before any work is done: its extension is one of `extensions` and its
-/// directory exists, so a long run never ends in "cannot write".
+/// Checks an output path before any work is done: its extension is one of `extensions`, its
+/// directory exists and is writable, and it is neither a directory nor the file `input`, so a long
+/// run never ends in "cannot write" nor replaces its own input.
 inline Status CheckOutputPath(const std::filesystem::path& path,
-                              const std::vector<std::string>& extensions) {
+                              const std::vector<std::string>& extensions,
+                              const std::filesystem::path& input = {}) {
   const std::string ext = LowerExtension(path);
   if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
     std::string list;
@@ -134,8 +138,12 @@ inline Status CheckOutputPath(const std::filesystem::path& path,
   if (std::filesystem::is_directory(path, ec)) {
     return Status::BadInput("{}: is a directory, not a file", path.string());
   }
+  if (!input.empty() && std::filesystem::equivalent(path, input, ec)) {
+    return Status::BadInput("{}: is the input file; write the output elsewhere", path.string());
+  }
   if (::access(dir.c_str(), W_OK | X_OK) != 0) {
-    return Status::BadInput("{}: output directory is not writable", path.string());
+    return Status::CannotWrite("{}: output directory is not writable ({})", path.string(),
+                               std::strerror(errno));
   }
   return Status::Ok();
 }
@@ -220,7 +228,12 @@ inline int Fail(const std::string& tool, const Status& status) {
 /// touched pages are resident, so the padding costs address space, not memory. Nothing changes
 /// where hugetlb is already given (also `hugetlb=0`) or the exec fails.
 inline void UseHugePages(char** argv) {
-  static constexpr const char* kTunables = "glibc.malloc.hugetlb=1:glibc.malloc.top_pad=67108864";
+  // Under an address-space limit (ulimit -v) 64 MB steps would fail allocations that fit.
+  rlimit address_space{};
+  const bool unlimited =
+      ::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur == RLIM_INFINITY;
+  const char* const kTunables =
+      unlimited ? "glibc.malloc.hugetlb=1:glibc.malloc.top_pad=67108864" : "glibc.malloc.hugetlb=1";
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.hugetlb") != nullptr) return;
   const std::string value = tunables != nullptr && *tunables != 0
@@ -230,10 +243,11 @@ inline void UseHugePages(char** argv) {
   execv("/proc/self/exe", argv);
 }
 
-/// Parses the command line and runs `body`, mapping usage errors to exit 2 and anything thrown to
-/// a one-line message with exit 3.
+/// Parses the command line and runs `body`, mapping usage errors to exit 2, a failed allocation to
+/// exit 5 and anything else thrown to a one-line message with exit 3; `input` (filled by the parse)
+/// is the file those messages name.
 inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
-               const std::function<int()>& body) {
+               const std::filesystem::path& input, const std::function<int()>& body) {
   UseHugePages(argv);
   try {
     try {
@@ -248,9 +262,9 @@ inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
     }
     return body();
   } catch (const std::bad_alloc&) {
-    return Fail(tool, Status::Internal("out of memory"));
+    return Fail(tool, Status::OutOfMemory("{}: out of memory", input.string()));
   } catch (const std::exception& e) {
-    return Fail(tool, Status::Internal("internal error: {}", e.what()));
+    return Fail(tool, Status::Internal("{}: internal error: {}", input.string(), e.what()));
   }
 }
 

@@ -26,9 +26,9 @@ int main(int argc, char** argv) {
   build.Add(cli);
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
-  return app::Run(tool, cli, argc, argv, [&] {
+  return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
-    if (Status s = app::CheckOutputPath(output, {"svo"}); !s.ok()) return app::Fail(tool, s);
+    if (Status s = app::CheckOutputPath(output, {"svo"}, input); !s.ok()) return app::Fail(tool, s);
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 

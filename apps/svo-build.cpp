@@ -27,8 +27,8 @@ int main(int argc, char** argv) {
   build.Add(cli);
   app::AddCommonOptions(cli, common, "svo-build bunny.vfrag --mesh bunny.svm -o bunny.svo");
 
-  return app::Run(tool, cli, argc, argv, [&] {
-    if (Status s = app::CheckOutputPath(output, {"svo"}); !s.ok()) return app::Fail(tool, s);
+  return app::Run(tool, cli, argc, argv, input, [&] {
+    if (Status s = app::CheckOutputPath(output, {"svo"}, input); !s.ok()) return app::Fail(tool, s);
     if (build.contours && mesh_path.empty()) {
       return app::Fail(tool, Status::BadInput("{}: contours are fitted to the surface: give the "
                                               "voxelized mesh with --mesh, or --no-contours",

@@ -27,8 +27,8 @@ int main(int argc, char** argv) {
       ->option_text("L");
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
-  return app::Run(tool, cli, argc, argv, [&] {
-    if (Status s = app::CheckOutputPath(output, ExportExtensions()); !s.ok()) {
+  return app::Run(tool, cli, argc, argv, input, [&] {
+    if (Status s = app::CheckOutputPath(output, ExportExtensions(), input); !s.ok()) {
       return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);

@@ -27,9 +27,10 @@ int main(int argc, char** argv) {
                "Also count self-intersecting triangle pairs (exact, slower)");
   app::AddCommonOptions(cli, common, "svo-import bunny.obj -o bunny.svm");
 
-  return app::Run(tool, cli, argc, argv, [&] {
+  return app::Run(tool, cli, argc, argv, input, [&] {
     if (!output.empty()) {
-      if (Status s = app::CheckOutputPath(output, {"svm"}); !s.ok()) return app::Fail(tool, s);
+      if (Status s = app::CheckOutputPath(output, {"svm"}, input); !s.ok())
+        return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();

@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
   app::AddCommonOptions(cli, common,
                         "svo-inspect bunny.svo --levels --render bunny.png --view iso");
 
-  return app::Run(tool, cli, argc, argv, [&] {
+  return app::Run(tool, cli, argc, argv, input, [&] {
     // Every option is checked before the file is read, so a typo costs nothing.
     const StatusOr<View> view = ParseView(view_name);
     if (!view.ok()) return app::Fail(tool, view.status());
@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     const StatusOr<std::array<int, 2>> size = ParseImageSize(size_text);
     if (!size.ok()) return app::Fail(tool, size.status());
     if (!render_path.empty()) {
-      if (Status s = app::CheckOutputPath(render_path, {"png"}); !s.ok()) {
+      if (Status s = app::CheckOutputPath(render_path, {"png"}, input); !s.ok()) {
         return app::Fail(tool, s);
       }
     }
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
       if (!parsed.ok()) return app::Fail(tool, parsed.status());
       slice = *parsed;
       slice_path = slice_args[1];
-      if (Status s = app::CheckOutputPath(slice_path, {"png"}); !s.ok()) {
+      if (Status s = app::CheckOutputPath(slice_path, {"png"}, input); !s.ok()) {
         return app::Fail(tool, s);
       }
     }

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   cli.add_flag("--json", json, "Print the report as one JSON object");
   app::AddCommonOptions(cli, common, "svo-validate bunny.svo --mesh bunny.svm");
 
-  return app::Run(tool, cli, argc, argv, [&] {
+  return app::Run(tool, cli, argc, argv, input, [&] {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<LenientSvo> file =

@@ -27,9 +27,9 @@ int main(int argc, char** argv) {
   voxelize.Add(cli);
   app::AddCommonOptions(cli, common, "svo-voxelize bunny.svm -r 1024 -o bunny.vfrag");
 
-  return app::Run(tool, cli, argc, argv, [&] {
+  return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
-    if (Status s = app::CheckOutputPath(output, {"vfrag", "xyz", "ply"}); !s.ok()) {
+    if (Status s = app::CheckOutputPath(output, {"vfrag", "xyz", "ply"}, input); !s.ok()) {
       return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);

@@ -16,6 +16,8 @@
 #include <string>
 #include <thread>
 
+#include "tests/test_util.hpp"
+
 namespace svokit::test {
 
 /// `check` runs in a forked child limited to `seconds` of wall time and `memory` bytes of address
@@ -29,8 +31,10 @@ inline std::string RunBounded(const std::function<std::string()>& check, int sec
   if (pid < 0) return "fork failed";
   if (pid == 0) {
     ::close(fds[0]);
-    const rlimit limit{memory, memory};
-    ::setrlimit(RLIMIT_AS, &limit);
+    if (!kAddressSanitizer) {
+      const rlimit limit{memory, memory};
+      ::setrlimit(RLIMIT_AS, &limit);
+    }
     // Nothing may escape the child: an exception would unwind into the test runner's copy.
     std::string result;
     try {

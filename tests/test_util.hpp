@@ -26,6 +26,21 @@ inline std::filesystem::path AssimpModels() {
 }
 
 /// A fresh directory under the system temp dir, removed with its contents on destruction.
+/// Whether this build runs under AddressSanitizer, which reserves terabytes of address space:
+/// address-space limits cannot be tested there.
+constexpr bool kAddressSanitizer =
+#if defined(__SANITIZE_ADDRESS__)
+    true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    true;
+#else
+    false;
+#endif
+#else
+    false;
+#endif
+
 class TempDir {
  public:
   TempDir() {

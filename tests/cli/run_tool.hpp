@@ -34,16 +34,25 @@ struct ToolResult {
   }
 };
 
-/// Runs `tool` with stdin from /dev/null and its output captured. With `seconds` > 0 it is
-/// limited to that much wall time (then killed: exit code 128 + 9) and 4 GiB of address space, so
-/// a tool that would hang or read without end fails the test instead of blocking the suite.
+/// How a tool is run: `seconds` > 0 bounds its wall time (then it is killed: exit code 128 + 9);
+/// `address_space` > 0 bounds its memory; `file_size` > 0 bounds the size of any file it writes,
+/// as a full disk would (a write past it fails with EFBIG); `wrapper` is a command line it runs
+/// under (e.g. unshare or setpriv).
+struct RunOptions {
+  int seconds = 0;
+  std::uint64_t address_space = 0;
+  std::uint64_t file_size = 0;
+  std::vector<std::string> wrapper;
+};
+
+/// Runs `tool` with stdin from /dev/null and its output captured.
 inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args,
-                          int seconds = 0) {
+                          const RunOptions& options) {
   TempDir capture;
   const std::string out_path = (capture / "stdout").string(),
                     err_path = (capture / "stderr").string();
-  const std::string exe = std::string(SVOKIT_BIN_DIR) + "/" + tool;
-  std::vector<std::string> argv_storage = {exe};
+  std::vector<std::string> argv_storage = options.wrapper;
+  argv_storage.push_back(std::string(SVOKIT_BIN_DIR) + "/" + tool);
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_storage) argv.push_back(a.data());
@@ -52,9 +61,14 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
   // The child makes only async-signal-safe calls between fork and exec.
   const pid_t pid = ::fork();
   if (pid == 0) {
-    if (seconds > 0) {
-      const rlimit limit{std::uint64_t{4} << 30, std::uint64_t{4} << 30};
+    if (options.address_space > 0 && !kAddressSanitizer) {
+      const rlimit limit{options.address_space, options.address_space};
       ::setrlimit(RLIMIT_AS, &limit);
+    }
+    if (options.file_size > 0) {
+      const rlimit limit{options.file_size, options.file_size};
+      ::setrlimit(RLIMIT_FSIZE, &limit);
+      ::signal(SIGXFSZ, SIG_IGN);  // stays ignored across exec: the write fails instead
     }
     const int in = ::open("/dev/null", O_RDONLY);
     const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -63,15 +77,15 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
         ::dup2(err, 2) < 0) {
       ::_exit(127);
     }
-    ::execv(exe.c_str(), argv.data());
+    ::execvp(argv[0], argv.data());
     ::_exit(127);
   }
   if (pid < 0) return r;
   int status = 0;
-  if (seconds <= 0) {
+  if (options.seconds <= 0) {
     ::waitpid(pid, &status, 0);
   } else {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options.seconds);
     while (::waitpid(pid, &status, WNOHANG) == 0) {
       if (std::chrono::steady_clock::now() > deadline) {
         ::kill(pid, SIGKILL);
@@ -85,6 +99,13 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
   r.out = ReadText(out_path);
   r.err = ReadText(err_path);
   return r;
+}
+
+/// The same; with `seconds` > 0, bounded to that much wall time and 4 GiB of address space, so a
+/// tool that would hang or read without end fails the test instead of blocking the suite.
+inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args,
+                          int seconds = 0) {
+  return RunTool(tool, args, RunOptions{seconds, seconds > 0 ? std::uint64_t{4} << 30 : 0, 0, {}});
 }
 
 /// Every .svo the suite produces goes through svo-validate (with the mesh it came from, when

@@ -113,8 +113,6 @@ TEST(SvoExportCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{svo, "-o", "{dir}/out.vdb", "--level", "-1"}, "--level"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "x"}, "--level"},
       {{svo, "-o", "{dir}/missing/out.binvox"}, "output directory does not exist"},
-      {{svo, "-o", "/proc/svokit-export-cli.vdb"}, "svokit-export-cli.vdb: cannot create output"},
-      {{svo, "-o", "/proc/svokit-export-cli.ply"}, "svokit-export-cli.ply: cannot create output"},
       {{svo, "-o", "{dir}/taken.xyz"}, "taken.xyz: is a directory"},
       {{svo}, "--output is required"},
   };

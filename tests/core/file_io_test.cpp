@@ -1,6 +1,11 @@
 #include "svokit/core/file_io.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -47,9 +52,8 @@ TEST(AtomicFileWriter, AbandonedRewriteKeepsOldFile) {
   EXPECT_EQ(test::ReadText(target), "old");
 }
 
-// Commit swaps the new file with an existing one and removes the old: only the new content
-// remains, under the target's name, with no hidden leftovers; a reader holding the old file open
-// keeps reading the old content.
+// Commit replaces an existing file: only the new content remains, under the target's name, with
+// no hidden leftovers; a reader holding the old file open keeps reading the old content.
 TEST(AtomicFileWriter, CommitReplacesExistingFile) {
   TempDir dir;
   const auto target = dir.Write("out.bin", std::string("old content"));
@@ -88,6 +92,73 @@ TEST(AtomicFileWriter, MissingDirectoryIsBadInput) {
   const Status s = w.Open();
   EXPECT_EQ(s.code(), StatusCode::kBadInput);
   EXPECT_NE(s.message().find("out.bin"), std::string::npos);
+}
+
+// The file being written has no name: a process killed before Commit leaves nothing to clean up.
+bool HasUnnamedFiles(const std::filesystem::path& dir) {
+  const int fd = ::open(dir.c_str(), O_TMPFILE | O_RDWR, 0600);
+  if (fd < 0) return false;
+  ::close(fd);
+  return true;
+}
+
+TEST(AtomicFileWriter, KilledWriterLeavesNothingBehind) {
+  TempDir dir;
+  if (!HasUnnamedFiles(dir.path())) GTEST_SKIP() << dir.path() << " has no O_TMPFILE";
+  const auto target = dir.Write("out.bin", std::string("old"));
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    AtomicFileWriter w(target);
+    const std::string data(1 << 20, 'n');
+    if (!w.Open().ok() || !w.Write(data.data(), data.size()).ok()) ::_exit(1);
+    ::raise(SIGKILL);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.bin"});
+  EXPECT_EQ(test::ReadText(target), "old");
+}
+
+// Where a temporary has a name (no O_TMPFILE, or a kill between link and rename), the next writer
+// of that output removes it once its process is gone, and only then.
+TEST(AtomicFileWriter, OpenRemovesTemporariesOfProcessesThatAreGone) {
+  TempDir dir;
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
+  const std::string stale = TemporaryName("out.bin", gone, "a1b2c3");
+  const std::string live = TemporaryName("out.bin", ::getpid(), "d4e5f6");
+  const std::string other_output = TemporaryName("other.bin", gone, "a1b2c3");
+  const std::string other_host = ".out.bin.tmp-elsewhere-" + std::to_string(gone) + "-a1b2c3";
+  for (const std::string& name : {stale, live, other_output, other_host}) dir.Write(name, name);
+  AtomicFileWriter w(dir / "out.bin");
+  ASSERT_TRUE(w.Open().ok());
+  std::vector<std::string> kept = {live, other_output, other_host};
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(dir.Files(), kept);
+}
+
+// A write the system refuses (here RLIMIT_FSIZE, as a full disk would) is kCannotWrite, names the
+// output and not the temporary, and leaves nothing.
+TEST(AtomicFileWriter, RefusedWriteIsCannotWriteAndNamesTheOutput) {
+  TempDir dir;
+  const auto target = dir / "out.bin";
+  const std::string failure = test::RunBounded([&]() -> std::string {
+    const rlimit limit{1 << 16, 1 << 16};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    ::signal(SIGXFSZ, SIG_IGN);
+    AtomicFileWriter w(target);
+    if (!w.Open().ok()) return "open failed";
+    const std::string data(1 << 20, 'x');
+    Status s = w.Write(data.data(), data.size());
+    if (s.ok()) s = w.Commit();
+    if (s.code() != StatusCode::kCannotWrite) return "code " + std::to_string(s.exit_code());
+    if (s.message() != target.string() + ": cannot write (File too large)") return s.message();
+    return "";
+  });
+  EXPECT_EQ(failure, "");
+  EXPECT_TRUE(dir.Files().empty());
 }
 
 TEST(ReadFileBytes, ErrorsNameTheFile) {

@@ -64,8 +64,8 @@ TEST(Vfrag, AttributesRoundTripAndMustMatchTheVoxelCount) {
     EXPECT_EQ(c, (Rgba{RoundToHalf(f), RoundToHalf(1 - f), 0.5f, 1}));
     EXPECT_NEAR(c.g, 1 - f, (1 - f) / 2048);
     const Vec3d exact = Vec3d{0, f, 1} / std::sqrt(1.0 + double{f} * f);
-    EXPECT_NEAR(std::sqrt(Dot(Vec3d(n.x, n.y, n.z), Vec3d(n.x, n.y, n.z))), 1.0, 1e-6);
-    EXPECT_LT(Length(Cross(Vec3d(n.x, n.y, n.z), exact)), 7e-5) << i;
+    EXPECT_NEAR(std::sqrt(Dot(Vec3d{n.x, n.y, n.z}, Vec3d{n.x, n.y, n.z})), 1.0, 1e-6);
+    EXPECT_LT(Length(Cross(Vec3d{n.x, n.y, n.z}, exact)), 7e-5) << i;
   }
   s.colors.pop_back();
   auto bad = DecodeVfrag(EncodeVfrag(s, {}), "short.vfrag");
@@ -366,10 +366,25 @@ TEST(Vfrag, RejectsUnsortedOrOutOfGridKeysAndCorruption) {
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("outside the 5x6x7 grid"), std::string::npos);
   auto bytes = EncodeVfrag(Sample(), {});
-  bytes[bytes.size() / 2] ^= 1;
-  EXPECT_FALSE(DecodeVfrag(bytes, "flip.vfrag").ok());
   bytes.resize(bytes.size() - 3);
   EXPECT_FALSE(DecodeVfrag(bytes, "cut.vfrag").ok());
+}
+
+TEST(Vfrag, EveryFlippedByteIsDetected) {
+  VoxelSet s = Sample();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.colors.push_back({0.5f, 0.25f, 1, 1});
+    s.normals.push_back(Vec3f{0, 0, 1});
+    s.coverage.push_back(static_cast<float>(i));
+  }
+  const auto clean = EncodeVfrag(s, {"m.obj", "--resolution 7"});
+  for (std::size_t i = 0; i < clean.size(); ++i) {
+    auto bytes = clean;
+    bytes[i] ^= 0x08;
+    auto r = DecodeVfrag(bytes, "flip.vfrag");
+    ASSERT_FALSE(r.ok()) << "flipped byte " << i << " not detected";
+    EXPECT_EQ(r.status().message().rfind("flip.vfrag: ", 0), 0u) << r.status().message();
+  }
 }
 
 TEST(Vfrag, XyzHeaderRoundTripsTheTransformExactly) {

@@ -374,8 +374,8 @@ TEST(VfragFileWriter, WritesTheBytesOfWriteVfrag) {
       auto voxels = VoxelizePacked(*c.mesh, *grid, options, file);
       ASSERT_TRUE(voxels.ok());
       EXPECT_EQ(voxels->count, reference->count);
-      ASSERT_EQ(dir.Files().size(), 1u);  // a hidden temporary only, until the commit
-      EXPECT_EQ(dir.Files()[0].rfind(".out.vfrag.tmp", 0), 0u);
+      // Until the commit the file has no name (or, without O_TMPFILE, a hidden temporary's).
+      for (const std::string& name : dir.Files()) EXPECT_EQ(name.rfind(".out.vfrag.tmp-", 0), 0u);
       ASSERT_TRUE(file.Commit(*voxels).ok());
       EXPECT_TRUE(test::ReadBytes(path) == expected)
           << c.resolution << " colours " << c.colors << " normals " << c.normals << " threads "

@@ -1,11 +1,17 @@
 #include "svokit/core/file_io.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cctype>
 #include <cerrno>
+#include <charconv>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 
@@ -122,6 +128,66 @@ std::string LowerExtension(const std::filesystem::path& path) {
   return ext;
 }
 
+namespace {
+
+// The host's name as a temporary's name carries it: no '-' (it separates HOST-PID-XXXXXX) or '/'.
+const std::string& HostName() {
+  static const std::string name = [] {
+    char host[256] = {};
+    std::string out;
+    if (::gethostname(host, sizeof host - 1) == 0) {
+      for (const char c : std::string_view(host)) {
+        out.push_back(std::isalnum(static_cast<unsigned char>(c)) || c == '.' ? c : '_');
+      }
+    }
+    return out.empty() ? std::string("localhost") : out;
+  }();
+  return name;
+}
+
+// Six characters that make a temporary's name unique among this process's.
+std::string UniqueSuffix() {
+  static std::atomic<std::uint64_t> counter{0};
+  std::uint64_t x =
+      static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
+      (counter.fetch_add(1) * 0x9E3779B97F4A7C15ull);
+  static constexpr char kDigits[] = "0123456789abcdefghijklmnopqrstuvwxyz";
+  std::string out;
+  for (int i = 0; i < 6; ++i, x /= 36) out.push_back(kDigits[x % 36]);
+  return out;
+}
+
+}  // namespace
+
+std::string TemporaryName(const std::string& name, long pid, std::string_view unique) {
+  return fmt::format(".{}.tmp-{}-{}-{}", name, HostName(), pid, unique);
+}
+
+void RemoveStaleTemporaries(int dir_fd, const std::string& name) {
+  const int fd = ::openat(dir_fd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  DIR* dir = ::fdopendir(fd);
+  if (dir == nullptr) {
+    ::close(fd);
+    return;
+  }
+  const std::string prefix = fmt::format(".{}.tmp-{}-", name, HostName());
+  while (const dirent* entry = ::readdir(dir)) {
+    const std::string_view entry_name = entry->d_name;
+    if (!entry_name.starts_with(prefix)) continue;
+    const std::string_view rest = entry_name.substr(prefix.size());  // PID-XXXXXX
+    const std::size_t dash = rest.find('-');
+    if (dash == std::string_view::npos || rest.size() - dash - 1 != 6) continue;
+    pid_t pid = 0;
+    const auto [end, ec] = std::from_chars(rest.data(), rest.data() + dash, pid);
+    if (ec != std::errc() || end != rest.data() + dash || pid <= 0) continue;
+    // Only a process that is gone: EPERM means it runs (as another user).
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    ::unlinkat(::dirfd(dir), entry->d_name, 0);
+  }
+  ::closedir(dir);
+}
+
 AtomicFileWriter::AtomicFileWriter(std::filesystem::path path) : path_(std::move(path)) {}
 
 AtomicFileWriter::~AtomicFileWriter() {
@@ -133,27 +199,73 @@ void AtomicFileWriter::Discard() {
     std::fclose(file_);
     file_ = nullptr;
   }
-  if (!temp_path_.empty()) {
-    ::unlink(temp_path_.c_str());
-    temp_path_.clear();
+  if (!temp_name_.empty()) {
+    ::unlinkat(dir_fd_, temp_name_.c_str(), 0);
+    temp_name_.clear();
+  }
+  temp_path_.clear();
+  if (dir_fd_ >= 0) {
+    ::close(dir_fd_);
+    dir_fd_ = -1;
   }
 }
 
+Status AtomicFileWriter::Failure(std::string_view doing, int err) const {
+  if (err == ENOMEM) return Status::OutOfMemory("{}: {} (out of memory)", path_.string(), doing);
+  return Status::CannotWrite("{}: {} ({})", path_.string(), doing, std::strerror(err));
+}
+
 Status AtomicFileWriter::Open() {
-  std::filesystem::path dir = path_.parent_path();
-  if (dir.empty()) dir = ".";
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    return Status::BadInput("{}: output directory does not exist", path_.string());
+  Discard();
+  const std::filesystem::path dir = path_.parent_path().empty() ? "." : path_.parent_path();
+  dir_fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd_ < 0) {
+    if (errno == ENOENT || errno == ENOTDIR) {
+      return Status::BadInput("{}: output directory does not exist", path_.string());
+    }
+    return Failure("cannot open the output directory", errno);
   }
-  // Hidden, in the same directory (rename is atomic only within one file system).
-  std::string templ = fmt::format("{}/.{}.tmp.XXXXXX", dir.string(), path_.filename().string());
-  const int fd = ::mkstemp(templ.data());
+  RemoveStaleTemporaries(dir_fd_, path_.filename().string());
+  // Unnamed: nothing to clean up if the process dies. Libraries that write by name (and linkat on
+  // commit) reach it through /proc; without /proc, or where the file system has no O_TMPFILE
+  // (EOPNOTSUPP; EISDIR from kernels before 3.11), the temporary gets a name.
+  int fd = ::openat(dir_fd_, ".", O_TMPFILE | O_RDWR | O_CLOEXEC, 0644);
+  if (fd < 0 && errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL) {
+    const Status failed = Failure("cannot create the output", errno);
+    Discard();
+    return failed;
+  }
+  if (fd >= 0) {
+    temp_path_ = fmt::format("/proc/self/fd/{}", fd);
+    if (::access(temp_path_.c_str(), W_OK) != 0) {
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  if (fd < 0) return OpenNamedTemporary();
+  ::fchmod(fd, 0644);  // the same mode whatever the umask: outputs are reproducible
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    ::close(fd);
+    Discard();
+    return Status::Internal("{}: fdopen failed", path_.string());
+  }
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::OpenNamedTemporary() {
+  const std::filesystem::path dir = path_.parent_path().empty() ? "." : path_.parent_path();
+  std::string full =
+      (dir / TemporaryName(path_.filename().string(), ::getpid(), "XXXXXX")).string();
+  const int fd = ::mkostemp(full.data(), O_CLOEXEC);
   if (fd < 0) {
-    return Status::BadInput("{}: cannot create output ({})", path_.string(), std::strerror(errno));
+    const Status failed = Failure("cannot create the output", errno);
+    Discard();
+    return failed;
   }
   ::fchmod(fd, 0644);
-  temp_path_ = templ;
+  temp_path_ = full;
+  temp_name_ = std::filesystem::path(full).filename().string();
   file_ = ::fdopen(fd, "wb");
   if (!file_) {
     ::close(fd);
@@ -166,9 +278,9 @@ Status AtomicFileWriter::Open() {
 Status AtomicFileWriter::Write(std::span<const std::uint8_t> bytes) {
   if (!file_) return Status::Internal("{}: write to a writer that is not open", path_.string());
   if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
-    const int err = errno;
+    const Status failed = Failure("cannot write", errno);
     Discard();
-    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+    return failed;
   }
   bytes_written_ += bytes.size();
   return Status::Ok();
@@ -187,46 +299,57 @@ Status AtomicFileWriter::WriteAt(std::uint64_t offset, std::span<const std::uint
     if (ok) done += static_cast<std::size_t>(n);
   }
   if (!ok) {
-    const int err = errno;
+    const Status failed = Failure("cannot write", errno);
     Discard();
-    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+    return failed;
   }
   return Status::Ok();
 }
 
-// An existing target is swapped with the temporary (one atomic step, as a rename over it) and
-// then unlinked: ext4 starts writing back a file renamed over another one (auto_da_alloc) inside
-// the rename, which then waits on the disk; the swap does not. Plain rename where there is no
-// target or the file system cannot swap, and for a directory (which a swap would move).
-bool AtomicFileWriter::ReplaceWithTemporary() const {
-  struct stat target {};
-  const bool swappable = ::lstat(path_.c_str(), &target) == 0 && !S_ISDIR(target.st_mode);
-  if (swappable &&
-      ::renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, path_.c_str(), RENAME_EXCHANGE) == 0) {
-    ::unlink(temp_path_.c_str());  // the previous file's data, now under the temporary's name
-    return true;
+// The data is on disk before the file has its name, and the name is on disk before Commit
+// returns: after a crash the path holds the old file or the new one, complete.
+Status AtomicFileWriter::PutInPlace() {
+  const std::string target = path_.filename().string();
+  if (temp_name_.empty()) {
+    // With no file at the path, the unnamed file becomes it in one step.
+    if (::linkat(AT_FDCWD, temp_path_.c_str(), dir_fd_, target.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+      return SyncDirectory();
+    }
+    if (errno != EEXIST) return Failure("cannot put the file in place", errno);
+    // Over an existing file: a name for the moment between link and rename (a process killed
+    // there leaves it to the next writer's sweep).
+    for (int attempt = 0; temp_name_.empty(); ++attempt) {
+      const std::string name = TemporaryName(target, ::getpid(), UniqueSuffix());
+      if (::linkat(AT_FDCWD, temp_path_.c_str(), dir_fd_, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+        temp_name_ = name;
+      } else if (errno != EEXIST || attempt > 100) {
+        return Failure("cannot put the file in place", errno);
+      }
+    }
   }
-  return std::rename(temp_path_.c_str(), path_.c_str()) == 0;
+  if (::renameat(dir_fd_, temp_name_.c_str(), dir_fd_, target.c_str()) != 0) {
+    return Failure("cannot put the file in place", errno);
+  }
+  temp_name_.clear();
+  return SyncDirectory();
+}
+
+Status AtomicFileWriter::SyncDirectory() {
+  // EINVAL: a file system that cannot sync directories (nothing more to do there).
+  if (::fsync(dir_fd_) != 0 && errno != EINVAL) return Failure("cannot sync the directory", errno);
+  return Status::Ok();
 }
 
 Status AtomicFileWriter::Commit() {
   if (!file_) return Status::Internal("{}: commit of a writer that is not open", path_.string());
-  const bool flushed = std::fflush(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!flushed || !closed) {
-    const int err = errno;
+  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
+    const Status failed = Failure("cannot write", errno);
     Discard();
-    return Status::Internal("{}: write failed ({})", path_.string(), std::strerror(err));
+    return failed;
   }
-  if (!ReplaceWithTemporary()) {
-    const int err = errno;
-    Discard();
-    return Status::Internal("{}: cannot rename into place ({})", path_.string(),
-                            std::strerror(err));
-  }
-  temp_path_.clear();
-  return Status::Ok();
+  const Status placed = PutInPlace();
+  Discard();
+  return placed;
 }
 
 Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {

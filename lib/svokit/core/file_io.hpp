@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "svokit/core/status.hpp"
@@ -47,8 +48,14 @@ std::string UnreadableReason(const Status& status, const std::filesystem::path& 
 /// Lower-case extension without the dot ("obj" for "Model.OBJ").
 std::string LowerExtension(const std::filesystem::path& path);
 
-/// Writes to a temporary file beside `path` and renames it into place on Commit(). Destroying an
-/// uncommitted writer removes the temporary, so a failed run never leaves a partial output.
+/// Writes an output file so that it appears complete or not at all, whatever happens to the process
+/// or the machine. The data goes to an unnamed file (O_TMPFILE) in the output's directory, which
+/// the kernel frees if the process dies; Commit() syncs it, links it in place of the old file and
+/// syncs the directory. Where the file system has no unnamed files it falls back to a hidden
+/// temporary, `.NAME.tmp-HOST-PID-XXXXXX`; Open() removes those of processes of this host that no
+/// longer run, so a kill leaves nothing behind for longer than the next write of that output.
+/// Errors name the output, never the temporary; a write refused by the system (disk full,
+/// permission, read-only file system) is StatusCode::kCannotWrite.
 class AtomicFileWriter {
  public:
   explicit AtomicFileWriter(std::filesystem::path path);
@@ -64,25 +71,42 @@ class AtomicFileWriter {
   }
   /// Overwrites bytes already written, at `offset` (e.g. a header completed last).
   Status WriteAt(std::uint64_t offset, std::span<const std::uint8_t> bytes);
-  /// Flushes, closes and renames onto the final path.
+  /// Flushes and syncs the data, puts the file in place of `path` and syncs the directory.
   Status Commit();
+  /// The output's path, for messages.
+  const std::filesystem::path& path() const { return path_; }
   std::uint64_t bytes_written() const { return bytes_written_; }
-  /// The temporary's path, for libraries that write files by name (OpenVDB): they fill it,
-  /// Commit() renames it into place.
+  /// A name that opens the temporary, for libraries that write files by name (OpenVDB,
+  /// OpenImageIO): they fill it, Commit() puts it in place.
   const std::string& temp_path() const { return temp_path_; }
   /// The temporary's descriptor, for writes that bypass Write() (a memory mapping of the file,
   /// container::MappedWriter); -1 unless open.
   int descriptor() const { return file_ ? ::fileno(file_) : -1; }
+  /// The status for a failed system call on the output with errno `err` (`doing`: "cannot
+  /// write"): kCannotWrite for the environment's refusals, kOutOfMemory for ENOMEM.
+  Status Failure(std::string_view doing, int err) const;
 
  private:
   void Discard();
-  bool ReplaceWithTemporary() const;
+  Status OpenNamedTemporary();
+  Status PutInPlace();
+  Status SyncDirectory();
 
   std::filesystem::path path_;
-  std::string temp_path_;
+  int dir_fd_ = -1;
   std::FILE* file_ = nullptr;
+  std::string temp_name_;  ///< the temporary's name in the directory; empty while it has none
+  std::string temp_path_;
   std::uint64_t bytes_written_ = 0;
 };
+
+/// The name of a hidden temporary of output `name` made by process `pid` of this host, `unique`
+/// telling a process's temporaries apart: ".NAME.tmp-HOST-PID-UNIQUE".
+std::string TemporaryName(const std::string& name, long pid, std::string_view unique);
+
+/// Removes the hidden temporaries `.NAME.tmp-HOST-PID-XXXXXX` of `name` in `dir_fd` left by
+/// processes of this host that no longer run; other hosts' and live processes' are kept.
+void RemoveStaleTemporaries(int dir_fd, const std::string& name);
 
 /// Writes `bytes` to `path` atomically.
 Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);

@@ -10,12 +10,15 @@
 
 namespace svokit {
 
-/// Exit-code-compatible error classes (the apps' exit code is the numeric value).
+/// Exit-code-compatible error classes: the apps' exit code is the numeric value (the table is in
+/// README.md, "Exit codes").
 enum class StatusCode : int {
   kOk = 0,
   kCheckFailed = 1,  ///< a validation found problems
   kBadInput = 2,     ///< unreadable / malformed input, impossible options
-  kInternal = 3,     ///< a bug or an environment failure (disk full, ...)
+  kInternal = 3,     ///< a bug
+  kCannotWrite = 4,  ///< the output cannot be written: disk full, permission, read-only, I/O error
+  kOutOfMemory = 5,  ///< an allocation or a memory mapping was refused
 };
 
 class [[nodiscard]] Status {
@@ -33,6 +36,14 @@ class [[nodiscard]] Status {
     return {StatusCode::kCheckFailed, fmt::format(f, std::forward<Args>(args)...)};
   }
   template <class... Args>
+  static Status CannotWrite(fmt::format_string<Args...> f, Args&&... args) {
+    return {StatusCode::kCannotWrite, fmt::format(f, std::forward<Args>(args)...)};
+  }
+  template <class... Args>
+  static Status OutOfMemory(fmt::format_string<Args...> f, Args&&... args) {
+    return {StatusCode::kOutOfMemory, fmt::format(f, std::forward<Args>(args)...)};
+  }
+  template <class... Args>
   static Status Internal(fmt::format_string<Args...> f, Args&&... args) {
     return {StatusCode::kInternal, fmt::format(f, std::forward<Args>(args)...)};
   }
@@ -42,7 +53,8 @@ class [[nodiscard]] Status {
   const std::string& message() const { return message_; }
   int exit_code() const { return static_cast<int>(code_); }
 
-  /// The same status with "context: " in front of the message (e.g. the file name).
+  /// The same status with "context: " in front of the message (e.g. the input's name), except for
+  /// kCannotWrite, whose message starts with the output's path.
   Status WithContext(const std::string& context) const;
 
  private:

@@ -1256,7 +1256,7 @@ StatusOr<Mesh> ImportGltf(const std::filesystem::path& path) {
     SVOKIT_RETURN_IF_ERROR(GltfImporter(*model, path.parent_path(), mesh).Run().WithContext(name));
     return mesh;
   } catch (const std::bad_alloc&) {
-    return Status::BadInput("{}: out of memory while importing", name);
+    return Status::OutOfMemory("{}: out of memory while importing", name);
   } catch (const std::exception& e) {
     return Status::BadInput("{}: {}", name, OneLine(e.what()));
   }

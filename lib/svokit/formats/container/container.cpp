@@ -151,12 +151,11 @@ void MappedWriter::Unmap() {
 }
 
 Status MappedWriter::MapFile(std::uint64_t size) {
-  const std::string name = file_->temp_path();
   Unmap();
   const int fd = file_->descriptor();
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
-    return Status::Internal("{}: cannot stat ({})", name, std::strerror(errno));
+    return file_->Failure("cannot stat", errno);
   }
   const auto current = static_cast<std::uint64_t>(st.st_size);
   // Blocks reserved now: a store into a mapped hole of a full disk would be a SIGBUS.
@@ -168,16 +167,16 @@ Status MappedWriter::MapFile(std::uint64_t size) {
             ? 0
             : errno;
     if (err != 0 && err != EOPNOTSUPP && err != EINVAL) {
-      return Status::BadInput("{}: cannot reserve {} bytes ({})", name, size, std::strerror(err));
+      return file_->Failure(fmt::format("cannot reserve {} bytes", size), err);
     }
   }
   if (::ftruncate(fd, static_cast<off_t>(size)) != 0) {
-    return Status::BadInput("{}: cannot size to {} bytes ({})", name, size, std::strerror(errno));
+    return file_->Failure(fmt::format("cannot size to {} bytes", size), errno);
   }
   if (size == 0) return Status::Ok();
   void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (p == MAP_FAILED) {
-    return Status::Internal("{}: cannot map ({})", name, std::strerror(errno));
+    return file_->Failure("cannot map", errno);
   }
   data_ = static_cast<std::uint8_t*>(p);
   mapped_ = size;
@@ -278,7 +277,7 @@ Status MappedWriter::Commit(std::vector<Section> sections) {
 }
 
 Status MappedWriter::Finish(const std::vector<Section>& sections) {
-  const std::string& name = file_->temp_path();
+  const std::string name = file_->path().string();
   std::vector<std::uint64_t> keep(region_offsets_.size());
   bool matches = sections.size() == plan_.size();
   for (std::size_t i = 0; matches && i < sections.size(); ++i) {
@@ -309,7 +308,7 @@ Status MappedWriter::Finish(const std::vector<Section>& sections) {
   std::copy(head.begin(), head.end(), data_);
   Unmap();
   if (::ftruncate(file_->descriptor(), static_cast<off_t>(size)) != 0) {
-    return Status::Internal("{}: cannot size to {} bytes ({})", name, size, std::strerror(errno));
+    return file_->Failure(fmt::format("cannot size to {} bytes", size), errno);
   }
   return file_->Commit();
 }
@@ -327,6 +326,37 @@ struct Mapping {
   }
 };
 
+// No byte lies outside the checksums: the sections follow one another in table order, each at
+// the first aligned offset after the previous one, with zero padding between, as the writer puts
+// them, and the file ends with the last.
+template <class IssueFn>
+void CheckLayout(std::span<const std::uint8_t> bytes, std::size_t table_end,
+                 std::uint64_t file_size, const std::vector<Frame::Section>& sections,
+                 const IssueFn& issue) {
+  std::uint64_t end = table_end;
+  for (const Frame::Section& s : sections) {
+    if (!s.in_file) return;  // reported already
+    if (s.offset != AlignUp(end)) {
+      issue(Frame::IssueKind::kLayout,
+            fmt::format("section '{}' starts at offset {}, not {} where the writer puts it",
+                        TagString(s.tag), s.offset, AlignUp(end)));
+      return;
+    }
+    const auto padding = bytes.subspan(end, s.offset - end);
+    if (std::any_of(padding.begin(), padding.end(), [](std::uint8_t b) { return b != 0; })) {
+      issue(Frame::IssueKind::kLayout,
+            fmt::format("padding before section '{}' is not zero (file is corrupt)",
+                        TagString(s.tag)));
+    }
+    end = s.offset + s.size;
+  }
+  if (end != file_size) {
+    issue(Frame::IssueKind::kLayout,
+          fmt::format("the sections end at byte {}, the header says the file is {} bytes", end,
+                      file_size));
+  }
+}
+
 }  // namespace
 
 StatusOr<Frame> Frame::Open(const std::filesystem::path& path, const FormatId& format,
@@ -343,8 +373,10 @@ StatusOr<Frame> Frame::Open(const std::filesystem::path& path, const FormatId& f
   if (mapping->size > 0) {
     void* p = ::mmap(nullptr, mapping->size, PROT_READ, MAP_PRIVATE, fd, 0);
     if (p == MAP_FAILED) {
+      const int err = errno;
       ::close(fd);
-      return Status::BadInput("{}: cannot map ({})", name, std::strerror(errno));
+      if (err == ENOMEM) return Status::OutOfMemory("{}: cannot map (out of memory)", name);
+      return Status::BadInput("{}: cannot map ({})", name, std::strerror(err));
     }
     mapping->data = p;
   }
@@ -423,6 +455,7 @@ StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std:
     }
     f.sections_.push_back(s);
   }
+  CheckLayout(bytes, table_end, file_size, f.sections_, issue);
   return f;
 }
 

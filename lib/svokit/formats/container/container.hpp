@@ -151,7 +151,8 @@ class Frame {
     kSectionTable,
     kHeaderChecksum,
     kSectionBounds,
-    kSectionChecksum
+    kSectionChecksum,
+    kLayout  ///< sections out of the writer's order, or padding that is not zero
   };
   struct Issue {
     IssueKind kind;

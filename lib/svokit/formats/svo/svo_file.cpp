@@ -324,6 +324,8 @@ const char* FrameIssueKind(container::Frame::IssueKind kind) {
       return "section_bounds";
     case container::Frame::IssueKind::kSectionChecksum:
       return "section_checksum";
+    case container::Frame::IssueKind::kLayout:
+      return "layout";
   }
   return "frame";
 }
