@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
@@ -125,6 +127,34 @@ TEST(SvoVoxelizeCli, NumberOptionsAreRefusedWithShortMessages) {
     ASSERT_EQ(r.ErrLines().size(), 1u) << what << ": " << r.err;
     EXPECT_LT(r.err.size(), 200u) << what << ": " << r.err;
     EXPECT_EQ(r.err.find("179769313486"), std::string::npos) << what << ": " << r.err;
+  }
+}
+
+// A grid of one voxel (-r 1, or a voxel larger than the mesh) holds the whole mesh in one voxel
+// with its attributes. UBSan found the attribute pass copying from an empty vector's null data()
+// there: the sanitizer run of this test is that regression test.
+TEST(SvoVoxelizeCli, OneVoxelGridsHoldTheWholeMesh) {
+  TempDir dir;
+  const std::string out = (dir / "one.vfrag").string();
+  for (const std::string mesh : {"tetra.off", "uv-torus.obj"}) {
+    for (const std::vector<std::string>& grid :
+         {std::vector<std::string>{"-r", "1"}, std::vector<std::string>{"--voxel-size", "1e308"}}) {
+      std::vector<std::string> args = {(DataDir() / mesh).string(), "-o", out, "-q"};
+      args.insert(args.end(), grid.begin(), grid.end());
+      const ToolResult r = RunTool("svo-voxelize", args);
+      ASSERT_EQ(r.exit_code, 0) << mesh << " " << grid[1] << ": " << r.err;
+      VfragMetadata meta;
+      StatusOr<VoxelSet> voxels = ReadVfrag(out, &meta);
+      ASSERT_TRUE(voxels.ok()) << voxels.status().message();
+      ASSERT_EQ(voxels->keys.size(), 1u) << mesh << " " << grid[1];
+      EXPECT_EQ(voxels->keys[0], 0u);
+      ASSERT_EQ(voxels->normals.size(), 1u);
+      ASSERT_EQ(voxels->colors.size(), 1u);
+      // Closed surfaces: their area-weighted normals cancel out in the one voxel.
+      const Vec3f n = voxels->normals[0];
+      EXPECT_LT(n.x * n.x + n.y * n.y + n.z * n.z, 1.0001f) << mesh << " " << grid[1];
+      EXPECT_TRUE(std::isfinite(voxels->color(0).r)) << mesh << " " << grid[1];
+    }
   }
 }
 

@@ -1,10 +1,13 @@
 #include "svokit/mesh/texture.hpp"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
 
 #include "svokit/core/file_io.hpp"
+#include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit {
@@ -60,6 +63,58 @@ TEST(Texture, GarbageIsAnErrorNotACrash) {
   EXPECT_FALSE(t.ReadInfo().ok());
   Texture unknown("noext", std::vector<std::uint8_t>{1, 2, 3});
   EXPECT_FALSE(unknown.Decoded().ok());
+}
+
+// The bytes given are decoded, never a file that happens to carry the texture's name in the
+// working directory (OpenImageIO, given a name, opens that file to identify its format).
+TEST(Texture, DecodesItsOwnBytesNotAFileOfTheSameName) {
+  test::TempDir dir;
+  test::TempDir other;
+  other.Write("img.png", std::vector<std::uint8_t>{0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a});
+  const std::string failure = test::RunBounded([&]() -> std::string {
+    if (::chdir(other.path().c_str()) != 0) return "chdir failed";
+    for (const std::string ext : {"png", "tga", "bmp", "tif"}) {
+      Texture t("img." + ext, Encode(dir, ext, OIIO::TypeDesc::UINT8), /*srgb=*/true);
+      if (ext == "png") other.Write("img.png", std::vector<std::uint8_t>(100, 0));
+      auto img = t.Decoded();
+      if (!img.ok()) return ext + ": " + img.status().message();
+      if ((*img)->Texel(0, 0).r != 1.f || (*img)->Texel(0, 1).b != 1.f) return ext + ": pixels";
+    }
+    return "";
+  });
+  EXPECT_EQ(failure, "");
+}
+
+// A PNG header may declare any size: one over the limit is refused before any pixel is decoded.
+TEST(Texture, ImagesOverThePixelLimitAreRefusedUndecoded) {
+  // Signature and IHDR of a 100000 × 100000 RGB image, then an empty IDAT and IEND.
+  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  const auto chunk = [&](const char* type, std::vector<std::uint8_t> data) {
+    const std::uint32_t n = static_cast<std::uint32_t>(data.size());
+    for (int shift = 24; shift >= 0; shift -= 8)
+      png.push_back(static_cast<std::uint8_t>(n >> shift));
+    std::vector<std::uint8_t> body(type, type + 4);
+    body.insert(body.end(), data.begin(), data.end());
+    std::uint32_t crc = 0xffffffffu;  // zlib's CRC-32, bit by bit
+    for (std::uint8_t b : body) {
+      crc ^= b;
+      for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+    }
+    crc ^= 0xffffffffu;
+    png.insert(png.end(), body.begin(), body.end());
+    for (int shift = 24; shift >= 0; shift -= 8)
+      png.push_back(static_cast<std::uint8_t>(crc >> shift));
+  };
+  chunk("IHDR", {0, 1, 0x86, 0xa0, 0, 1, 0x86, 0xa0, 8, 2, 0, 0, 0});
+  chunk("IDAT", {0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});  // an empty zlib stream
+  chunk("IEND", {});
+  Texture t("bomb.png", png);
+  auto info = t.ReadInfo();
+  ASSERT_FALSE(info.ok());
+  EXPECT_EQ(info.status().message(),
+            "texture 'bomb.png': 100000x100000 pixels with 3 channels, over the limit of "
+            "268435456 pixels and 4 channels");
+  EXPECT_FALSE(t.Decoded().ok());
 }
 
 }  // namespace

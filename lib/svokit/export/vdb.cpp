@@ -1,11 +1,18 @@
 // The only translation unit that sees OpenVDB's headers: they are heavy to compile, and the rest
 // of svokit stays free of them.
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
 #include <mutex>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include <fmt/format.h>
+
+#include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/export/voxel_writers.hpp"
 
@@ -17,6 +24,42 @@ namespace {
 void InitializeOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
+}
+
+// io::File::write is this with a std::ofstream of its own, which it never checks.
+class VdbArchive : public openvdb::io::Archive {
+ public:
+  void Write(std::ostream& out, const openvdb::GridPtrVec& grids,
+             const openvdb::MetaMap& meta) const {
+    Archive::write(out, grids, /*seekable=*/true, meta);
+  }
+};
+
+// OpenVDB writes a random UUID into every header (36 characters after magic, three versions and a
+// flag): it becomes one derived from the rest of the file, so the same grids give the same bytes.
+Status ReplaceUuid(const AtomicFileWriter& file) {
+  constexpr std::size_t kUuidOffset = 8 + 3 * 4 + 1, kUuidEnd = kUuidOffset + 36;
+  const int fd = file.descriptor();
+  std::vector<std::uint8_t> chunk(std::size_t{1} << 20);
+  std::uint32_t crc[2] = {0, 0x9E3779B9u};
+  std::uint64_t size = 0;
+  for (ssize_t n; (n = ::pread(fd, chunk.data(), chunk.size(), static_cast<off_t>(size))) != 0;) {
+    if (n < 0) return file.Failure("cannot read back", errno);
+    if (size == 0) {
+      if (n < static_cast<ssize_t>(kUuidEnd))
+        return Status::Internal("{}: no VDB header", file.path().string());
+      std::fill(chunk.begin() + kUuidOffset, chunk.begin() + kUuidEnd, 0);
+    }
+    for (std::uint32_t& c : crc) c = Crc32c(chunk.data(), static_cast<std::size_t>(n), c);
+    size += static_cast<std::uint64_t>(n);
+  }
+  const std::string uuid =
+      fmt::format("{:08x}-{:04x}-4{:03x}-8{:03x}-{:012x}", crc[0], crc[1] >> 16, crc[1] & 0xfff,
+                  size >> 48 & 0xfff, size & 0xffffffffffffull);
+  if (::pwrite(fd, uuid.data(), uuid.size(), kUuidOffset) != static_cast<ssize_t>(uuid.size())) {
+    return file.Failure("cannot write", errno);
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -64,15 +107,18 @@ Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path)
 
   AtomicFileWriter temp(path);
   SVOKIT_RETURN_IF_ERROR(temp.Open());
+  openvdb::MetaMap meta;
+  meta.insertMeta("creator", openvdb::StringMetadata(std::string("svokit ") + SVOKIT_VERSION));
+  std::ofstream out(temp.temp_path(), std::ios::binary | std::ios::trunc);
   try {
-    openvdb::io::File file(temp.temp_path());
-    openvdb::MetaMap meta;
-    meta.insertMeta("creator", openvdb::StringMetadata(std::string("svokit ") + SVOKIT_VERSION));
-    file.write(grids, meta);
-    file.close();
+    VdbArchive().Write(out, grids, meta);
   } catch (const openvdb::Exception& e) {
-    return Status::Internal("{}: OpenVDB could not write the file ({})", path.string(), e.what());
+    return Status::Internal("{}: OpenVDB could not write the grids ({})", path.string(), e.what());
   }
+  // io::File does not look at its stream after writing: a full disk would pass unnoticed.
+  if (!out.flush()) return temp.Failure("cannot write", errno);
+  out.close();
+  SVOKIT_RETURN_IF_ERROR(ReplaceUuid(temp));
   return temp.Commit();
 }
 

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <mutex>
 
+#include <fmt/format.h>
+
 #include "svokit/core/file_io.hpp"
 
 namespace svokit {
@@ -17,8 +19,8 @@ constexpr const char* kPluginName = "libsvokit_oiio.so";
 
 struct Plugin {
   SvokitDecodeFn decode = nullptr;
-  SvokitEncodeFn encode = nullptr;  // null in a plugin built before image writing existed
-  std::string error;
+  SvokitEncodeFn encode = nullptr;  // null in a plugin of an older svokit
+  Status error;                     // why there is no plugin
 };
 
 // Candidates, in order: $SVOKIT_PLUGIN_DIR, the running executable's ../lib and its own folder,
@@ -48,13 +50,29 @@ const Plugin& LoadPlugin() {
     candidates.push_back(kPluginName);
     for (const std::string& path : candidates) {
       void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (!handle) continue;
+      if (!handle) {
+        // A plugin that is there but does not load (its libraries missing, no memory) says why.
+        std::error_code ec;
+        if (plugin.error.ok() && std::filesystem::is_regular_file(path, ec)) {
+          const std::string why = ::dlerror();
+          const bool memory = why.find("failed to map") != std::string::npos ||
+                              why.find("Cannot allocate memory") != std::string::npos;
+          plugin.error = Status(memory ? StatusCode::kOutOfMemory : StatusCode::kInternal,
+                                fmt::format("cannot load the image plugin ({})", why));
+        }
+        continue;
+      }
       plugin.decode = reinterpret_cast<SvokitDecodeFn>(::dlsym(handle, "svokit_oiio_decode"));
-      plugin.encode = reinterpret_cast<SvokitEncodeFn>(::dlsym(handle, "svokit_oiio_encode"));
-      if (plugin.decode) return;
+      plugin.encode = reinterpret_cast<SvokitEncodeFn>(::dlsym(handle, "svokit_oiio_encode_to"));
+      if (plugin.decode) {
+        plugin.error = Status::Ok();
+        return;
+      }
     }
-    plugin.error = std::string("the image decoding plugin ") + kPluginName +
-                   " was not found (set SVOKIT_PLUGIN_DIR)";
+    if (plugin.error.ok()) {
+      plugin.error = Status::Internal("the image plugin {} was not found (set SVOKIT_PLUGIN_DIR)",
+                                      kPluginName);
+    }
   });
   return plugin;
 }
@@ -62,7 +80,7 @@ const Plugin& LoadPlugin() {
 Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageHeader& header,
             float* pixels, std::size_t pixel_count) {
   const Plugin& plugin = LoadPlugin();
-  if (!plugin.decode) return Status::Internal("texture '{}': {}", name, plugin.error);
+  if (!plugin.decode) return plugin.error.WithContext(fmt::format("texture '{}'", name));
   SvokitImageHeader h{};
   char error[512] = {};
   if (plugin.decode(name.c_str(), bytes.data(), bytes.size(), &h, pixels, pixel_count, error,
@@ -72,6 +90,14 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
   header = {h.width, h.height, h.channels, h.is_float != 0, h.format};
   if (h.width <= 0 || h.height <= 0 || h.channels <= 0) {
     return Status::BadInput("texture '{}': empty image", name);
+  }
+  const auto pixels_in_image =
+      static_cast<std::uint64_t>(h.width) * static_cast<std::uint64_t>(h.height);
+  if (pixels_in_image > kImagePixelLimit || h.channels > 4) {
+    return Status::BadInput(
+        "texture '{}': {}x{} pixels with {} channels, over the limit of {} "
+        "pixels and 4 channels",
+        name, h.width, h.height, h.channels, kImagePixelLimit);
   }
   return Status::Ok();
 }
@@ -111,19 +137,22 @@ Status WriteImage(const std::filesystem::path& path, int width, int height, int 
     return Status::BadInput("{}: no extension to choose an image format by", path.string());
   }
   const Plugin& plugin = LoadPlugin();
-  if (!plugin.decode) return Status::Internal("{}: {}", path.string(), plugin.error);
+  if (!plugin.decode) return plugin.error.WithContext(path.string());
   if (!plugin.encode) {
     return Status::Internal("{}: the image plugin {} cannot write images (rebuild it)",
                             path.string(), kPluginName);
   }
-  AtomicFileWriter file(path);
-  SVOKIT_RETURN_IF_ERROR(file.Open());
   char error[512] = {};
-  if (plugin.encode(file.temp_path().c_str(), format.c_str(), width, height, channels,
-                    pixels.data(), error, sizeof error) != 0) {
-    return Status::BadInput("{}: cannot write the image ({})", path.string(), error);
-  }
-  return file.Commit();
+  std::vector<std::uint8_t> encoded;
+  const SvokitEmitFn keep = [](void* context, const std::uint8_t* bytes, std::size_t size) {
+    static_cast<std::vector<std::uint8_t>*>(context)->assign(bytes, bytes + size);
+  };
+  const int failed = plugin.encode(format.c_str(), width, height, channels, pixels.data(), keep,
+                                   &encoded, error, sizeof error);
+  if (failed == 2) return Status::BadInput("{}: {}", path.string(), error);
+  if (failed != 0)
+    return Status::Internal("{}: cannot encode the image ({})", path.string(), error);
+  return WriteFileAtomic(path, encoded);
 }
 
 }  // namespace svokit

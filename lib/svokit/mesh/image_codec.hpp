@@ -20,7 +20,12 @@ struct ImageHeader {
   std::string format;     ///< e.g. "png"
 };
 
-/// Header only (no pixel decoding). `name` is a format hint (file name or URI).
+/// The most pixels an image may have (16384², 4 GiB as floats with 4 channels): a few bytes of
+/// PNG header may declare any size, and decoding allocates before it reads.
+inline constexpr std::uint64_t kImagePixelLimit = std::uint64_t{1} << 28;
+
+/// Header only (no pixel decoding); an image over kImagePixelLimit or 4 channels is bad input.
+/// `name` is a format hint (file name or URI).
 StatusOr<ImageHeader> ReadImageHeader(const std::string& name, std::span<const std::uint8_t> bytes);
 /// All pixels as floats, width × height × channels, row 0 at the top.
 StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
@@ -29,8 +34,8 @@ StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
 
 /// Encodes 8-bit pixels (width × height × channels, row 0 at the top; 4 channels = RGBA with
 /// straight alpha) in the format the extension of `path` names (png, tif, jpg, ...) and writes it
-/// atomically: the plugin fills a temporary beside `path` that is renamed into place, so a failed
-/// write leaves no file. Bad sizes or an unknown format are bad input.
+/// as AtomicFileWriter does: a failed write leaves no file. Bad sizes, or a format OpenImageIO
+/// cannot write, are bad input.
 Status WriteImage(const std::filesystem::path& path, int width, int height, int channels,
                   std::span<const std::uint8_t> pixels);
 
@@ -44,11 +49,13 @@ struct SvokitImageHeader {
 using SvokitDecodeFn = int (*)(const char* name, const std::uint8_t* bytes, std::size_t size,
                                SvokitImageHeader* header, float* pixels, std::size_t pixel_count,
                                char* error, std::size_t error_size);
-/// Writes `pixels` (8 bit) to the file `path` in `format` (a format name such as "png": the path
-/// is a temporary whose extension says nothing).
-using SvokitEncodeFn = int (*)(const char* path, const char* format, int width, int height,
-                               int channels, const std::uint8_t* pixels, char* error,
-                               std::size_t error_size);
+/// Receives the encoded bytes of an image.
+using SvokitEmitFn = void (*)(void* context, const std::uint8_t* bytes, std::size_t size);
+/// Encodes `pixels` (8 bit) in `format` (a format name such as "png") and calls `emit` once with
+/// the bytes. Returns 2 for a format it cannot write, 1 for other failures.
+using SvokitEncodeFn = int (*)(const char* format, int width, int height, int channels,
+                               const std::uint8_t* pixels, SvokitEmitFn emit, void* context,
+                               char* error, std::size_t error_size);
 }
 
 }  // namespace svokit

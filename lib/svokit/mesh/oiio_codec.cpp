@@ -1,12 +1,17 @@
 // libsvokit_oiio: the plugin module that decodes and encodes images with OpenImageIO (see
 // image_codec.hpp). svokit_oiio_decode: with `pixels` null it reads the header only; otherwise it
-// decodes all pixels into the caller's buffer of `pixel_count` floats. svokit_oiio_encode: writes
-// 8-bit pixels to a named file in a named format.
+// decodes all pixels into the caller's buffer of `pixel_count` floats. svokit_oiio_encode_to:
+// encodes 8-bit pixels in a named format and hands the bytes to the caller.
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -14,32 +19,40 @@
 
 namespace {
 
-// Most OIIO decoders read from memory through an IOProxy; for a format whose plugin cannot, the
-// bytes go through a temporary file. The name only serves as a format hint.
+// The reader the name's extension picks decodes the bytes from memory, through an IOProxy, or,
+// for a format whose reader cannot, from an unnamed in-memory file (memfd): the bytes never go
+// through a file name, so no file of the same name is read instead and no temporary is left.
 class EncodedImageReader {
  public:
   EncodedImageReader(const std::string& name, const std::uint8_t* bytes, std::size_t size)
       : reader_(bytes, size) {
     const std::string ext = OIIO::Filesystem::extension(name);
-    auto probe = OIIO::ImageInput::create(ext.empty() ? name : ext);
-    if (probe && probe->supports("ioproxy")) {
-      OIIO::ImageSpec config;
-      OIIO::Filesystem::IOProxy* proxy = &reader_;
-      config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-      input_ = OIIO::ImageInput::open(name, &config, proxy);
+    // A format name ("png"): given a file name, create() would try to open that file.
+    input_ = OIIO::ImageInput::create(ext.empty() ? name : ext.substr(1));
+    OIIO::ImageSpec spec;
+    if (!input_) {
+      error_ = "unknown or unsupported image format";
+    } else if (input_->supports("ioproxy")) {
+      if (!input_->set_ioproxy(&reader_) || !input_->open(name, spec)) Fail();
     } else {
-      temp_ = OIIO::Filesystem::unique_path(OIIO::Filesystem::temp_directory_path() +
-                                            "/svokit-%%%%-%%%%" + ext);
-      if (OIIO::Filesystem::write_binary_file(temp_, OIIO::cspan<std::uint8_t>(bytes, size))) {
-        input_ = OIIO::ImageInput::open(temp_);
+      memfd_ = ::memfd_create("svokit-image", MFD_CLOEXEC);
+      bool written = memfd_ >= 0;
+      for (std::size_t done = 0; written && done < size;) {
+        const ssize_t n = ::write(memfd_, bytes + done, size - done);
+        written = n > 0;
+        if (written) done += static_cast<std::size_t>(n);
+      }
+      if (!written) {
+        error_ = std::string("cannot hold the image in memory (") + std::strerror(errno) + ")";
+        input_.reset();
+      } else if (!input_->open("/proc/self/fd/" + std::to_string(memfd_), spec)) {
+        Fail();
       }
     }
-    if (!input_) error_ = OIIO::geterror();
-    if (error_.empty() && !input_) error_ = "unknown or unsupported image format";
   }
   ~EncodedImageReader() {
     input_.reset();
-    if (!temp_.empty()) OIIO::Filesystem::remove(temp_);
+    if (memfd_ >= 0) ::close(memfd_);
   }
   EncodedImageReader(const EncodedImageReader&) = delete;
   EncodedImageReader& operator=(const EncodedImageReader&) = delete;
@@ -48,15 +61,23 @@ class EncodedImageReader {
   const std::string& error() const { return error_; }
 
  private:
+  void Fail() {
+    error_ = input_->geterror();
+    if (error_.empty()) error_ = OIIO::geterror();
+    if (error_.empty()) error_ = "not a valid image";
+    input_.reset();
+  }
+
   OIIO::Filesystem::IOMemReader reader_;
-  std::string temp_;
+  int memfd_ = -1;
   std::unique_ptr<OIIO::ImageInput> input_;
   std::string error_;
 };
 
-int Fail(const std::string& message, char* error, std::size_t error_size) {
+// Returns `code`: 1 for a failure of the file or the data, 2 for a format OIIO cannot write.
+int Fail(const std::string& message, char* error, std::size_t error_size, int code = 1) {
   std::snprintf(error, error_size, "%s", message.c_str());
-  return 1;
+  return code;
 }
 
 }  // namespace
@@ -90,23 +111,30 @@ extern "C" __attribute__((visibility("default"))) int svokit_oiio_decode(
   }
 }
 
-extern "C" __attribute__((visibility("default"))) int svokit_oiio_encode(
-    const char* path, const char* format, int width, int height, int channels,
-    const std::uint8_t* pixels, char* error, std::size_t error_size) {
+extern "C" __attribute__((visibility("default"))) int svokit_oiio_encode_to(
+    const char* format, int width, int height, int channels, const std::uint8_t* pixels,
+    svokit::SvokitEmitFn emit, void* context, char* error, std::size_t error_size) {
   try {
     auto output = OIIO::ImageOutput::create(format);
     if (!output) {
       const std::string message = OIIO::geterror();
       return Fail(message.empty() ? std::string("no writer for format '") + format + "'" : message,
-                  error, error_size);
+                  error, error_size, 2);
     }
+    // Encoded in memory: OIIO's writers do not all check their file writes, the caller does.
+    if (!output->supports("ioproxy")) {
+      return Fail(std::string("OpenImageIO cannot write '") + format + "' to memory", error,
+                  error_size, 2);
+    }
+    OIIO::Filesystem::IOVecOutput memory;
     OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
     // Our alpha is straight: without this the PNG writer would un-premultiply the colours.
     spec.attribute("oiio:UnassociatedAlpha", 1);
-    if (!output->open(path, spec) || !output->write_image(OIIO::TypeDesc::UINT8, pixels) ||
-        !output->close()) {
+    if (!output->set_ioproxy(&memory) || !output->open(std::string("image.") + format, spec) ||
+        !output->write_image(OIIO::TypeDesc::UINT8, pixels) || !output->close()) {
       return Fail(output->geterror(), error, error_size);
     }
+    emit(context, memory.buffer().data(), memory.buffer().size());
     return 0;
   } catch (const std::exception& e) {
     return Fail(e.what(), error, error_size);

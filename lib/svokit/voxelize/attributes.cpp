@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/polygon_clip.hpp"
@@ -139,6 +140,8 @@ AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoin
     }
   });
   for (std::size_t t : used) {
+    // A texture that cannot be decoded is the input's fault; memory running out is not.
+    if (errors[t].code() == StatusCode::kOutOfMemory) throw std::bad_alloc();
     if (!errors[t].ok()) {
       warnings_.push_back(errors[t].message() + "; its materials use their base colour");
     } else if (!textures_[t].valid()) {
