@@ -112,6 +112,23 @@ TEST(Svm, InconsistentSectionSizesAreRejected) {
   EXPECT_NE(r.status().message().find("MTID"), std::string::npos);
 }
 
+// Checksums vouch for the bytes, not their sense: a triangle naming a vertex that does not exist,
+// or a material id past the materials, is refused by the reader itself (the fuzzer's first .svm
+// find: the mesh report read past the positions).
+TEST(Svm, IndicesOutOfRangeAreRefused) {
+  Mesh bad_vertex = RichMesh();
+  bad_vertex.triangles[0][1] = static_cast<std::uint32_t>(bad_vertex.positions.size());
+  auto r = DecodeSvm(EncodeSvm(bad_vertex, "rich.obj"), "bad.svm");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
+  EXPECT_EQ(r.status().message().rfind("bad.svm: ", 0), 0u) << r.status().message();
+  Mesh bad_material = RichMesh();
+  bad_material.material_ids[0] = static_cast<std::uint32_t>(bad_material.materials.size());
+  r = DecodeSvm(EncodeSvm(bad_material, "rich.obj"), "bad.svm");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().message().rfind("bad.svm: ", 0), 0u) << r.status().message();
+}
+
 // The source name goes into the META JSON: one that is not UTF-8 is escaped, not thrown on.
 TEST(Svm, NonUtf8SourceNameIsEscaped) {
   std::vector<std::uint8_t> bytes;

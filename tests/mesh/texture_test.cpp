@@ -113,7 +113,7 @@ TEST(Texture, ImagesOverThePixelLimitAreRefusedUndecoded) {
   ASSERT_FALSE(info.ok());
   EXPECT_EQ(info.status().message(),
             "texture 'bomb.png': 100000x100000 pixels with 3 channels, over the limit of "
-            "268435456 pixels and 4 channels");
+            "67108864 pixels and 4 channels");
   EXPECT_FALSE(t.Decoded().ok());
 }
 

@@ -20,9 +20,9 @@ struct ImageHeader {
   std::string format;     ///< e.g. "png"
 };
 
-/// The most pixels an image may have (16384², 4 GiB as floats with 4 channels): a few bytes of
+/// The most pixels an image may have (8192², 1 GiB as floats with 4 channels): a few bytes of
 /// PNG header may declare any size, and decoding allocates before it reads.
-inline constexpr std::uint64_t kImagePixelLimit = std::uint64_t{1} << 28;
+inline constexpr std::uint64_t kImagePixelLimit = std::uint64_t{1} << 26;
 
 /// Header only (no pixel decoding); an image over kImagePixelLimit or 4 channels is bad input.
 /// `name` is a format hint (file name or URI).

@@ -153,6 +153,9 @@ StatusOr<Mesh> DecodeSections(const StatusOr<container::Reader>& file) {
     if (mesh.warnings.size() != count) return Status::BadInput("{}: WARN section is corrupt", name);
     for (std::string& w : mesh.warnings) SVOKIT_RETURN_IF_ERROR(wr.GetString(w));
   }
+  // Checksums vouch for the bytes, not for what they say: a file written by another program may
+  // still name a vertex or material that does not exist.
+  SVOKIT_RETURN_IF_ERROR(ValidateAndSanitize(mesh, name));
   return mesh;
 }
 

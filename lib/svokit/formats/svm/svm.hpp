@@ -24,7 +24,7 @@ std::vector<std::uint8_t> EncodeSvm(const Mesh& mesh, const std::string& source)
 /// Writes atomically: the file appears complete or not at all.
 Status WriteSvm(const Mesh& mesh, const std::string& source, const std::filesystem::path& path);
 
-/// Reads and verifies (checksums, sizes, counts); the mesh is not yet validated (ImportMesh does).
+/// Reads, verifies (checksums, sizes, counts) and validates the mesh (ValidateAndSanitize).
 StatusOr<Mesh> ReadSvm(const std::filesystem::path& path);
 StatusOr<Mesh> DecodeSvm(std::span<const std::uint8_t> bytes, const std::string& name);
 
