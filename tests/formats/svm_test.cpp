@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "tests/test_util.hpp"
@@ -127,6 +129,19 @@ TEST(Svm, IndicesOutOfRangeAreRefused) {
   r = DecodeSvm(EncodeSvm(bad_material, "rich.obj"), "bad.svm");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().message().rfind("bad.svm: ", 0), 0u) << r.status().message();
+}
+
+// A material colour that is not finite (a corrupt .svm, or another writer's) would reach the brick
+// encoder as NaN: it is read as white, with a warning naming the material.
+TEST(Svm, NonFiniteMaterialColourIsWhiteWithAWarning) {
+  Mesh mesh = RichMesh();
+  mesh.materials[0].base_color.g = std::numeric_limits<float>::quiet_NaN();
+  auto r = DecodeSvm(EncodeSvm(mesh, "rich.obj"), "nan.svm");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->materials[0].base_color, Rgba{});
+  ASSERT_FALSE(r->warnings.empty());
+  EXPECT_EQ(r->warnings.back(),
+            "material '" + mesh.materials[0].name + "' has a non-finite colour; white is used");
 }
 
 // The source name goes into the META JSON: one that is not UTF-8 is escaped, not thrown on.

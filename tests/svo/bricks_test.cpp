@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -552,6 +554,10 @@ TEST(Bricks, Unorm8RoundTrip) {
   EXPECT_EQ(EncodeUnorm8(-3.f), 0);  // clamped
   EXPECT_EQ(EncodeUnorm8(7.f), 255);
   EXPECT_EQ(EncodeUnorm8(0.5f), 128);
+  // NaN (a NaN texel of a float texture) is 0, never a conversion UBSan rejects.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(EncodeUnorm8(nan), 0);
+  EXPECT_EQ(EncodeColor({nan, 1, nan, nan}), 0x0000ff00u);
 }
 
 TEST(Bricks, ColorRoundTripIsWithinHalfAnSrgbStep) {

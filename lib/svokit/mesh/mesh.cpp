@@ -71,7 +71,13 @@ Status ValidateAndSanitize(Mesh& mesh, const std::string& source) {
                               mesh.materials.size());
     }
   }
-  for (const Material& m : mesh.materials) {
+  for (Material& m : mesh.materials) {
+    if (!std::isfinite(m.base_color.r) || !std::isfinite(m.base_color.g) ||
+        !std::isfinite(m.base_color.b) || !std::isfinite(m.base_color.a)) {
+      mesh.warnings.push_back(
+          fmt::format("material '{}' has a non-finite colour; white is used", m.name));
+      m.base_color = {};
+    }
     if (m.texture >= static_cast<std::int32_t>(mesh.textures.size())) {
       return Status::BadInput("{}: material '{}' refers to texture {}, but there are only {}",
                               source, m.name, m.texture, mesh.textures.size());

@@ -14,8 +14,9 @@
 
 namespace svokit {
 
+/// [0, 1] to 8 bits; NaN (from a NaN texel, say) encodes as 0, as anything below 0 does.
 inline std::uint8_t EncodeUnorm8(float v) {
-  return static_cast<std::uint8_t>(std::clamp(v, 0.f, 1.f) * 255.f + 0.5f);
+  return static_cast<std::uint8_t>((v > 0.f ? std::min(v, 1.f) : 0.f) * 255.f + 0.5f);
 }
 inline float DecodeUnorm8(std::uint8_t v) {
   return static_cast<float>(v) * (1.f / 255.f);
@@ -58,7 +59,7 @@ inline const Tables& GetTables() {
 
 inline std::uint32_t EncodeSrgb8(float linear) {
   const Tables& t = GetTables();
-  const float v = std::clamp(linear, 0.f, 1.f);
+  const float v = linear > 0.f ? std::min(linear, 1.f) : 0.f;  // NaN too: 0
   std::uint32_t code = t.srgb_start[static_cast<std::size_t>(v * Tables::kBins)];
   while (v >= t.srgb_midpoints[code]) ++code;
   return code;
