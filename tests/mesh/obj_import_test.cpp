@@ -195,6 +195,21 @@ TEST(ObjImport, MissingLibraryTextureAndMaterialAreWarnings) {
   EXPECT_EQ(m->warnings.size(), 3u);
 }
 
+// A library or texture name longer than a path may be (ENAMETOOLONG) is a name that names no
+// file: a warning. The check whether a spaced name is one file threw instead (found by fuzzing).
+TEST(ObjImport, NamesTooLongForAPathAreWarnings) {
+  TempDir dir;
+  const std::string long_name(5000, 'm');
+  dir.Write("a.mtl", "newmtl red\nKd 1 0 0\nmap_Kd " + long_name + ".png\n");
+  const auto p = dir.Write("a.obj", "mtllib a.mtl\nmtllib " + long_name + " " + long_name +
+                                        "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+  auto m = ImportMesh(p);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->warnings.size(), 3u);  // two libraries, one texture
+  for (const std::string& w : m->warnings) EXPECT_NE(w.find(long_name), std::string::npos) << w;
+  EXPECT_EQ(m->materials[0].base_color, (Rgba{1, 0, 0, 1}));
+}
+
 TEST(ObjImport, BadInputIsOneLineErrorNamingFileAndLine) {
   TempDir dir;
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";

@@ -211,7 +211,8 @@ class ObjParser {
   Status LoadMaterialLibraries(std::string_view names) {
     // "mtllib a.mtl b.mtl"; a single name with spaces is tried first.
     std::vector<std::string> files;
-    if (std::filesystem::exists(base_dir_ / std::string(names))) {
+    std::error_code ec;  // a name too long for a path is simply not one file's name
+    if (std::filesystem::exists(base_dir_ / std::string(names), ec)) {
       files.emplace_back(names);
     } else {
       TextScanner words(names, "");
