@@ -25,7 +25,6 @@ inline std::filesystem::path AssimpModels() {
   return SVOKIT_ASSIMP_MODELS;
 }
 
-/// A fresh directory under the system temp dir, removed with its contents on destruction.
 /// Whether this build runs under AddressSanitizer, which reserves terabytes of address space:
 /// address-space limits cannot be tested there.
 constexpr bool kAddressSanitizer =
@@ -41,6 +40,7 @@ constexpr bool kAddressSanitizer =
     false;
 #endif
 
+/// A fresh directory under the system temp dir, removed with its contents on destruction.
 class TempDir {
  public:
   TempDir() {

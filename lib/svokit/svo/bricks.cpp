@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "svokit/core/morton.hpp"
+#include "svokit/svo/brick_math.hpp"
 #include "svokit/svo/key_index.hpp"
 
 namespace svokit {
@@ -90,31 +91,10 @@ Block ChildBlock(const Svo& svo, std::uint32_t child_level, const Block& parent,
   return FillBlock(svo.levels[child_level].nodes, neighbours);
 }
 
-void Accumulate(PremultipliedSample& acc, const PremultipliedSample& v, float w) {
-  acc.opacity += w * v.opacity;
-  acc.r += w * v.r;
-  acc.g += w * v.g;
-  acc.b += w * v.b;
-  acc.a += w * v.a;
-  acc.nx += w * v.nx;
-  acc.ny += w * v.ny;
-  acc.nz += w * v.nz;
-}
-
-struct EncodedSample {
-  std::uint8_t opacity;
-  std::uint32_t color;
-  std::uint16_t normal;
-};
-
-// A sample whose opacity rounds to 0 is empty: no colour, no normal.
-EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {
-  const std::uint8_t opacity = EncodeUnorm8(p.opacity);
-  if (opacity == 0) return {0, 0, 0};
-  const BrickSample s = Unpremultiply(p);
-  return {opacity, color ? EncodeColor(s.color) : 0u,
-          normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
-}
+using brick_math::Accumulate;
+using brick_math::Encode;
+using brick_math::EncodedSample;
+using brick_math::kTent;
 
 void Store(const EncodedSample& e, std::size_t at, SvoLevel& out) {
   out.opacity[at] = e.opacity;
@@ -212,26 +192,12 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
   }
 }
 
-// Premultiply(decoded sample i of `lv`), without the straight sample in between (the same
-// products: absent colour and normal stay 0).
+// Premultiply(decoded sample i of `lv`).
 PremultipliedSample DecodePremultiplied(const SvoLevel& lv, std::size_t i, bool color,
                                         bool normal) {
-  PremultipliedSample p;
-  const float o = p.opacity = DecodeUnorm8(lv.opacity[i]);
-  if (color) {
-    const Rgba c = DecodeColor(lv.color[i]);
-    p.r = c.r * o;
-    p.g = c.g * o;
-    p.b = c.b * o;
-    p.a = c.a * o;
-  }
-  if (normal) {
-    const Vec3f n = DecodeNormal(lv.normal[i]);
-    p.nx = n.x * o;
-    p.ny = n.y * o;
-    p.nz = n.z * o;
-  }
-  return p;
+  return brick_math::DecodePremultiplied(
+      {lv.opacity[i], color ? lv.color[i] : 0u, normal ? lv.normal[i] : std::uint16_t{0}}, color,
+      normal);
 }
 
 // The brick of `node` at `level` from the stored level + 1 bricks in `block`, into `out`: the finer
@@ -294,7 +260,6 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
   }
   // Separable tent, one axis at a time (x, then y, then z): every shared sample is the same sum
   // of the same values in the same order, whichever parent computes it.
-  static constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};
   std::array<PremultipliedSample, 7 * 7 * 3> fx{};
   std::array<PremultipliedSample, 7 * 3 * 3> fy{};
   for (int z = 0; z < n; ++z) {

@@ -65,8 +65,7 @@ void StoreContours(const std::vector<std::vector<std::uint32_t>>& words, Svo& sv
 
 }  // namespace
 
-StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
-                       std::string metadata, Progress& progress) {
+Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options) {
   if (voxels.keys.empty()) return Status::BadInput("the voxel set is empty: nothing to build");
   if (options.brick_side != 0 && options.brick_side != 2 && options.brick_side != 3) {
     return Status::BadInput("bricks must be 3, 2 or none (got {})", options.brick_side);
@@ -78,6 +77,12 @@ StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
       (voxels.has_normals() && voxels.normals.size() != voxels.size())) {
     return Status::BadInput("voxel attribute arrays do not match the voxel count");
   }
+  return Status::Ok();
+}
+
+StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
+                       std::string metadata, Progress& progress) {
+  SVOKIT_RETURN_IF_ERROR(CheckBuildInput(voxels, mesh, options));
   Svo svo;
   svo.grid = voxels.grid;
   svo.mode = voxels.mode;

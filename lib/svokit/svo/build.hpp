@@ -25,6 +25,10 @@ struct BuildOptions {
 StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
                        std::string metadata = "{}", Progress& progress = Progress::Silent());
 
+/// BuildSvo's (and BuildCompactSvo's) refusals: an empty voxel set, a brick side other than 3, 2
+/// or 0, contours without the mesh, attribute arrays that do not match the voxels.
+Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options);
+
 /// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending.
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth);

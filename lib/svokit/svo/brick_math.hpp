@@ -1,0 +1,98 @@
+#pragma once
+// The arithmetic of the brick filter, shared by the reference (bricks.cpp) and the distinct-sample
+// filter (sample_filter.cpp), which must agree to the last bit: premultiplied sums, the tent, and
+// the encoding of a sample. Internal to lib/svokit/svo.
+
+#include <cstdint>
+#include <cstring>
+
+#include "svokit/svo/bricks.hpp"
+#include "svokit/svo/sample_codec.hpp"
+
+namespace svokit::brick_math {
+
+// acc += w·v per channel, four channels per instruction: each lane rounds the product and then the
+// sum, as the scalar expression does (no fused multiply-add on the x86-64 baseline), so the result
+// is the same to the last bit.
+using Lanes = float __attribute__((vector_size(16)));
+static_assert(sizeof(PremultipliedSample) == 2 * sizeof(Lanes));
+
+inline void Accumulate(PremultipliedSample& acc, const PremultipliedSample& v, float w) {
+  Lanes a[2], b[2];
+  std::memcpy(a, &acc, sizeof a);
+  std::memcpy(b, &v, sizeof b);
+  const Lanes ww = {w, w, w, w};
+  a[0] += ww * b[0];
+  a[1] += ww * b[1];
+  std::memcpy(&acc, a, sizeof a);
+}
+
+struct EncodedSample {
+  std::uint8_t opacity = 0;
+  std::uint32_t color = 0;
+  std::uint16_t normal = 0;
+};
+
+/// A sample whose opacity rounds to 0 is empty: no colour, no normal.
+inline EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {
+  const std::uint8_t opacity = EncodeUnorm8(p.opacity);
+  if (opacity == 0) return {};
+  const BrickSample s = Unpremultiply(p);
+  return {opacity, color ? EncodeColor(s.color) : 0u,
+          normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
+}
+
+/// Premultiply(decoded sample), without the straight sample in between (the same products: absent
+/// colour and normal stay 0).
+inline PremultipliedSample DecodePremultiplied(const EncodedSample& e, bool color, bool normal) {
+  PremultipliedSample p;
+  const float o = p.opacity = DecodeUnorm8(e.opacity);
+  if (color) {
+    const Rgba c = DecodeColor(e.color);
+    p.r = c.r * o;
+    p.g = c.g * o;
+    p.b = c.b * o;
+    p.a = c.a * o;
+  }
+  if (normal) {
+    const Vec3f n = DecodeNormal(e.normal);
+    p.nx = n.x * o;
+    p.ny = n.y * o;
+    p.nz = n.z * o;
+  }
+  return p;
+}
+
+inline constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};
+
+/// The [¼ ½ ¼]³ tent over the 3³ finer samples tap(dx, dy, dz) around a point, summed along x,
+/// then y, then z, each sum from zero in ascending position: the operations FilterBricks' passes
+/// make for that point (in lanes: the same operations, four channels at a time).
+template <class Tap>
+PremultipliedSample Tent(const Tap& tap) {
+  Lanes o[2] = {};
+  for (int dz = 0; dz < 3; ++dz) {
+    Lanes fy[2] = {};
+    for (int dy = 0; dy < 3; ++dy) {
+      Lanes fx[2] = {};
+      for (int dx = 0; dx < 3; ++dx) {
+        Lanes v[2];
+        std::memcpy(v, &tap(dx, dy, dz), sizeof v);
+        const Lanes w = {kTent[dx], kTent[dx], kTent[dx], kTent[dx]};
+        fx[0] += w * v[0];
+        fx[1] += w * v[1];
+      }
+      const Lanes w = {kTent[dy], kTent[dy], kTent[dy], kTent[dy]};
+      fy[0] += w * fx[0];
+      fy[1] += w * fx[1];
+    }
+    const Lanes w = {kTent[dz], kTent[dz], kTent[dz], kTent[dz]};
+    o[0] += w * fy[0];
+    o[1] += w * fy[1];
+  }
+  PremultipliedSample out;
+  std::memcpy(&out, o, sizeof o);
+  return out;
+}
+
+}  // namespace svokit::brick_math

@@ -1,0 +1,94 @@
+#pragma once
+// Consecutive levels of an octree (the whole tree, or one page's subtree) as child masks, and the
+// walk that hands every node of a level its 26 neighbours at that level without a key lookup.
+//
+// Node i of level L has child c (0..7; bit 0 = x, 1 = y, 2 = z) when bit c of its mask is set; its
+// children are nodes first_child + rank of the next level, every level in ascending Morton order.
+// A neighbourhood is 27 node indices, slot (x+1) + 3(y+1) + 9(z+1) for the offset (x, y, z) ∈
+// {−1, 0, 1}³, −1 where there is no node; slot 13 is the node itself. A child's neighbourhood
+// follows from its parent's: node 2p + c + o has parent p + ⌊(c + o)/2⌋, child bit (c + o) mod 2.
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+namespace svokit {
+
+using Neighbourhood = std::array<std::int64_t, 27>;
+
+/// Slot of offset (x, y, z) ∈ {−1, 0, 1}³ in a Neighbourhood.
+constexpr int NeighbourSlot(int x, int y, int z) {
+  return (x + 1) + 3 * (y + 1) + 9 * (z + 1);
+}
+
+struct MaskTree {
+  /// The level of masks[0]; masks[k] are the child masks of level first_level + k, whose root
+  /// level holds exactly one node.
+  std::uint32_t first_level = 0;
+  std::vector<std::vector<std::uint8_t>> masks;
+  /// Prefix sums of the masks' popcounts: the index of each node's first child.
+  std::vector<std::vector<std::uint64_t>> first_child;
+
+  /// The levels first_level .. last_level() have nodes (the last one has no masks).
+  std::uint32_t last_level() const {
+    return first_level + static_cast<std::uint32_t>(masks.size());
+  }
+  std::uint64_t NodeCount(std::uint32_t level) const;
+  /// Fills first_child from the masks.
+  void LinkChildren();
+  /// Index of child `c` of node `i` of `level`, or −1.
+  std::int64_t Child(std::uint32_t level, std::uint64_t i, unsigned c) const {
+    const std::uint8_t m = masks[level - first_level][i];
+    if (!(m >> c & 1u)) return -1;
+    return static_cast<std::int64_t>(
+        first_child[level - first_level][i] +
+        static_cast<unsigned>(std::popcount(static_cast<unsigned>(m) & ((1u << c) - 1))));
+  }
+};
+
+/// The tree of `level_keys` (sorted Morton keys per level, level 0 the root, as
+/// LevelKeysFromVoxels gives them) for levels first .. level_keys.size() − 1.
+MaskTree MaskTreeFromKeys(std::span<const std::vector<std::uint64_t>> level_keys,
+                          std::uint32_t first = 0);
+
+/// The neighbourhood of child `c` of a node of `level` whose neighbourhood is `parent`.
+Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
+                                 const Neighbourhood& parent, unsigned c);
+
+/// The neighbourhoods of every node of `level`, walked down from the root (which has no
+/// neighbours: nodes outside the tree count as absent).
+std::vector<Neighbourhood> LevelNeighbourhoods(const MaskTree& tree, std::uint32_t level);
+
+/// Calls body(i, neighbourhood) for every node i of `level`, in parallel over subtrees (in no
+/// particular order). Neighbourhoods are carried down from a level of at most a few thousand
+/// nodes, so no node is looked up by key.
+template <class Body>
+void ForEachNeighbourhood(const MaskTree& tree, std::uint32_t level, const Body& body) {
+  std::uint32_t top = tree.first_level;
+  while (top < level && tree.NodeCount(top) < 1024) ++top;
+  const std::vector<Neighbourhood> start = LevelNeighbourhoods(tree, top);
+  const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t i,
+                         const Neighbourhood& nb) -> void {
+    if (l == level) {
+      body(i, nb);
+      return;
+    }
+    const std::uint8_t m = tree.masks[l - tree.first_level][i];
+    std::uint64_t child = tree.first_child[l - tree.first_level][i];
+    for (unsigned c = 0; c < 8; ++c) {
+      if (m >> c & 1u) self(self, l + 1, child++, ChildNeighbourhood(tree, l, nb, c));
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        visit(visit, top, i, start[i]);
+                      }
+                    });
+}
+
+}  // namespace svokit

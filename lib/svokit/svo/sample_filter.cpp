@@ -1,0 +1,479 @@
+#include "svokit/svo/sample_filter.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <memory>
+
+#include "svokit/svo/brick_math.hpp"
+
+namespace svokit {
+
+namespace {
+
+using brick_math::Accumulate;
+using brick_math::DecodePremultiplied;
+using brick_math::Encode;
+using brick_math::EncodedSample;
+using brick_math::Tent;
+
+struct Flags {
+  bool color, normal;
+};
+
+// The children of a node's 27 neighbours: next-level node indices, 6³, block coordinate
+// 2·offset + child bit + 2 per axis (the node's own children at 2..3), −1 where absent.
+constexpr int kBlock = 6;
+using ChildBlock = std::array<std::int64_t, kBlock * kBlock * kBlock>;
+constexpr int BlockIndex(int x, int y, int z) {
+  return x + kBlock * (y + kBlock * z);
+}
+
+ChildBlock ChildrenOf(const MaskTree& tree, std::uint32_t level, const Neighbourhood& nb) {
+  ChildBlock block;
+  block.fill(-1);
+  const std::uint8_t* masks = tree.masks[level - tree.first_level].data();
+  const std::uint64_t* first = tree.first_child[level - tree.first_level].data();
+  for (int oz = -1; oz <= 1; ++oz) {
+    for (int oy = -1; oy <= 1; ++oy) {
+      for (int ox = -1; ox <= 1; ++ox) {
+        const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
+        if (q < 0) continue;
+        const unsigned m = masks[q];
+        auto child = static_cast<std::int64_t>(first[q]);
+        for (int c = 0; c < 8; ++c) {
+          if (!(m >> c & 1u)) continue;
+          block[BlockIndex(2 * ox + (c & 1) + 2, 2 * oy + (c >> 1 & 1) + 2,
+                           2 * oz + (c >> 2 & 1) + 2)] = child++;
+        }
+      }
+    }
+  }
+  return block;
+}
+
+// The voxels around a tile of the octree (a node up to four levels above the voxels) as the filter
+// sees them, and the voxel-level samples there, each computed once per tile. Coordinates are
+// relative to the tile's corner: voxels from −2 to W + 1 (W voxels per tile edge), lattice points
+// in half voxels from −2 to 2W + 2. Entries are valid for the tile they were written in (stamps:
+// nothing is cleared between tiles).
+class VoxelTile {
+ public:
+  explicit VoxelTile(std::uint32_t width) : width_(static_cast<int>(width)) {
+    const int voxels = width_ + 4, points = 2 * width_ + 5;
+    voxel_.resize(static_cast<std::size_t>(voxels * voxels * voxels));
+    point_.resize(static_cast<std::size_t>(points * points * points));
+  }
+  int width() const { return width_; }
+
+  // A new tile, of these voxels: every entry of the last one becomes invalid.
+  void Start(const VoxelSamplesSource& source, Flags f) {
+    source_ = &source;
+    f_ = f;
+    ++stamp_;
+  }
+
+  // The voxels of the block of a node above the voxels whose corner is voxel `corner` + (2, 2, 2)
+  // of the tile (block voxel b is tile voxel corner + b).
+  void AddBlock(const ChildBlock& block, const int corner[3]) {
+    for (int z = 0; z < kBlock; ++z) {
+      for (int y = 0; y < kBlock; ++y) {
+        for (int x = 0; x < kBlock; ++x) {
+          const std::int64_t v = block[BlockIndex(x, y, z)];
+          if (v < 0) continue;
+          Voxel& e = voxel_[VoxelAt(corner[0] + x, corner[1] + y, corner[2] + z)];
+          if (e.stamp == stamp_) continue;
+          e = {v, stamp_, false, {}, {}};
+        }
+      }
+    }
+  }
+
+  struct Point {
+    EncodedSample encoded;
+    PremultipliedSample decoded;  // the encoded sample premultiplied again, as a tent reads it
+    std::uint32_t stamp = 0;
+  };
+  // The voxel-level sample at half-voxel coordinates h: the mean over the voxels whose closed cube
+  // holds it (absent ones count as empty), summed in z, y, x order and scaled, as FilterBricks
+  // computes it, then encoded.
+  const Point& At(int hx, int hy, int hz) {
+    const int points = 2 * width_ + 5;
+    Point& p = point_[static_cast<std::size_t>((hx + 2) + points * ((hy + 2) + points * (hz + 2)))];
+    if (p.stamp == stamp_) return p;
+    p.stamp = stamp_;
+    const int h[3] = {hx, hy, hz};
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = FloorHalf(h[a] - 1);  // ⌈(h − 2)/2⌉
+      hi[a] = FloorHalf(h[a]);
+    }
+    Voxel* contributors[8];
+    int n = 0;
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          Voxel& v = voxel_[VoxelAt(x, y, z)];
+          if (v.stamp == stamp_) contributors[n++] = &v;
+        }
+      }
+    }
+    const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    if (n == 0) {
+      p.encoded = {};
+    } else if (n == 1) {
+      // One voxel: its own colour and normal, exactly (the scaling by 1/count is a power of 2).
+      p.encoded = Alone(*contributors[0]);
+      p.encoded.opacity = EncodeUnorm8(1.f / static_cast<float>(count));
+    } else {
+      PremultipliedSample sum;
+      for (int i = 0; i < n; ++i) Accumulate(sum, Cell(*contributors[i]), 1.f);
+      PremultipliedSample mean;
+      Accumulate(mean, sum, 1.f / static_cast<float>(count));
+      p.encoded = Encode(f_.color, f_.normal, mean);
+    }
+    p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
+                                       : DecodePremultiplied(p.encoded, f_.color, f_.normal);
+    return p;
+  }
+
+ private:
+  struct Voxel {
+    std::int64_t index = -1;
+    std::uint32_t stamp = 0;
+    bool converted = false;
+    PremultipliedSample cell;
+    EncodedSample alone;
+  };
+
+  std::size_t VoxelAt(int x, int y, int z) const {
+    const int voxels = width_ + 4;
+    return static_cast<std::size_t>((x + 2) + voxels * ((y + 2) + voxels * (z + 2)));
+  }
+  void Convert(Voxel& v) {
+    if (v.converted) return;
+    BrickSample b;
+    b.opacity = 1;
+    const auto i = static_cast<std::size_t>(v.index);
+    if (f_.color) b.color = source_->color(i);
+    if (f_.normal) b.normal = source_->normals[i];
+    v.cell = Premultiply(b);
+    v.alone = Encode(f_.color, f_.normal, v.cell);
+    v.converted = true;
+  }
+  const PremultipliedSample& Cell(Voxel& v) {
+    Convert(v);
+    return v.cell;
+  }
+  const EncodedSample& Alone(Voxel& v) {
+    Convert(v);
+    return v.alone;
+  }
+
+  static int FloorHalf(int a) { return a >= 0 ? a / 2 : -((1 - a) / 2); }
+
+  int width_;
+  const VoxelSamplesSource* source_ = nullptr;
+  Flags f_{};
+  std::uint32_t stamp_ = 0;
+  std::vector<Voxel> voxel_;
+  std::vector<Point> point_;
+};
+
+// Calls body(tile, i, nb, corner) for every node i of the level above the voxels, with its
+// neighbourhood and its voxel block's corner in tile coordinates (the block's voxel (2, 2, 2) is
+// the node's first child), tile by tile: the nodes below one node up to four levels higher, which
+// `tile` gathers the voxels of.
+template <class Body>
+void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, Flags f,
+                        const Body& body) {
+  const std::uint32_t voxels = tree.last_level(), above = voxels - 1;
+  const std::uint32_t tile_level = std::max(tree.first_level, voxels >= 4 ? voxels - 4 : 0u);
+  const std::uint32_t width = 1u << (voxels - tile_level);
+  ForEachNeighbourhood(tree, tile_level, [&](std::uint64_t t, const Neighbourhood& tile_nb) {
+    static thread_local std::unique_ptr<VoxelTile> scratch;
+    if (!scratch || scratch->width() != static_cast<int>(width)) {
+      scratch = std::make_unique<VoxelTile>(width);
+    }
+    VoxelTile& tile = *scratch;
+    tile.Start(source, f);
+    struct Node {
+      std::uint64_t i;
+      Neighbourhood nb;
+      int corner[3];
+    };
+    std::vector<Node> nodes;
+    const auto descend = [&](const auto& self, std::uint32_t level, std::uint64_t i,
+                             const Neighbourhood& nb, int x, int y, int z) -> void {
+      if (level == above) {
+        // The node at (x, y, z) in its level's units: its first child is voxel 2·(x, y, z).
+        Node n{i, nb, {2 * x - 2, 2 * y - 2, 2 * z - 2}};
+        tile.AddBlock(ChildrenOf(tree, above, nb), n.corner);
+        nodes.push_back(n);
+        return;
+      }
+      const std::uint8_t m = tree.masks[level - tree.first_level][i];
+      std::uint64_t child = tree.first_child[level - tree.first_level][i];
+      for (int c = 0; c < 8; ++c) {
+        if (!(m >> c & 1u)) continue;
+        self(self, level + 1, child++,
+             ChildNeighbourhood(tree, level, nb, static_cast<unsigned>(c)), 2 * x + (c & 1),
+             2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
+      }
+    };
+    descend(descend, tile_level, t, tile_nb, 0, 0, 0);
+    for (const Node& n : nodes) body(tile, n.i, n.nb, n.corner);
+  });
+}
+
+// Decoded finer samples around one node, computed on first use: index t ∈ [0, 7)³ per axis, the
+// finer lattice point 2k + d − 1 of the node's sample k and tap d (in finer lattice steps from
+// the node's corner).
+template <class Compute>
+class TapCache {
+ public:
+  explicit TapCache(const Compute& compute) : compute_(compute) { done_.fill(0); }
+  const PremultipliedSample& operator()(int x, int y, int z) {
+    const int i = x + 7 * (y + 7 * z);
+    if (!done_[i]) {
+      taps_[i] = compute_(x, y, z);
+      done_[i] = 1;
+    }
+    return taps_[i];
+  }
+
+ private:
+  const Compute& compute_;
+  std::array<std::uint8_t, 343> done_;
+  std::array<PremultipliedSample, 343> taps_;
+};
+
+void Store(const EncodedSample& e, std::uint64_t at, LevelSamples& out) {
+  out.opacity[at] = e.opacity;
+  if (!out.color.empty()) out.color[at] = e.color;
+  if (!out.normal.empty()) out.normal[at] = e.normal;
+}
+
+EncodedSample Load(const LevelSamples& in, std::uint64_t at) {
+  return {in.opacity[at], in.color.empty() ? 0u : in.color[at],
+          in.normal.empty() ? std::uint16_t{0} : in.normal[at]};
+}
+
+// Filters and stores the samples a node stores, in layout order: its home samples, then its
+// orphans. fetch(tx, ty, tz) is the decoded finer sample at tap index t = 2k + d (k the sample,
+// d ∈ 0..2 the tap, t ∈ [0, 2·side]). With side 3 the eight home samples share one separable pass
+// over their 5³ taps: the same sums FilterBricks makes, shared rather than repeated.
+template <class Fetch>
+void StoreNodeSamples(std::uint32_t side, std::uint32_t orphans, Fetch&& fetch, Flags f,
+                      LevelSamples& out, std::uint64_t first) {
+  using brick_math::Lanes;
+  const layout_detail::SideTable& t = layout_detail::TableFor(side);
+  const auto tent_of = [&](unsigned s) {
+    const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
+                      static_cast<int>(s / (side * side))};
+    return Tent([&](int dx, int dy, int dz) -> const PremultipliedSample& {
+      return fetch(2 * k[0] + dx, 2 * k[1] + dy, 2 * k[2] + dz);
+    });
+  };
+  if (side == 3) {
+    Lanes taps[5][5][5][2];  // [z][y][x]
+    for (int z = 0; z < 5; ++z) {
+      for (int y = 0; y < 5; ++y) {
+        for (int x = 0; x < 5; ++x)
+          std::memcpy(taps[z][y][x], &fetch(x, y, z), sizeof taps[z][y][x]);
+      }
+    }
+    const auto weight = [](int d) {
+      return Lanes{brick_math::kTent[d], brick_math::kTent[d], brick_math::kTent[d],
+                   brick_math::kTent[d]};
+    };
+    Lanes fx[5][5][2][2] = {};  // [z][y][kx]
+    for (int z = 0; z < 5; ++z) {
+      for (int y = 0; y < 5; ++y) {
+        for (int kx = 0; kx < 2; ++kx) {
+          for (int d = 0; d < 3; ++d) {
+            for (int l = 0; l < 2; ++l) fx[z][y][kx][l] += weight(d) * taps[z][y][2 * kx + d][l];
+          }
+        }
+      }
+    }
+    Lanes fy[5][2][2][2] = {};  // [z][ky][kx]
+    for (int z = 0; z < 5; ++z) {
+      for (int ky = 0; ky < 2; ++ky) {
+        for (int kx = 0; kx < 2; ++kx) {
+          for (int d = 0; d < 3; ++d) {
+            for (int l = 0; l < 2; ++l) fy[z][ky][kx][l] += weight(d) * fx[z][2 * ky + d][kx][l];
+          }
+        }
+      }
+    }
+    for (int kz = 0; kz < 2; ++kz) {
+      for (int ky = 0; ky < 2; ++ky) {
+        for (int kx = 0; kx < 2; ++kx) {
+          Lanes o[2] = {};
+          for (int d = 0; d < 3; ++d) {
+            for (int l = 0; l < 2; ++l) o[l] += weight(d) * fy[2 * kz + d][ky][kx][l];
+          }
+          PremultipliedSample p;
+          std::memcpy(&p, o, sizeof o);
+          Store(Encode(f.color, f.normal, p),
+                first + static_cast<std::uint64_t>(kx + 2 * ky + 4 * kz), out);
+        }
+      }
+    }
+  } else {
+    Store(Encode(f.color, f.normal, tent_of(0)), first, out);
+  }
+  std::uint64_t next = first + t.home_count;
+  for (unsigned s = 0; s < side * side * side; ++s) {
+    if (!t.is_home[s] && (orphans >> t.index[s] & 1u)) {
+      Store(Encode(f.color, f.normal, tent_of(s)), next++, out);
+    }
+  }
+}
+
+LevelSamples Allocate(std::uint64_t n, Flags f) {
+  LevelSamples out;
+  out.opacity.resize(n);
+  out.color.resize(f.color ? n : 0);
+  out.normal.resize(f.normal ? n : 0);
+  return out;
+}
+
+// The level above the voxels: each node's samples from the voxel-level samples around it (encoded,
+// as the voxel bricks would store them, then decoded), which its tile computes once.
+void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::uint32_t side,
+                       const VoxelSamplesSource& source, Flags f, LevelSamples& out) {
+  ForEachAboveVoxels(
+      tree, source, f,
+      [&](VoxelTile& tile, std::uint64_t i, const Neighbourhood&, const int corner[3]) {
+        // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
+        // voxels.
+        int origin[3];
+        for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
+        const int step = side == 3 ? 1 : 2;
+        StoreNodeSamples(
+            side, layout.orphans[i],
+            [&](int x, int y, int z) -> const PremultipliedSample& {
+              return tile
+                  .At(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
+                      origin[2] + step * (z - 1))
+                  .decoded;
+            },
+            f, out, layout.first[i]);
+      });
+}
+
+// An inner level's samples from the stored samples of the level below.
+void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
+                 const SampleLayout& finer_layout, const LevelSamples& finer, std::uint32_t side,
+                 Flags f, LevelSamples& out) {
+  ForEachNeighbourhood(tree, level, [&](std::uint64_t i, const Neighbourhood& nb) {
+    const ChildBlock block = ChildrenOf(tree, level, nb);
+    const auto finer_sample = [&](int x, int y, int z) {
+      // Finer lattice point 2k + d − 1: its home node's block coordinate and home sample.
+      const int t[3] = {x, y, z};
+      int home[3], k[3];
+      for (int a = 0; a < 3; ++a) {
+        if (side == 3) {
+          const int r = t[a] - 1;  // −1..5
+          const int half = r < 0 ? -1 : r / 2;
+          home[a] = half + 2;
+          k[a] = r - 2 * half;
+        } else {
+          home[a] = t[a] + 1;
+          k[a] = 0;
+        }
+      }
+      const std::uint64_t at =
+          PointIndex(finer_layout, static_cast<unsigned>(k[0] + side * (k[1] + side * k[2])),
+                     [&](unsigned fb) {
+                       return block[BlockIndex(home[0] - static_cast<int>(fb & 1),
+                                               home[1] - static_cast<int>(fb >> 1 & 1),
+                                               home[2] - static_cast<int>(fb >> 2 & 1))];
+                     });
+      if (at == ~std::uint64_t{0}) return PremultipliedSample{};
+      const EncodedSample e = Load(finer, at);
+      return e.opacity == 0 ? PremultipliedSample{} : DecodePremultiplied(e, f.color, f.normal);
+    };
+    TapCache taps(finer_sample);
+    StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
+  });
+}
+
+}  // namespace
+
+std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
+                                        std::uint32_t side, const VoxelSamplesSource& source) {
+  const Flags f{!source.colors.empty(), !source.normals.empty()};
+  const std::uint32_t voxels = tree.last_level();
+  std::vector<LevelSamples> out(voxels - tree.first_level);
+  for (std::uint32_t level = voxels; level-- > tree.first_level;) {
+    const std::size_t k = level - tree.first_level;
+    out[k] = Allocate(layouts[k].size(), f);
+    if (level + 1 == voxels) {
+      FilterAboveVoxels(tree, layouts[k], side, source, f, out[k]);
+    } else {
+      FilterInner(tree, level, layouts[k], layouts[k + 1], out[k + 1], side, f, out[k]);
+    }
+  }
+  return out;
+}
+
+void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
+                    const LevelSamples& samples, SvoLevel& out) {
+  const std::uint32_t n = layout.side * layout.side * layout.side;
+  const std::uint64_t nodes = tree.NodeCount(level);
+  out.opacity.resize(nodes * n);
+  out.color.resize(samples.color.empty() ? 0 : nodes * n);
+  out.normal.resize(samples.normal.empty() ? 0 : nodes * n);
+  ForEachNeighbourhood(tree, level, [&](std::uint64_t i, const Neighbourhood& nb) {
+    for (unsigned s = 0; s < n; ++s) {
+      const std::uint64_t from = SampleIndex(layout, nb, s), to = i * n + s;
+      out.opacity[to] = samples.opacity[from];
+      if (!out.color.empty()) out.color[to] = samples.color[from];
+      if (!out.normal.empty()) out.normal[to] = samples.normal[from];
+    }
+  });
+}
+
+void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
+                 SvoLevel& out, std::span<const std::uint8_t> keep) {
+  const Flags f{!source.colors.empty(), !source.normals.empty()};
+  const std::uint32_t level = tree.last_level() - 1, n = side * side * side;
+  const std::uint64_t voxels = tree.NodeCount(tree.last_level());
+  // Where each voxel's brick goes: its rank among the kept ones.
+  std::vector<std::int64_t> slot(voxels);
+  std::int64_t kept = 0;
+  for (std::uint64_t v = 0; v < voxels; ++v) slot[v] = keep.empty() || keep[v] ? kept++ : -1;
+  out.opacity.resize(static_cast<std::uint64_t>(kept) * n);
+  out.color.resize(f.color ? out.opacity.size() : 0);
+  out.normal.resize(f.normal ? out.opacity.size() : 0);
+  ForEachAboveVoxels(
+      tree, source, f,
+      [&](VoxelTile& tile, std::uint64_t i, const Neighbourhood&, const int corner[3]) {
+        const std::uint8_t m = tree.masks[level - tree.first_level][i];
+        std::uint64_t voxel = tree.first_child[level - tree.first_level][i];
+        for (int c = 0; c < 8; ++c) {
+          if (!(m >> c & 1u)) continue;
+          const std::int64_t to_voxel = slot[voxel++];
+          if (to_voxel < 0) continue;
+          // The voxel's corner in half voxels.
+          const int h[3] = {2 * (corner[0] + 2 + (c & 1)), 2 * (corner[1] + 2 + (c >> 1 & 1)),
+                            2 * (corner[2] + 2 + (c >> 2 & 1))};
+          const int step = side == 3 ? 1 : 2;
+          for (unsigned s = 0; s < n; ++s) {
+            const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
+                              static_cast<int>(s / (side * side))};
+            const EncodedSample& e =
+                tile.At(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]).encoded;
+            const std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n + s;
+            out.opacity[to] = e.opacity;
+            if (f.color) out.color[to] = e.color;
+            if (f.normal) out.normal[to] = e.normal;
+          }
+        }
+      });
+}
+
+}  // namespace svokit

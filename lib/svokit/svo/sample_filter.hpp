@@ -1,0 +1,55 @@
+#pragma once
+// The brick filter of bricks.hpp, computed on distinct samples: every stored sample once, in
+// SampleLayout order, with the same arithmetic in the same order, so the bricks assembled from
+// them equal FilterBricks' byte for byte. What the octree build runs (bricks.hpp stays the
+// reference the validator recomputes bricks with).
+//
+// The voxel level's samples are not stored (a .svo keeps each voxel's attributes instead): they
+// are computed around each node of the level above from the voxels in its 6³ neighbourhood, for
+// that level's samples, and for assembled voxel bricks.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "svokit/svo/mask_tree.hpp"
+#include "svokit/svo/sample_layout.hpp"
+#include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+/// One level's distinct samples, in its SampleLayout's order, encoded as SvoLevel's bricks are.
+struct LevelSamples {
+  std::vector<std::uint8_t> opacity;
+  std::vector<std::uint32_t> color;   ///< empty without colour
+  std::vector<std::uint16_t> normal;  ///< empty without normals
+  bool operator==(const LevelSamples&) const = default;
+};
+
+/// What the filter reads of the voxels: their colours (one for all, or one per voxel, in the
+/// order of the tree's last level) and normals, each optional.
+struct VoxelSamplesSource {
+  std::span<const HalfRgba> colors;  ///< empty, one shared colour, or one per voxel
+  std::span<const OctNormal> normals;
+  HalfRgba color(std::size_t i) const { return colors[colors.size() == 1 ? 0 : i]; }
+};
+
+/// Samples of the levels first_level .. last_level() − 1 of `tree`, whose last level holds the
+/// voxels; `layouts[k]` is level first_level + k's layout for bricks of `side`. Colour and normal
+/// planes are filled when `source` has them.
+std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
+                                        std::uint32_t side, const VoxelSamplesSource& source);
+
+/// The bricks of level `level` (< tree.last_level()) assembled from its distinct samples: side³
+/// samples per node, SvoLevel's layout.
+void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
+                    const LevelSamples& samples, SvoLevel& out);
+
+/// The voxel level's bricks (of tree.last_level()), computed from the voxels: side³ samples per
+/// voxel, SvoLevel's layout. With `keep` (one flag per voxel), only the voxels it marks get
+/// bricks, in their order (a page's voxels among its halo's); the others only contribute.
+void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
+                 SvoLevel& out, std::span<const std::uint8_t> keep = {});
+
+}  // namespace svokit

@@ -1,0 +1,116 @@
+#include "svokit/svo/sample_layout.hpp"
+
+namespace svokit {
+
+namespace layout_detail {
+namespace {
+
+constexpr SideTable MakeSideTable(int side) {
+  SideTable t;
+  t.side = static_cast<std::uint32_t>(side);
+  const int top = side - 1;
+  t.home_count = static_cast<std::uint32_t>(top * top * top);
+  int homes = 0, others = 0;
+  for (int s = 0; s < side * side * side; ++s) {
+    const int k[3] = {s % side, s / side % side, s / (side * side)};
+    t.is_home[s] = k[0] < top && k[1] < top && k[2] < top;
+    t.index[s] = static_cast<std::uint8_t>(t.is_home[s] ? homes++ : others++);
+    if (!t.is_home[s]) continue;
+    HomeSample& home = t.home[t.index[s]];
+    for (int f = 1; f < 8; ++f) {
+      const int fa[3] = {f & 1, f >> 1 & 1, f >> 2 & 1};
+      bool holds = true;
+      for (int a = 0; a < 3; ++a) holds = holds && (fa[a] == 0 || k[a] == 0);
+      if (!holds) continue;
+      home.f[home.candidates] = static_cast<std::uint8_t>(f);
+      home.brick_sample[home.candidates] = static_cast<std::uint8_t>(
+          (k[0] + top * fa[0]) + side * ((k[1] + top * fa[1]) + side * (k[2] + top * fa[2])));
+      ++home.candidates;
+    }
+  }
+  return t;
+}
+
+constexpr SideTable kSide2 = MakeSideTable(2), kSide3 = MakeSideTable(3);
+
+}  // namespace
+
+const SideTable& TableFor(std::uint32_t side) {
+  return side == 2 ? kSide2 : kSide3;
+}
+
+}  // namespace layout_detail
+
+namespace {
+
+// Brick sample s of a node: its home's offset e (bit a set where k_a = side − 1) and its home
+// sample k − (side − 1)·e.
+struct HomeOf {
+  unsigned e, home_sample;
+};
+HomeOf HomeOfSample(std::uint32_t side, unsigned s) {
+  const unsigned top = side - 1;
+  unsigned k[3] = {s % side, s / side % side, s / (side * side)};
+  unsigned e = 0;
+  for (unsigned a = 0; a < 3; ++a) {
+    if (k[a] == top) {
+      e |= 1u << a;
+      k[a] = 0;
+    }
+  }
+  return {e, k[0] + side * (k[1] + side * k[2])};
+}
+
+// Slot in a node's neighbourhood of the node at offset e − f from it (e, f ∈ {0,1}³ as bits).
+int SlotOf(unsigned e, unsigned f) {
+  const auto d = [&](unsigned a) {
+    return static_cast<int>(e >> a & 1u) - static_cast<int>(f >> a & 1u);
+  };
+  return NeighbourSlot(d(0), d(1), d(2));
+}
+
+}  // namespace
+
+std::uint32_t OrphanMask(std::uint32_t side, const Neighbourhood& nb) {
+  const layout_detail::SideTable& t = layout_detail::TableFor(side);
+  std::uint32_t mask = 0;
+  for (unsigned s = 0; s < side * side * side; ++s) {
+    if (t.is_home[s]) continue;
+    const HomeOf h = HomeOfSample(side, s);
+    if (nb[SlotOf(h.e, 0)] >= 0) continue;
+    const layout_detail::HomeSample& home = t.home[t.index[h.home_sample]];
+    // The first existing candidate stores it; this node (f = e) is one of them.
+    for (int c = 0; c < home.candidates; ++c) {
+      if (nb[SlotOf(h.e, home.f[c])] < 0) continue;
+      if (home.f[c] == h.e) mask |= 1u << t.index[s];
+      break;
+    }
+  }
+  return mask;
+}
+
+SampleLayout LayOutSamples(const MaskTree& tree, std::uint32_t level, std::uint32_t side) {
+  SampleLayout layout;
+  layout.side = side;
+  const std::uint64_t n = tree.NodeCount(level);
+  layout.orphans.resize(n);
+  ForEachNeighbourhood(tree, level, [&](std::uint64_t i, const Neighbourhood& nb) {
+    layout.orphans[i] = OrphanMask(side, nb);
+  });
+  layout.first.resize(n + 1);
+  const std::uint64_t home = layout_detail::TableFor(side).home_count;
+  std::uint64_t next = 0;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    layout.first[i] = next;
+    next += home + static_cast<unsigned>(std::popcount(layout.orphans[i]));
+  }
+  layout.first[n] = next;
+  return layout;
+}
+
+std::uint64_t SampleIndex(const SampleLayout& layout, const Neighbourhood& nb, unsigned sample) {
+  const HomeOf h = HomeOfSample(layout.side, sample);
+  return PointIndex(layout, h.home_sample, [&](unsigned f) { return nb[SlotOf(h.e, f)]; });
+}
+
+}  // namespace svokit
