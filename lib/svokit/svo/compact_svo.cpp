@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "svokit/svo/contour.hpp"
+#include "svokit/svo/svo_pages.hpp"
 
 namespace svokit {
 
@@ -58,51 +59,29 @@ StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
   return svo;
 }
 
+SvoShape Shape(const CompactSvo& svo) {
+  SvoShape shape;
+  shape.depth = svo.depth;
+  shape.brick_side = svo.brick_side;
+  shape.has_color = svo.has_color;
+  shape.has_normal = svo.has_normal;
+  shape.has_contours = svo.has_contours;
+  if (svo.has_color && svo.colors.size() == 1) shape.shared_color = {svo.colors[0]};
+  return shape;
+}
+
 Svo AssembleSvo(const CompactSvo& in) {
-  Svo svo;
-  svo.grid = in.grid;
-  svo.mode = in.mode;
-  svo.depth = in.depth;
-  svo.brick_side = in.brick_side;
-  svo.has_color = in.has_color;
-  svo.has_normal = in.has_normal;
-  svo.has_contours = in.has_contours;
-  svo.metadata = in.metadata;
-  svo.levels.resize(in.depth + 1);
-  for (std::uint32_t l = 0; l <= in.depth; ++l) {
-    SvoLevel& lv = svo.levels[l];
-    lv.node_count = in.NodeCount(l);
-    for (const std::uint32_t w : in.contours[l]) {
-      if (w != 0) lv.contours.push_back(w);
-    }
-    if (l == in.depth) break;
-    const std::vector<std::uint8_t>& masks = in.tree.masks[l];
-    const std::vector<std::uint32_t>& below = in.contours[l + 1];
-    lv.nodes.resize(masks.size());
-    std::uint32_t child = 0, contour = 0;
-    for (std::size_t i = 0; i < masks.size(); ++i) {
-      SvoNode& n = lv.nodes[i];
-      n.child_mask = masks[i];
-      n.leaf_mask = l + 1 == in.depth ? masks[i] : 0;
-      n.first_child = child;
-      n.first_contour = contour;
-      for (unsigned c = 0; c < 8; ++c) {
-        if (!(masks[i] >> c & 1u)) continue;
-        if (below[child] != 0) {
-          n.contour_mask |= static_cast<std::uint8_t>(1u << c);
-          ++contour;
-        }
-        ++child;
-      }
-    }
-  }
-  if (in.brick_side != 0) {
-    for (std::uint32_t l = 0; l < in.depth; ++l) {
-      AssembleBricks(in.tree, l, in.layouts[l], in.samples[l], svo.levels[l]);
-    }
-    VoxelBricks(in.tree, in.brick_side, in.VoxelSource(), svo.levels[in.depth]);
-  }
-  return svo;
+  // The whole tree as one chunk: its own layouts are the tree's, and it has no halo.
+  SvoChunk whole;
+  whole.tree = in.tree;
+  whole.contours = in.contours;
+  whole.layouts = in.layouts;
+  whole.samples = in.samples;
+  if (in.colors.size() > 1) whole.colors = in.colors;
+  whole.normals = in.normals;
+  SvoAssembler assembler(Shape(in), in.depth);
+  assembler.Append(whole);
+  return assembler.Finish(in.grid, in.mode, in.metadata);
 }
 
 std::string LevelTable(const CompactSvo& svo) {

@@ -57,6 +57,10 @@ StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
 /// Every node's brick and the node records: the Svo the octree stands for.
 Svo AssembleSvo(const CompactSvo& svo);
 
+struct SvoShape;
+/// The depth, bricks and attributes of the octree, as its file's header gives them.
+SvoShape Shape(const CompactSvo& svo);
+
 /// The per-level table the tools print: level, node size, nodes, contours, distinct samples.
 std::string LevelTable(const CompactSvo& svo);
 

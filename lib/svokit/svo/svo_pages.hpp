@@ -1,0 +1,97 @@
+#pragma once
+// An octree cut into pages, as a version-2 .svo stores it (formats/svo/README.md): the top levels
+// 0 .. P − 1 in one chunk, and below the page level P each node's subtree as a page holding its
+// levels P .. depth with indices of its own. A page is self-contained: its samples are laid out
+// over its own nodes (SampleLayout, nodes outside it absent), and it carries the voxels around it
+// (its halo) that its voxel bricks read, so one page decodes into its part of every level.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "svokit/core/default_init.hpp"
+#include "svokit/core/half.hpp"
+#include "svokit/core/octahedral.hpp"
+#include "svokit/svo/compact_svo.hpp"
+#include "svokit/svo/mask_tree.hpp"
+#include "svokit/svo/sample_filter.hpp"
+#include "svokit/svo/sample_layout.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+/// The subtree of one node (a page), or the top levels of the whole tree (the top chunk).
+struct SvoChunk {
+  std::uint32_t root_level = 0;  ///< tree.first_level
+  std::uint64_t root_key = 0;    ///< the root's Morton key at root_level (0 for the top chunk)
+  /// Child masks of the levels root_level .. tree.last_level() − 1. The top chunk's last masks
+  /// (level P − 1) name the pages; a page's reach the voxels.
+  MaskTree tree;
+  /// Per level held (root_level .. root_level + contours.size() − 1), per node: the contour word
+  /// or 0.
+  std::vector<std::vector<std::uint32_t>> contours;
+  /// Per level held above the voxels, with bricks: the chunk's own layout and its samples.
+  std::vector<SampleLayout> layouts;
+  std::vector<LevelSamples> samples;
+  /// A page's voxels' colours (per voxel; empty when shared or absent) and normals.
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
+  /// The voxels outside the page that touch one of its voxels (their voxel bricks read them):
+  /// Morton keys, ascending, and their colours (per voxel, as `colors`) and normals.
+  std::vector<std::uint64_t> halo_keys;
+  DefaultInitVector<HalfRgba> halo_colors;
+  DefaultInitVector<OctNormal> halo_normals;
+
+  std::uint32_t levels_held() const { return static_cast<std::uint32_t>(contours.size()); }
+};
+
+/// Pages of about this many voxels on average: the page level is the shallowest whose mean page
+/// holds at most this many (formats/svo/README.md, "Pages": why).
+inline constexpr std::uint64_t kPageVoxels = std::uint64_t{1} << 15;
+
+/// The page level of an octree: the shallowest level (below depth) whose nodes hold at most
+/// kPageVoxels voxels on average, or 0 for a small octree.
+std::uint32_t PageLevel(const CompactSvo& svo);
+
+/// The top chunk: levels 0 .. page_level − 1 with every level's samples and contours, and the
+/// masks of level page_level − 1, which name the pages. Empty (no levels) when page_level is 0.
+SvoChunk TopChunk(const CompactSvo& svo, std::uint32_t page_level);
+
+/// Page `page` (a node of page_level, whose neighbourhood in the whole tree is `nb` and Morton
+/// key `key`): its levels, samples laid out over its own nodes, contours, voxels and halo.
+SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_t page,
+                   const Neighbourhood& nb, std::uint64_t key);
+
+/// What a file's header says about all chunks: the tree's depth, brick side, attributes, and
+/// the colour every voxel shares if any.
+struct SvoShape {
+  std::uint32_t depth = 0, brick_side = 0;
+  bool has_color = false, has_normal = false, has_contours = false;
+  std::vector<HalfRgba> shared_color;  ///< one entry, or empty
+};
+
+/// Joins chunks into the Svo they are parts of: the top chunk first, then the pages in order
+/// (each level's nodes in ascending Morton order), or one chunk holding the whole tree. Bricks
+/// are assembled chunk by chunk (a page's voxel bricks from its voxels and halo); node records
+/// and contours once all are in.
+class SvoAssembler {
+ public:
+  /// An octree of the levels 0 .. max_level (at most the depth).
+  SvoAssembler(const SvoShape& shape, std::uint32_t max_level);
+  /// Appends the levels `chunk` holds, down to max_level.
+  void Append(const SvoChunk& chunk);
+  Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
+
+ private:
+  SvoShape shape_;
+  std::uint32_t max_level_;
+  std::vector<std::vector<std::uint8_t>> masks_;
+  std::vector<std::vector<std::uint32_t>> words_;
+  std::vector<SvoLevel> levels_;
+};
+
+/// The voxel bricks of a page (or of a whole tree, `halo` empty): side³ samples per voxel of
+/// `chunk` in its order, computed from its voxels and those of its halo.
+void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out);
+
+}  // namespace svokit
