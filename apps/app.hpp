@@ -209,6 +209,22 @@ inline StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem
   return mesh;
 }
 
+/// The octree part of svo-build's and mesh2svo's summary: the levels, then what each kind of array
+/// takes in the file (stored and decoded, per voxel) and the pages.
+inline void PrintOctreeSummary(const CompactSvo& svo, const SvoFileStats& stats) {
+  fmt::print("{}", LevelTable(svo));
+  const double voxels = static_cast<double>(svo.voxel_count());
+  fmt::print("{:<14} {:>12} {:>12} {:>11}\n", "section", "stored B", "raw B", "B/voxel");
+  for (const SvoSectionBytes& s : stats.sections) {
+    fmt::print("{:<14} {:>12} {:>12} {:>11.3f}\n", s.name, s.stored, s.raw,
+               static_cast<double>(s.stored) / voxels);
+  }
+  fmt::print("{:<14} {:>12} {:>12} {:>11.3f}\n", "file", stats.file_bytes, "",
+             static_cast<double>(stats.file_bytes) / voxels);
+  fmt::print("pages       {} below level {} ({} to {} bytes)\n", stats.pages, stats.page_level,
+             stats.smallest_page, stats.largest_page);
+}
+
 /// Prints each of `warnings` as one line on stderr.
 inline void Warn(const std::string& tool, const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);

@@ -2,6 +2,7 @@
 // The options of the chain's stages, declared once: svo-voxelize and mesh2svo share the
 // voxelization options, svo-build and mesh2svo the build options.
 
+#include <charconv>
 #include <map>
 #include <string>
 
@@ -9,6 +10,8 @@
 #include <CLI/CLI.hpp>
 
 #include "svokit/core/grid_transform.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/svo/build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
@@ -115,6 +118,7 @@ struct VoxelizeCli {
 struct BuildCli {
   std::string bricks = "3";
   bool contours = true;
+  std::string compression = "zstd";
 
   void Add(CLI::App& cli) {
     cli.add_option("--bricks", bricks,
@@ -125,6 +129,27 @@ struct BuildCli {
         ->capture_default_str();
     cli.add_flag("--contours,!--no-contours", contours,
                  "ESVO contour slabs fitted to the surface; they need the mesh (default: on)");
+    cli.add_option("--compression", compression,
+                   "How the file's arrays are stored: zstd at its level 3, zstd:LEVEL (1-22), or "
+                   "none")
+        ->option_text("zstd[:LEVEL]|none")
+        ->capture_default_str();
+  }
+
+  /// The compression option, or why it is not one.
+  StatusOr<SvoCompression> Compression() const {
+    if (compression == "none") return SvoCompression{false, 0};
+    if (compression == "zstd") return SvoCompression{};
+    if (compression.starts_with("zstd:")) {
+      const std::string level = compression.substr(5);
+      int value = 0;
+      const auto [end, ec] = std::from_chars(level.data(), level.data() + level.size(), value);
+      if (ec == std::errc() && end == level.data() + level.size() && value >= 1 && value <= 22) {
+        return SvoCompression{true, value};
+      }
+    }
+    return Status::BadInput("--compression '{}': expected zstd, zstd:LEVEL (1 to 22) or none",
+                            compression);
   }
 
   BuildOptions Options() const {
@@ -135,7 +160,8 @@ struct BuildCli {
   }
 
   std::string Recorded() const {
-    return fmt::format("--bricks {} --{}", bricks, contours ? "contours" : "no-contours");
+    return fmt::format("--bricks {} --{} --compression {}", bricks,
+                       contours ? "contours" : "no-contours", compression);
   }
 };
 

@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
+    const StatusOr<SvoCompression> compression = build.Compression();
+    if (!compression.ok()) return app::Fail(tool, compression.status());
     if (Status s = app::CheckOutputPath(output, {"svo"}, input); !s.ok()) return app::Fail(tool, s);
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
@@ -42,17 +44,18 @@ int main(int argc, char** argv) {
 
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    StatusOr<Svo> svo = BuildSvo(*voxels, &*mesh, build.Options(), meta, progress);
+    StatusOr<CompactSvo> svo = BuildCompactSvo(*voxels, &*mesh, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
-    const Status written = app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output); });
-    if (!written.ok()) return app::Fail(tool, written);
+    StatusOr<SvoFileStats> written =
+        app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
+    if (!written.ok()) return app::Fail(tool, written.status());
 
     const auto& d = grid->dims();
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
                grid->voxel_size(), svo->depth);
     fmt::print("voxels      {} ({})\n", voxels->size(), voxelize.ModeName());
-    fmt::print("{}", LevelTable(*svo));
+    app::PrintOctreeSummary(*svo, *written);
     std::string times;
     double total = 0;
     for (const Progress::Timing& t : progress.timings()) {
@@ -60,7 +63,7 @@ int main(int argc, char** argv) {
       total += t.seconds;
     }
     fmt::print("time        {}total {:.2f} s\n", times, total);
-    fmt::print("output      {} ({} bytes)\n", output.string(), std::filesystem::file_size(output));
+    fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
     return 0;
   });
 }

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = app::CheckOutputPath(output, {"svo"}, input); !s.ok()) return app::Fail(tool, s);
+    const StatusOr<SvoCompression> compression = build.Compression();
+    if (!compression.ok()) return app::Fail(tool, compression.status());
     if (build.contours && mesh_path.empty()) {
       return app::Fail(tool, Status::BadInput("{}: contours are fitted to the surface: give the "
                                               "voxelized mesh with --mesh, or --no-contours",
@@ -48,15 +50,17 @@ int main(int argc, char** argv) {
       mesh = std::move(*m);
     }
     const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
-    StatusOr<Svo> svo = BuildSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta, progress);
+    StatusOr<CompactSvo> svo =
+        BuildCompactSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
-    const Status written = app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output); });
-    if (!written.ok()) return app::Fail(tool, written);
+    StatusOr<SvoFileStats> written =
+        app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
+    if (!written.ok()) return app::Fail(tool, written.status());
     fmt::print("input       {} ({} voxels)\n", input.string(), voxels->size());
     fmt::print("octree      depth {}, bricks {}, contours {}\n", svo->depth, build.bricks,
                build.contours ? "on" : "off");
-    fmt::print("{}", LevelTable(*svo));
-    fmt::print("output      {} ({} bytes)\n", output.string(), std::filesystem::file_size(output));
+    app::PrintOctreeSummary(*svo, *written);
+    fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
     return 0;
   });
 }

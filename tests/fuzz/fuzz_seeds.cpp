@@ -24,8 +24,9 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/mesh/mesh.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
+#include "tests/formats/svo_v1_writer.hpp"
 
 namespace fs = std::filesystem;
 
@@ -225,10 +226,12 @@ void ChainFiles() {
     svokit::BuildOptions build;
     build.brick_side = resolution > 4 ? 3 : 0;
     build.contours = resolution > 4;
-    auto svo = svokit::BuildSvo(*voxels, &mesh, build);
+    auto svo = svokit::BuildCompactSvo(*voxels, &mesh, build);
     if (!svo.ok()) continue;
     const auto bytes = svokit::EncodeSvo(*svo);
     Put("svo", fmt::format("tetra-{}.svo", resolution), Bytes(bytes.data(), bytes.size()));
+    const auto v1 = svokit::test::EncodeSvoV1(svokit::AssembleSvo(*svo));
+    Put("svo", fmt::format("tetra-{}-version1.svo", resolution), Bytes(v1.data(), v1.size()));
   }
 }
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "svokit/mesh/mesh.hpp"
-#include "svokit/svo/svo.hpp"
+#include "svokit/svo/compact_svo.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
@@ -34,11 +34,11 @@ std::vector<std::uint8_t> WithChecksumsFixed(std::span<const std::uint8_t> bytes
 
 /// What every mesh a reader accepts must survive: its report, the .svm round trip (the same mesh
 /// and bytes again), an 8³ voxelization with attributes and its octree with bricks and contours,
-/// whose .svo decodes to the same octree.
+/// whose .svo decodes to the octree (CheckOctreeFile).
 void CheckMesh(const Mesh& mesh);
 
-/// An octree a reader accepts encodes to a file that decodes to it again.
-void CheckSvoRoundTrip(const Svo& svo);
+/// An octree's .svo decodes to that octree, and is the same bytes twice.
+void CheckOctreeFile(const CompactSvo& svo);
 
 /// Stops the process where libFuzzer sees a crash, naming the broken promise.
 [[noreturn]] void Fail(const char* what);

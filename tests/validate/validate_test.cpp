@@ -19,9 +19,11 @@
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/build.hpp"
+#include "svokit/svo/compact_svo.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
 #include "svokit/voxelize/voxelize.hpp"
+#include "tests/formats/svo_v1_writer.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit::validate {
@@ -77,6 +79,17 @@ Svo Build(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3, bool
   auto svo = BuildSvo(voxels, &mesh, options);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
+}
+
+// The version-2 file of the voxels' octree, as svo-build writes it.
+std::vector<std::uint8_t> File(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3,
+                               bool contours = true) {
+  BuildOptions options;
+  options.brick_side = side;
+  options.contours = contours;
+  auto svo = BuildCompactSvo(voxels, &mesh, options);
+  EXPECT_TRUE(svo.ok()) << svo.status().message();
+  return svo.ok() ? EncodeSvo(*svo) : std::vector<std::uint8_t>{};
 }
 
 Report ValidateBytes(const std::vector<std::uint8_t>& bytes, const Mesh* mesh) {
@@ -179,15 +192,15 @@ double CentreDistance(const Mesh& mesh, const GridTransform& grid, MortonCoord c
 
 TEST(Validate, ValidFilesPassEveryCheck) {
   const VoxelSet conservative = VoxelsOf(Torus(), 64, VoxelMode::kConservative);
-  ExpectValid(ValidateBytes(EncodeSvo(Build(conservative, Torus())), &Torus()));
-  ExpectValid(ValidateBytes(EncodeSvo(Build(conservative, Torus(), 2, false)), &Torus()), false);
-  ExpectValid(ValidateBytes(EncodeSvo(Build(conservative, Torus(), 0, true)), &Torus()));
+  ExpectValid(ValidateBytes(File(conservative, Torus()), &Torus()));
+  ExpectValid(ValidateBytes(File(conservative, Torus(), 2, false), &Torus()), false);
+  ExpectValid(ValidateBytes(File(conservative, Torus(), 0, true), &Torus()));
   const VoxelSet thin = VoxelsOf(Torus(), 64, VoxelMode::kThin);
-  const Report t = ValidateBytes(EncodeSvo(Build(thin, Torus())), &Torus());
+  const Report t = ValidateBytes(File(thin, Torus()), &Torus());
   ExpectValid(t);
   EXPECT_NE(Check(t, "occupancy").note.find("thin"), std::string::npos);
   // Without the mesh, the mesh checks are skipped, not passed.
-  const Report bare = ValidateBytes(EncodeSvo(Build(conservative, Torus())), nullptr);
+  const Report bare = ValidateBytes(File(conservative, Torus()), nullptr);
   EXPECT_TRUE(bare.ok());
   EXPECT_EQ(Check(bare, "occupancy").state, CheckResult::State::kSkipped);
   EXPECT_EQ(Check(bare, "bricks").state, CheckResult::State::kPassed);
@@ -196,7 +209,7 @@ TEST(Validate, ValidFilesPassEveryCheck) {
 TEST(Validate, OpenMeshPasses) {
   const Mesh patch = OpenPatch();
   for (VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
-    ExpectValid(ValidateBytes(EncodeSvo(Build(VoxelsOf(patch, 100, mode), patch)), &patch));
+    ExpectValid(ValidateBytes(File(VoxelsOf(patch, 100, mode), patch), &patch));
   }
 }
 
@@ -205,14 +218,14 @@ TEST(Validate, RealMeshesPass) {
   SVOKIT_REQUIRE_FILE(armadillo);
   const Mesh mesh = Load(armadillo);
   for (VoxelMode mode : {VoxelMode::kConservative, VoxelMode::kThin}) {
-    const Report r = ValidateBytes(EncodeSvo(Build(VoxelsOf(mesh, 160, mode), mesh)), &mesh);
+    const Report r = ValidateBytes(File(VoxelsOf(mesh, 160, mode), mesh), &mesh);
     ExpectValid(r);
     std::printf("%s", r.Text().c_str());
   }
   const auto wuson = test::AssimpModels() / "OBJ" / "WusonOBJ.obj";
   SVOKIT_REQUIRE_FILE(wuson);
   const Mesh w = Load(wuson);
-  ExpectValid(ValidateBytes(EncodeSvo(Build(VoxelsOf(w, 128, VoxelMode::kConservative), w)), &w));
+  ExpectValid(ValidateBytes(File(VoxelsOf(w, 128, VoxelMode::kConservative), w), &w));
 }
 
 // The OpenVDB distances against brute force over every voxel of a small grid: the voxels the
@@ -237,7 +250,7 @@ TEST(Validate, SandwichAgreesWithBruteForceDistances) {
       }
     }
   }
-  const Report r = ValidateBytes(EncodeSvo(Build(voxels, Torus())), &Torus());
+  const Report r = ValidateBytes(File(voxels, Torus()), &Torus());
   ExpectValid(r);
   const std::uint64_t vdb_required = Stat(Check(r, "occupancy"), "required");
   // Only voxels within the tolerance of exactly h/2 may be counted differently.
@@ -252,7 +265,7 @@ struct Fixture {
   Mesh mesh = Torus();
   VoxelSet voxels = VoxelsOf(mesh, 48, VoxelMode::kConservative);
   Svo svo = Build(voxels, mesh);
-  std::vector<std::uint8_t> bytes = EncodeSvo(svo);
+  std::vector<std::uint8_t> bytes = test::EncodeSvoV1(svo);
 };
 const Fixture& Base() {
   static const Fixture f;
@@ -302,7 +315,7 @@ TEST(ValidateMutation, RemovedLeafIsAMissingVoxel) {
   v.colors.erase(v.colors.begin() + at);
   v.normals.erase(v.normals.begin() + at);
   v.coverage.erase(v.coverage.begin() + at);
-  const Report r = ValidateBytes(EncodeSvo(Build(v, f.mesh)), &f.mesh);
+  const Report r = ValidateBytes(File(v, f.mesh), &f.mesh);
   const CheckResult& occ = Check(r, "occupancy");
   auto kinds = Kinds(r);
   EXPECT_EQ(kinds["occupancy/missing_voxel"], 1u) << Describe(kinds);
@@ -330,7 +343,7 @@ TEST(ValidateMutation, StrayLeafIsAnExtraVoxel) {
   v.colors.insert(v.colors.begin() + at, Rgba{1, 0, 0, 1});
   v.normals.insert(v.normals.begin() + at, Vec3f{0, 0, 1});
   v.coverage.insert(v.coverage.begin() + at, 1.f);
-  const Report r = ValidateBytes(EncodeSvo(Build(v, f.mesh)), &f.mesh);
+  const Report r = ValidateBytes(File(v, f.mesh), &f.mesh);
   const CheckResult& occ = Check(r, "occupancy");
   EXPECT_EQ(Count(occ, "extra_voxel"), 1u) << r.Text();
   EXPECT_EQ(Count(occ, "missing_voxel"), 0u);
@@ -352,7 +365,7 @@ TEST(ValidateMutation, WrongMaskIsAStructureFinding) {
   SvoNode& n = *it;
   const unsigned free = std::countr_one(static_cast<unsigned>(n.child_mask));
   n.child_mask = static_cast<std::uint8_t>(n.child_mask | (1u << free));
-  Report r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  Report r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   const CheckResult& s = Check(r, "structure");
   // The next node's first child no longer follows; the sums then resynchronize (one finding).
   ASSERT_LT(static_cast<std::size_t>(it - nodes.begin()) + 1, nodes.size());
@@ -366,7 +379,7 @@ TEST(ValidateMutation, WrongMaskIsAStructureFinding) {
   // A leaf bit above the voxel level.
   svo = Base().svo;
   svo.levels[1].nodes[0].leaf_mask = svo.levels[1].nodes[0].child_mask;
-  r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   EXPECT_EQ(Count(Check(r, "structure"), "mask"), 1u) << r.Text();
 }
 
@@ -383,7 +396,7 @@ TEST(ValidateMutation, WrongBrickBorderIsABorderFinding) {
   ASSERT_LT(node, keys.size());
   const std::size_t sample = node * 27 + (2 + 3 * (1 + 3 * 1));  // face centre (2, 1, 1)
   svo.levels[leaf].color[sample] ^= 0x00404040u;
-  const Report r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  const Report r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   const CheckResult& b = Check(r, "bricks");
   EXPECT_EQ(Count(b, "brick_border"), 1u) << r.Text();
   const auto border = std::find_if(b.examples.begin(), b.examples.end(),
@@ -404,7 +417,7 @@ TEST(ValidateMutation, WrongParentSampleIsAFilterFinding) {
   const std::size_t sample = 5 * 27 + 13;
   svo.levels[level].opacity[sample] =
       static_cast<std::uint8_t>(svo.levels[level].opacity[sample] ^ 0x40);
-  Report r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  Report r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   const auto kinds = Kinds(r);
   ASSERT_EQ(kinds.size(), 1u) << Describe(kinds);
   EXPECT_GE(kinds.at("bricks/brick_filter"), 1u);
@@ -417,7 +430,7 @@ TEST(ValidateMutation, WrongParentSampleIsAFilterFinding) {
   // A normal code with a zero axis is out of range.
   svo = Base().svo;
   svo.levels[level].normal[sample] = 0x0080;
-  r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   EXPECT_GE(Count(Check(r, "bricks"), "brick_range"), 1u) << r.Text();
 }
 
@@ -444,14 +457,14 @@ TEST(ValidateMutation, ContourCuttingOffGeometryIsASurfaceFinding) {
   c.thickness = 0;
   c.position = static_cast<int>(std::floor(half / 0.75));
   svo.levels[leaf].contours[word] = EncodeContour(c);
-  Report r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  Report r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   const auto kinds = Kinds(r);
   EXPECT_GE(kinds.count("contour_surface/point_outside_slab"), 1u) << Describe(kinds);
   EXPECT_EQ(kinds.size(), 1u) << Describe(kinds);
   // Beyond the cube altogether: the contour's own range check fires too.
   c.position = 63;
   svo.levels[leaf].contours[word] = EncodeContour(c);
-  r = ValidateBytes(EncodeSvo(svo), &Base().mesh);
+  r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   EXPECT_EQ(Count(Check(r, "contours"), "contour_range"), 1u) << r.Text();
 }
 
@@ -461,7 +474,7 @@ TEST(ValidateMutation, ReportDoesNotDependOnTheThreadCount) {
   for (std::size_t i = 0; i < svo.levels[svo.depth].opacity.size(); i += 50 * 27 + 4) {
     svo.levels[svo.depth].opacity[i] ^= 0x80;
   }
-  const auto bytes = EncodeSvo(svo);
+  const auto bytes = test::EncodeSvoV1(svo);
   std::string one, two;
   {
     ThreadLimit limit(1);

@@ -39,4 +39,38 @@ void AppendKeyGaps(std::span<const std::uint64_t> keys, std::uint64_t previous, 
   out.resize(at);
 }
 
+/// Reads a varint at `p` (not past `end`), advancing `p`; false if it runs past `end` or is longer
+/// than a 64-bit value allows.
+inline bool GetVarint(const std::uint8_t*& p, const std::uint8_t* end, std::uint64_t& value) {
+  value = 0;
+  for (int shift = 0;; shift += 7) {
+    // At most 10 bytes; the tenth carries bit 63 only.
+    if (p == end || (shift == 63 && *p > 1)) return false;
+    const std::uint8_t byte = *p++;
+    value |= std::uint64_t{byte & 0x7fu} << shift;
+    if (!(byte & 0x80u)) return true;
+  }
+}
+
+/// Reads `count` keys written by AppendKeyGaps (after `previous`) from `p` on. Returns `count`, or
+/// the index of the first key that could not be read: the bytes end inside it or hold a malformed
+/// varint (`*not_increasing` false), or it is not larger than the one before (true: a gap of 2^63
+/// or more, a smaller key after a larger one, wrapped).
+template <class Keys>
+std::size_t ReadKeyGaps(const std::uint8_t*& p, const std::uint8_t* end, std::size_t count,
+                        std::uint64_t previous, Keys& keys, bool* not_increasing) {
+  keys.resize(count);
+  *not_increasing = false;
+  for (std::size_t i = 0; i < count; ++i) {
+    std::uint64_t gap = 0;
+    if (!GetVarint(p, end, gap)) return i;
+    if (gap >> 63) {
+      *not_increasing = true;
+      return i;
+    }
+    keys[i] = previous = previous + 1 + gap;
+  }
+  return count;
+}
+
 }  // namespace svokit

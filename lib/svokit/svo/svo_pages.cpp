@@ -35,8 +35,9 @@ void AppendTo(std::vector<T, A>& to, const std::vector<T, A>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
-// The absolute Morton keys of the last level of a chunk's tree.
-std::vector<std::uint64_t> LastLevelKeys(const SvoChunk& chunk) {
+}  // namespace
+
+std::vector<std::uint64_t> ChunkVoxelKeys(const SvoChunk& chunk) {
   std::vector<std::uint64_t> keys = {chunk.root_key};
   for (const std::vector<std::uint8_t>& masks : chunk.tree.masks) {
     std::vector<std::uint64_t> next;
@@ -49,8 +50,6 @@ std::vector<std::uint64_t> LastLevelKeys(const SvoChunk& chunk) {
   }
   return keys;
 }
-
-}  // namespace
 
 std::uint32_t PageLevel(const CompactSvo& svo) {
   for (std::uint32_t level = 0; level + 1 < svo.depth; ++level) {
@@ -216,7 +215,7 @@ void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& ou
     return;
   }
   // The page's voxels and its halo as one voxel set, the page's voxels kept.
-  const std::vector<std::uint64_t> own = LastLevelKeys(chunk);
+  const std::vector<std::uint64_t> own = ChunkVoxelKeys(chunk);
   std::vector<std::uint64_t> keys;
   std::vector<std::uint8_t> keep;
   DefaultInitVector<HalfRgba> colors;

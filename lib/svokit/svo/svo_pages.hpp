@@ -90,6 +90,9 @@ class SvoAssembler {
   std::vector<SvoLevel> levels_;
 };
 
+/// The Morton keys of the last level of a chunk's tree (a page's voxels), ascending.
+std::vector<std::uint64_t> ChunkVoxelKeys(const SvoChunk& chunk);
+
 /// The voxel bricks of a page (or of a whole tree, `halo` empty): side³ samples per voxel of
 /// `chunk` in its order, computed from its voxels and those of its halo.
 void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out);

@@ -1,6 +1,8 @@
 #pragma once
-// .svo — the sparse voxel octree file svo-build and mesh2svo write: an Svo in the shared
-// container, levels breadth-first so a reader can stop after the top k. Layout: README.md here.
+// .svo — the sparse voxel octree file svo-build and mesh2svo write, in the shared container.
+// Version 2 (what is written): the top levels in one chunk and each subtree below the page level
+// a page, compressed; version 1 (still read): levels breadth-first with every node's brick.
+// Layout: README.md here. A renderer that streams pages uses svo_reader.hpp.
 
 #include <cstdint>
 #include <filesystem>
@@ -12,12 +14,14 @@
 
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/svo/svo_chunk.hpp"
+#include "svokit/svo/compact_svo.hpp"
 #include "svokit/svo/svo.hpp"
 
 namespace svokit {
 
 inline constexpr container::FormatId kSvoFormat{
-    {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 1, "svokit sparse voxel octree (.svo)"};
+    {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 2, "svokit sparse voxel octree (.svo)"};
 
 /// Provenance stored with the octree (the `META` section): what svo-voxelize + svo-build and
 /// mesh2svo record alike, so both routes write the same file.
@@ -29,8 +33,27 @@ struct SvoMetadata {
 /// The `META` section's JSON text (Svo::metadata; BuildSvo's `metadata`).
 std::string SvoMetadataJson(const SvoMetadata& meta);
 
-std::vector<std::uint8_t> EncodeSvo(const Svo& svo);
-Status WriteSvo(const Svo& svo, const std::filesystem::path& path);
+/// Stored and raw (decoded) bytes of one kind of array, over all chunks: "masks", "contours",
+/// "opacity", "colours", "normals", "voxel colours", "voxel normals", "halo", or "frame" (header,
+/// tables, grid, metadata).
+struct SvoSectionBytes {
+  std::string name;
+  std::uint64_t stored = 0, raw = 0;
+};
+/// What writing a version-2 file made.
+struct SvoFileStats {
+  std::uint64_t file_bytes = 0;
+  std::uint32_t page_level = 0;
+  std::uint64_t pages = 0;
+  std::uint64_t smallest_page = 0, largest_page = 0;  ///< stored bytes
+  std::vector<SvoSectionBytes> sections;
+};
+
+/// The version-2 file of `svo`, and what it holds.
+std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression = {},
+                                    SvoFileStats* stats = nullptr);
+StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
+                                const SvoCompression& compression = {});
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);

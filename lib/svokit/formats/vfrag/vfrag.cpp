@@ -69,28 +69,17 @@ Status DecodeKeys(std::span<const std::uint8_t> bytes, const std::string& name,
   if (count > size - sizeof(count)) {  // every key takes at least one byte
     return Status::BadInput("{}: KEYS section claims {} keys in {} bytes", name, count, size);
   }
-  keys.resize(count);
   const std::uint8_t* p = bytes.data() + sizeof(count);
   const std::uint8_t* end = bytes.data() + size;
-  std::uint64_t prev = ~std::uint64_t{0};  // the first gap is the first key
-  for (std::uint64_t i = 0; i < count; ++i) {
-    std::uint64_t gap = 0;
-    for (int shift = 0;; shift += 7) {
-      // At most 10 bytes; the tenth carries bit 63 only.
-      if (p == end || (shift == 63 && *p > 1)) {
-        return Status::BadInput("{}: KEYS section ends inside or holds a malformed key {}", name,
-                                i);
-      }
-      const std::uint8_t byte = *p++;
-      gap |= std::uint64_t{byte & 0x7fu} << shift;
-      if (!(byte & 0x80u)) break;
-    }
-    // A writer given a smaller key after a larger one wraps the gap to 2^63 or more. Keys with
-    // bit 63 set are refused by the grid check, so the sum cannot wrap unnoticed.
-    if (gap >> 63) {
+  // A writer given a smaller key after a larger one wraps the gap to 2^63 or more. Keys with bit
+  // 63 set are refused by the grid check, so the sum cannot wrap unnoticed.
+  bool not_increasing = false;
+  if (const std::size_t i = ReadKeyGaps(p, end, count, kNoPreviousKey, keys, &not_increasing);
+      i != count) {
+    if (not_increasing) {
       return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
     }
-    keys[i] = prev = prev + 1 + gap;
+    return Status::BadInput("{}: KEYS section ends inside or holds a malformed key {}", name, i);
   }
   if (p != end) return Status::BadInput("{}: KEYS section has {} trailing bytes", name, end - p);
   return Status::Ok();

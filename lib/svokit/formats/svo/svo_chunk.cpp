@@ -1,0 +1,559 @@
+#include "svokit/formats/svo/svo_chunk.hpp"
+
+#include <zstd.h>
+
+#include <bit>
+#include <cstring>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "svokit/core/key_gaps.hpp"
+#include "svokit/core/morton.hpp"
+
+namespace svokit {
+
+namespace {
+
+// Stream kinds, in the order a chunk stores them (README.md, "Chunks").
+enum Stream : std::uint8_t {
+  kMasks = 1,
+  kContourBits,
+  kContourThickness,
+  kContourPosition,
+  kContourNormals,
+  kOpacity,
+  kColors,
+  kNormals,
+  kVoxelColors,
+  kVoxelNormals,
+  kHaloKeys,
+  kHaloColors,
+  kHaloNormals,
+  kStreamKinds
+};
+constexpr std::uint8_t kStored = 0, kZstd = 1;
+
+using Bytes = std::vector<std::uint8_t>;
+
+// Byte plane b of each value, one plane after the other (plane 0: every low byte).
+template <class T>
+Bytes Planes(std::span<const T> values) {
+  Bytes out(values.size() * sizeof(T));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, &values[i], sizeof(T));
+    for (std::size_t k = 0; k < sizeof(T); ++k) out[k * values.size() + i] = b[k];
+  }
+  return out;
+}
+template <class T>
+void FromPlanes(std::span<const std::uint8_t> bytes, std::span<T> values) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint8_t b[sizeof(T)];
+    for (std::size_t k = 0; k < sizeof(T); ++k) b[k] = bytes[k * values.size() + i];
+    std::memcpy(&values[i], b, sizeof(T));
+  }
+}
+
+// Values of 16-bit lanes (a HalfRgba's 4, an OctNormal's 2), each lane the difference to the
+// previous value's (mod 2^16), then in byte planes: neighbouring voxels have similar colours and
+// normals, so the planes are mostly small numbers.
+template <class T>
+Bytes DeltaLanes(std::span<const T> values) {
+  constexpr std::size_t kLanes = sizeof(T) / 2;
+  std::vector<std::uint16_t> deltas(values.size() * kLanes);
+  std::uint16_t previous[kLanes] = {};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint16_t lanes[kLanes];
+    std::memcpy(lanes, &values[i], sizeof(T));
+    for (std::size_t k = 0; k < kLanes; ++k) {
+      deltas[k * values.size() + i] = static_cast<std::uint16_t>(lanes[k] - previous[k]);
+      previous[k] = lanes[k];
+    }
+  }
+  return Planes(std::span<const std::uint16_t>(deltas));
+}
+template <class T, class A>
+void FromDeltaLanes(std::span<const std::uint8_t> bytes, std::vector<T, A>& values) {
+  constexpr std::size_t kLanes = sizeof(T) / 2;
+  std::vector<std::uint16_t> deltas(values.size() * kLanes);
+  FromPlanes(bytes, std::span<std::uint16_t>(deltas));
+  std::uint16_t previous[kLanes] = {};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint16_t lanes[kLanes];
+    for (std::size_t k = 0; k < kLanes; ++k) {
+      previous[k] = lanes[k] =
+          static_cast<std::uint16_t>(previous[k] + deltas[k * values.size() + i]);
+    }
+    std::memcpy(&values[i], lanes, sizeof(T));
+  }
+}
+
+// Brick sample normals (two 8-bit octahedral codes) of the non-empty samples: per code, the
+// difference to the previous sample's, in two planes.
+Bytes DeltaCodes(std::span<const std::uint16_t> normals) {
+  Bytes out(normals.size() * 2);
+  std::uint16_t previous = 0;
+  for (std::size_t i = 0; i < normals.size(); ++i) {
+    out[i] = static_cast<std::uint8_t>((normals[i] & 0xff) - (previous & 0xff));
+    out[normals.size() + i] = static_cast<std::uint8_t>((normals[i] >> 8) - (previous >> 8));
+    previous = normals[i];
+  }
+  return out;
+}
+
+struct Contours {
+  Bytes bits, thickness, position, normals;
+};
+
+// Contour words: presence bits per level (a byte-padded bitset of the level's nodes), then the
+// words' fields apart: 7-bit thickness and position, and the three 6-bit normal components as
+// differences to the previous contour's (mod 64), component after component.
+Contours SplitContours(const SvoChunk& chunk) {
+  Contours c;
+  std::vector<std::uint32_t> words;
+  for (const std::vector<std::uint32_t>& level : chunk.contours) {
+    const std::size_t start = c.bits.size();
+    c.bits.resize(start + (level.size() + 7) / 8, 0);
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      if (level[i] == 0) continue;
+      c.bits[start + i / 8] |= static_cast<std::uint8_t>(1u << (i % 8));
+      words.push_back(level[i]);
+    }
+  }
+  c.normals.resize(3 * words.size());
+  std::uint32_t previous = 0;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    const std::uint32_t w = words[i];
+    c.thickness.push_back(static_cast<std::uint8_t>(w >> 25));
+    c.position.push_back(static_cast<std::uint8_t>(w >> 18 & 127));
+    for (int k = 0; k < 3; ++k) {
+      const int shift = 12 - 6 * k;
+      c.normals[k * words.size() + i] =
+          static_cast<std::uint8_t>(((w >> shift) - (previous >> shift)) & 63);
+    }
+    previous = w;
+  }
+  return c;
+}
+
+struct Compressor {
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  ~Compressor() { ZSTD_freeCCtx(cctx); }
+};
+
+// What each stream kind counts as in a file's summary.
+std::string SectionOf(Stream kind) {
+  switch (kind) {
+    case kMasks:
+      return "masks";
+    case kContourBits:
+    case kContourThickness:
+    case kContourPosition:
+    case kContourNormals:
+      return "contours";
+    case kOpacity:
+      return "opacity";
+    case kColors:
+      return "colours";
+    case kNormals:
+      return "normals";
+    case kVoxelColors:
+      return "voxel colours";
+    case kVoxelNormals:
+      return "voxel normals";
+    default:
+      return "halo";
+  }
+}
+
+// Appends one stream: its directory entry to `directory`, its stored bytes to `data`.
+void AddStream(Stream kind, const Bytes& raw, const SvoCompression& compression, Bytes& directory,
+               Bytes& data, ChunkBytes* bytes) {
+  if (raw.empty()) return;
+  Bytes stored;
+  std::uint8_t codec = kStored;
+  if (compression.zstd) {
+    static thread_local Compressor compressor;
+    stored.resize(ZSTD_compressBound(raw.size()));
+    const std::size_t n = ZSTD_compressCCtx(compressor.cctx, stored.data(), stored.size(),
+                                            raw.data(), raw.size(), compression.level);
+    // A stream zstd does not shrink (short ones, mostly) is kept as it is.
+    if (!ZSTD_isError(n) && n < raw.size()) {
+      stored.resize(n);
+      codec = kZstd;
+    }
+  }
+  if (codec == kStored) stored = raw;
+  std::uint8_t varint[kMaxVarintBytes];
+  directory.push_back(kind);
+  directory.push_back(codec);
+  directory.insert(directory.end(), varint, varint + PutVarint(raw.size(), varint));
+  directory.insert(directory.end(), varint, varint + PutVarint(stored.size(), varint));
+  data.insert(data.end(), stored.begin(), stored.end());
+  if (bytes != nullptr) bytes->Add(SectionOf(kind), raw.size(), stored.size());
+}
+
+// The bytes of the stored samples of every level, with their colours and normals for the
+// non-empty ones only (an empty sample has neither).
+struct SampleStreams {
+  Bytes opacity, colors, normals;
+};
+SampleStreams SplitSamples(const SvoChunk& chunk) {
+  SampleStreams s;
+  std::vector<std::uint32_t> colors;
+  std::vector<std::uint16_t> normals;
+  for (const LevelSamples& level : chunk.samples) {
+    s.opacity.insert(s.opacity.end(), level.opacity.begin(), level.opacity.end());
+    for (std::size_t i = 0; i < level.opacity.size(); ++i) {
+      if (level.opacity[i] == 0) continue;
+      if (!level.color.empty()) colors.push_back(level.color[i]);
+      if (!level.normal.empty()) normals.push_back(level.normal[i]);
+    }
+  }
+  s.colors = Planes(std::span<const std::uint32_t>(colors));
+  s.normals = DeltaCodes(normals);
+  return s;
+}
+
+}  // namespace
+
+void ChunkBytes::Add(const std::string& name, std::uint64_t raw, std::uint64_t stored) {
+  for (auto& [n, v] : by_name) {
+    if (n == name) {
+      v.first += raw;
+      v.second += stored;
+      return;
+    }
+  }
+  by_name.push_back({name, {raw, stored}});
+}
+
+void ChunkBytes::Add(const ChunkBytes& other) {
+  for (const auto& [name, v] : other.by_name) Add(name, v.first, v.second);
+}
+
+std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& shape,
+                                      const SvoCompression& compression, ChunkBytes* bytes) {
+  Bytes masks;
+  for (const std::vector<std::uint8_t>& level : chunk.tree.masks) {
+    masks.insert(masks.end(), level.begin(), level.end());
+  }
+  const Contours contours = SplitContours(chunk);
+  const SampleStreams samples = SplitSamples(chunk);
+  // Halo keys: their count, then AppendKeyGaps' gaps.
+  Bytes halo_keys;
+  if (!chunk.halo_keys.empty()) {
+    std::uint8_t varint[kMaxVarintBytes];
+    std::uint64_t previous = kNoPreviousKey;
+    halo_keys.insert(halo_keys.end(), varint, varint + PutVarint(chunk.halo_keys.size(), varint));
+    for (const std::uint64_t key : chunk.halo_keys) {
+      halo_keys.insert(halo_keys.end(), varint, varint + PutVarint(key - previous - 1, varint));
+      previous = key;
+    }
+  }
+  const std::pair<Stream, Bytes> streams[] = {
+      {kMasks, masks},
+      {kContourBits, shape.has_contours ? contours.bits : Bytes{}},
+      {kContourThickness, contours.thickness},
+      {kContourPosition, contours.position},
+      {kContourNormals, contours.normals},
+      {kOpacity, samples.opacity},
+      {kColors, samples.colors},
+      {kNormals, samples.normals},
+      {kVoxelColors, DeltaLanes(std::span<const HalfRgba>(chunk.colors))},
+      {kVoxelNormals, DeltaLanes(std::span<const OctNormal>(chunk.normals))},
+      {kHaloKeys, halo_keys},
+      {kHaloColors, DeltaLanes(std::span<const HalfRgba>(chunk.halo_colors))},
+      {kHaloNormals, DeltaLanes(std::span<const OctNormal>(chunk.halo_normals))},
+  };
+  Bytes directory = {0}, data;
+  for (const auto& [kind, raw] : streams) {
+    const std::size_t before = directory.size();
+    AddStream(kind, raw, compression, directory, data, bytes);
+    if (directory.size() != before) ++directory[0];
+  }
+  directory.insert(directory.end(), data.begin(), data.end());
+  return directory;
+}
+
+namespace {
+
+// A chunk's streams, decompressed, by kind (empty where absent).
+class StreamSet {
+ public:
+  static StatusOr<StreamSet> Read(std::span<const std::uint8_t> bytes, const std::string& name) {
+    StreamSet set;
+    const std::uint8_t* p = bytes.data();
+    const std::uint8_t* end = p + bytes.size();
+    if (p == end) return Status::BadInput("{}: empty chunk", name);
+    const unsigned count = *p++;
+    struct Entry {
+      std::uint8_t kind, codec;
+      std::uint64_t raw, stored;
+    };
+    std::vector<Entry> entries;
+    std::uint8_t last_kind = 0;
+    for (unsigned i = 0; i < count; ++i) {
+      Entry e{};
+      if (end - p < 2) return Status::BadInput("{}: stream directory runs past the chunk", name);
+      e.kind = *p++;
+      e.codec = *p++;
+      if (!GetVarint(p, end, e.raw) || !GetVarint(p, end, e.stored)) {
+        return Status::BadInput("{}: stream directory runs past the chunk", name);
+      }
+      if (e.kind <= last_kind || e.kind >= kStreamKinds) {
+        return Status::BadInput("{}: stream {} is unknown or out of order", name, e.kind);
+      }
+      if (e.codec > kZstd || (e.codec == kStored && e.raw != e.stored)) {
+        return Status::BadInput("{}: stream {} has an unknown codec or inconsistent sizes", name,
+                                e.kind);
+      }
+      last_kind = e.kind;
+      entries.push_back(e);
+    }
+    for (const Entry& e : entries) {
+      if (e.stored > static_cast<std::uint64_t>(end - p)) {
+        return Status::BadInput("{}: stream {} runs past the chunk", name, e.kind);
+      }
+      Bytes& out = set.streams_[e.kind];
+      // A stream decodes to at most 1 GiB per chunk (pages are a few hundred kilobytes): a size
+      // read from a damaged directory must not allocate without bound.
+      if (e.raw > (std::uint64_t{1} << 30)) {
+        return Status::BadInput("{}: stream {} claims {} bytes", name, e.kind, e.raw);
+      }
+      if (e.codec == kStored) {
+        out.assign(p, p + e.stored);
+      } else {
+        if (ZSTD_getFrameContentSize(p, e.stored) != e.raw) {
+          return Status::BadInput("{}: stream {} does not decompress to its stated size", name,
+                                  e.kind);
+        }
+        out.resize(e.raw);
+        const std::size_t n = ZSTD_decompress(out.data(), out.size(), p, e.stored);
+        if (ZSTD_isError(n) || n != e.raw) {
+          return Status::BadInput("{}: stream {} is damaged (zstd: {})", name, e.kind,
+                                  ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short");
+        }
+      }
+      p += e.stored;
+    }
+    if (p != end) return Status::BadInput("{}: {} bytes after the last stream", name, end - p);
+    return set;
+  }
+  const Bytes& operator[](Stream kind) const { return streams_[kind]; }
+
+ private:
+  Bytes streams_[kStreamKinds];
+};
+
+std::string_view StreamName(Stream kind) {
+  static constexpr std::string_view kNames[] = {"",
+                                                "masks",
+                                                "contour bits",
+                                                "contour thickness",
+                                                "contour position",
+                                                "contour normals",
+                                                "opacity",
+                                                "colours",
+                                                "normals",
+                                                "voxel colours",
+                                                "voxel normals",
+                                                "halo keys",
+                                                "halo colours",
+                                                "halo normals"};
+  return kNames[kind];
+}
+
+Status ExpectSize(const StreamSet& set, Stream kind, std::uint64_t size, const std::string& name) {
+  if (set[kind].size() != size) {
+    return Status::BadInput("{}: {} stream holds {} bytes, expected {}", name, StreamName(kind),
+                            set[kind].size(), size);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
+                               const ChunkFrame& frame, const std::string& name) {
+  StatusOr<StreamSet> read = StreamSet::Read(bytes, name);
+  if (!read.ok()) return read.status();
+  const StreamSet& set = *read;
+  SvoChunk chunk;
+  chunk.root_level = frame.root_level;
+  chunk.root_key = frame.root_key;
+  chunk.tree.first_level = frame.root_level;
+
+  // Masks, level by level: each level's node count is the popcount of the one above.
+  const std::uint32_t mask_levels = frame.page ? shape.depth - frame.root_level : frame.levels;
+  const Bytes& masks = set[kMasks];
+  std::uint64_t at = 0, nodes = 1;
+  std::vector<std::uint64_t> counts = {1};
+  for (std::uint32_t k = 0; k < mask_levels; ++k) {
+    if (nodes > masks.size() - at) {
+      return Status::BadInput("{}: masks stream ends inside level {}", name, frame.root_level + k);
+    }
+    std::vector<std::uint8_t>& level =
+        chunk.tree.masks.emplace_back(masks.begin() + static_cast<std::ptrdiff_t>(at),
+                                      masks.begin() + static_cast<std::ptrdiff_t>(at + nodes));
+    at += nodes;
+    std::uint64_t next = 0;
+    for (const std::uint8_t m : level) {
+      if (m == 0) {
+        return Status::BadInput("{}: a node of level {} has no children", name,
+                                frame.root_level + k);
+      }
+      next += static_cast<unsigned>(std::popcount(m));
+    }
+    nodes = next;
+    counts.push_back(nodes);
+  }
+  if (at != masks.size()) {
+    return Status::BadInput("{}: masks stream has {} bytes more than its levels", name,
+                            masks.size() - at);
+  }
+  chunk.tree.LinkChildren();
+
+  // Contours.
+  std::uint64_t contour_count = 0, bit_bytes = 0;
+  for (std::uint32_t k = 0; k < frame.levels; ++k) bit_bytes += (counts[k] + 7) / 8;
+  if (shape.has_contours) SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourBits, bit_bytes, name));
+  const Bytes& bits = set[kContourBits];
+  for (const std::uint8_t b : bits) contour_count += static_cast<unsigned>(std::popcount(b));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourThickness, contour_count, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourPosition, contour_count, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourNormals, 3 * contour_count, name));
+  std::uint64_t bit = 0, word = 0;
+  std::uint32_t previous = 0;
+  for (std::uint32_t k = 0; k < frame.levels; ++k) {
+    std::vector<std::uint32_t>& level = chunk.contours.emplace_back(counts[k], 0u);
+    for (std::uint64_t i = 0; i < counts[k]; ++i) {
+      if (!shape.has_contours || !(bits[bit / 8 + i / 8] >> (i % 8) & 1u)) continue;
+      const std::uint8_t t = set[kContourThickness][word], pos = set[kContourPosition][word];
+      if (t > 127 || pos > 127) {
+        return Status::BadInput("{}: contour {} has a field out of range", name, word);
+      }
+      std::uint32_t w = std::uint32_t{t} << 25 | std::uint32_t{pos} << 18;
+      for (int c = 0; c < 3; ++c) {
+        const int shift = 12 - 6 * c;
+        const std::uint8_t d = set[kContourNormals][c * contour_count + word];
+        if (d > 63) return Status::BadInput("{}: contour {} has a field out of range", name, word);
+        w |= (((previous >> shift) + d) & 63u) << shift;
+      }
+      if ((w & 0x3ffffu) == 0) {
+        return Status::BadInput("{}: contour {} has a zero normal", name, word);
+      }
+      level[i] = previous = w;
+      ++word;
+    }
+    // Bits past the last node of a level are zero.
+    if (shape.has_contours && counts[k] % 8 != 0 &&
+        bits[bit / 8 + counts[k] / 8] >> (counts[k] % 8) != 0) {
+      return Status::BadInput("{}: contour bits past the nodes of level {}", name,
+                              frame.root_level + k);
+    }
+    bit += (counts[k] + 7) / 8 * 8;
+  }
+
+  // Samples, laid out over the chunk's own nodes.
+  const std::uint32_t sample_levels =
+      shape.brick_side == 0 ? 0 : std::min(frame.levels, shape.depth - frame.root_level);
+  std::uint64_t samples = 0;
+  for (std::uint32_t k = 0; k < sample_levels; ++k) {
+    chunk.layouts.push_back(LayOutSamples(chunk.tree, frame.root_level + k, shape.brick_side));
+    samples += chunk.layouts.back().size();
+  }
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kOpacity, samples, name));
+  std::uint64_t filled = 0;
+  for (const std::uint8_t o : set[kOpacity]) filled += o != 0;
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kColors, shape.has_color ? 4 * filled : 0, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kNormals, shape.has_normal ? 2 * filled : 0, name));
+  std::uint64_t sample = 0, nonempty = 0;
+  std::uint16_t previous_normal = 0;
+  for (std::uint32_t k = 0; k < sample_levels; ++k) {
+    LevelSamples& s = chunk.samples.emplace_back();
+    const std::uint64_t n = chunk.layouts[k].size();
+    s.opacity.assign(set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample),
+                     set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample + n));
+    s.color.assign(shape.has_color ? n : 0, 0);
+    s.normal.assign(shape.has_normal ? n : 0, 0);
+    for (std::uint64_t i = 0; i < n; ++i) {
+      if (s.opacity[i] == 0) continue;
+      if (shape.has_color) {
+        std::uint8_t b[4];
+        for (int c = 0; c < 4; ++c) b[c] = set[kColors][c * filled + nonempty];
+        std::memcpy(&s.color[i], b, 4);
+      }
+      if (shape.has_normal) {
+        const std::uint8_t lo =
+            static_cast<std::uint8_t>((previous_normal & 0xff) + set[kNormals][nonempty]);
+        const std::uint8_t hi =
+            static_cast<std::uint8_t>((previous_normal >> 8) + set[kNormals][filled + nonempty]);
+        s.normal[i] = previous_normal = static_cast<std::uint16_t>(lo | hi << 8);
+      }
+      ++nonempty;
+    }
+    sample += n;
+  }
+
+  // A page's voxels and halo.
+  const std::uint64_t voxels = frame.page ? counts.back() : 0;
+  const bool per_voxel_colors = shape.has_color && shape.shared_color.empty();
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kVoxelColors, per_voxel_colors ? 8 * voxels : 0, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kVoxelNormals, shape.has_normal ? 4 * voxels : 0, name));
+  if (per_voxel_colors) {
+    chunk.colors.resize(voxels);
+    FromDeltaLanes(set[kVoxelColors], chunk.colors);
+  }
+  if (shape.has_normal) {
+    chunk.normals.resize(voxels);
+    FromDeltaLanes(set[kVoxelNormals], chunk.normals);
+  }
+  const Bytes& halo = set[kHaloKeys];
+  if (!halo.empty()) {
+    if (!frame.page) return Status::BadInput("{}: the top chunk has a halo", name);
+    const std::uint8_t* p = halo.data();
+    const std::uint8_t* end = p + halo.size();
+    std::uint64_t count = 0;
+    bool not_increasing = false;
+    if (!GetVarint(p, end, count) || count > halo.size() ||
+        ReadKeyGaps(p, end, count, kNoPreviousKey, chunk.halo_keys, &not_increasing) != count ||
+        p != end) {
+      return Status::BadInput("{}: halo keys are malformed or not increasing", name);
+    }
+    // Each halo voxel lies outside the page, within one voxel of its cube.
+    const std::uint32_t shift = shape.depth - frame.root_level;
+    const MortonCoord root = MortonDecode(frame.root_key);
+    const std::int64_t size = std::int64_t{1} << shift;
+    for (const std::uint64_t key : chunk.halo_keys) {
+      const MortonCoord c = MortonDecode(key);
+      const std::int64_t v[3] = {c.x, c.y, c.z}, r[3] = {root.x, root.y, root.z};
+      bool inside = true, near = true;
+      for (int a = 0; a < 3; ++a) {
+        const std::int64_t lo = r[a] * size, hi = lo + size;
+        inside = inside && v[a] >= lo && v[a] < hi;
+        near = near && v[a] >= lo - 1 && v[a] <= hi;
+      }
+      if (inside || !near || key >> (3 * shape.depth) != 0) {
+        return Status::BadInput("{}: halo voxel {} is not next to the page", name, key);
+      }
+    }
+  }
+  const std::uint64_t halo_count = chunk.halo_keys.size();
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kHaloColors, per_voxel_colors ? 8 * halo_count : 0, name));
+  SVOKIT_RETURN_IF_ERROR(
+      ExpectSize(set, kHaloNormals, shape.has_normal ? 4 * halo_count : 0, name));
+  if (per_voxel_colors) {
+    chunk.halo_colors.resize(halo_count);
+    FromDeltaLanes(set[kHaloColors], chunk.halo_colors);
+  }
+  if (shape.has_normal) {
+    chunk.halo_normals.resize(halo_count);
+    FromDeltaLanes(set[kHaloNormals], chunk.halo_normals);
+  }
+  return chunk;
+}
+
+}  // namespace svokit

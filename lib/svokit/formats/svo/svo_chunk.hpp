@@ -1,0 +1,50 @@
+#pragma once
+// The bytes of a version-2 .svo chunk (its top chunk or one page; README.md here, "Chunks"): a
+// directory of streams, each array of the chunk after a transform that suits it (byte planes,
+// deltas), compressed with zstd or stored.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+#include "svokit/svo/svo_pages.hpp"
+
+namespace svokit {
+
+/// How chunk streams are stored: zstd at `level`, or as they are.
+struct SvoCompression {
+  bool zstd = true;
+  int level = 3;  ///< 1 .. 22 (zstd's levels)
+  bool operator==(const SvoCompression&) const = default;
+};
+
+/// Raw and stored bytes of a chunk's arrays, by name (SvoSectionBytes' names), added up.
+struct ChunkBytes {
+  std::vector<std::pair<std::string, std::pair<std::uint64_t, std::uint64_t>>> by_name;
+  void Add(const std::string& name, std::uint64_t raw, std::uint64_t stored);
+  void Add(const ChunkBytes& other);
+};
+
+/// The chunk's bytes; what each array took is added to `bytes` when given.
+std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& shape,
+                                      const SvoCompression& compression,
+                                      ChunkBytes* bytes = nullptr);
+
+/// What a decoder knows of a chunk before reading it: where its root is and which levels it holds
+/// (top chunk: root 0, levels 0 .. P − 1, masks down to P − 1; page: root at P, levels P ..
+/// depth, masks down to depth − 1).
+struct ChunkFrame {
+  std::uint32_t root_level = 0;
+  std::uint64_t root_key = 0;
+  std::uint32_t levels = 0;  ///< levels held: root_level .. root_level + levels − 1
+  bool page = false;         ///< holds the voxel level, its voxels' attributes and halo
+};
+
+/// Decodes and checks a chunk (sizes, counts, masks, contour words, halo keys): an error names
+/// `name` (e.g. "a.svo: page 12") and what is wrong.
+StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
+                               const ChunkFrame& frame, const std::string& name);
+
+}  // namespace svokit

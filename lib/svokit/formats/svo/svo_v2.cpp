@@ -1,0 +1,418 @@
+// Version 2 of .svo (README.md): GRID, HEAD, the top chunk (TOPL), the pages back to back (PAGE),
+// the page table (PTAB) and META. Pages are encoded in parallel and written in order.
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <memory>
+
+#include <tbb/parallel_for.h>
+
+#include "svokit/core/bytes.hpp"
+#include "svokit/core/crc32c.hpp"
+#include "svokit/core/morton.hpp"
+#include "svokit/formats/container/grid_section.hpp"
+#include "svokit/formats/svo/svo_detail.hpp"
+
+namespace svokit {
+
+namespace svo_detail {
+
+std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
+  std::vector<std::uint64_t> keys = {0};
+  for (std::uint32_t l = tree.first_level; l < level; ++l) {
+    std::vector<std::uint64_t> next;
+    next.reserve(tree.NodeCount(l + 1));
+    const std::vector<std::uint8_t>& masks = tree.masks[l - tree.first_level];
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      for (unsigned c = 0; c < 8; ++c) {
+        if (masks[i] >> c & 1u) next.push_back(keys[i] << 3 | c);
+      }
+    }
+    keys = std::move(next);
+  }
+  return keys;
+}
+
+namespace {
+
+constexpr std::uint32_t kSharedColor = 8;  // HEAD flag: every voxel has the colour in HEAD
+constexpr Tag kTop = MakeTag("TOPL");
+constexpr Tag kPages = MakeTag("PAGE");
+constexpr Tag kPageTable = MakeTag("PTAB");
+constexpr std::size_t kHeadFixed = 40, kHeadPerLevel = 24, kPageEntry = 32;
+
+// A version-2 file being written: the container and the bytes it borrows.
+struct Version2Writer {
+  container::Writer file{kSvoFormat, 0};
+  std::vector<std::vector<std::uint8_t>> pages;
+};
+
+std::unique_ptr<Version2Writer> MakeVersion2(const CompactSvo& svo,
+                                             const SvoCompression& compression,
+                                             SvoFileStats* stats) {
+  auto out = std::make_unique<Version2Writer>();
+  const SvoShape shape = Shape(svo);
+  const std::uint32_t page_level = PageLevel(svo);
+  const std::vector<std::uint64_t> keys = KeysOfLevel(svo.tree, page_level);
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
+  ChunkBytes top_bytes;
+  std::vector<std::uint8_t> top =
+      page_level == 0 ? std::vector<std::uint8_t>{}
+                      : EncodeChunk(TopChunk(svo, page_level), shape, compression, &top_bytes);
+  out->pages.resize(keys.size());
+  std::vector<ChunkBytes> page_bytes(keys.size());
+  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t p) {
+    out->pages[p] = EncodeChunk(PageChunk(svo, page_level, p, nbs[p], keys[p]), shape, compression,
+                                &page_bytes[p]);
+  });
+
+  ByteWriter head;
+  const bool shared = svo.has_color && svo.colors.size() == 1;
+  head.Put(svo.depth);
+  head.Put(svo.brick_side);
+  head.Put((svo.has_color ? kHasColor : 0) | (svo.has_normal ? kHasNormal : 0) |
+           (svo.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0));
+  head.Put(page_level);
+  head.Put(static_cast<std::uint64_t>(keys.size()));
+  head.Put(shared ? svo.colors[0] : HalfRgba(0, 0, 0, 0));
+  head.Put(svo.depth + 1);
+  head.Put(std::uint32_t{compression.zstd ? 1u : 0u});
+  for (std::uint32_t l = 0; l <= svo.depth; ++l) {
+    head.Put(svo.NodeCount(l));
+    head.Put(static_cast<std::uint64_t>(std::count_if(
+        svo.contours[l].begin(), svo.contours[l].end(), [](std::uint32_t w) { return w != 0; })));
+    head.Put(l < svo.layouts.size() ? svo.layouts[l].size() : std::uint64_t{0});
+  }
+  ByteWriter table;
+  std::uint64_t offset = 0;
+  for (std::size_t p = 0; p < keys.size(); ++p) {
+    const std::vector<std::uint8_t>& page = out->pages[p];
+    table.Put(keys[p]);
+    table.Put(offset);
+    table.Put(static_cast<std::uint32_t>(page.size()));
+    table.Put(Crc32c(page.data(), page.size()));
+    // The page's voxels: the voxels of the subtree of its root.
+    table.Put(std::uint64_t{0});  // patched below
+    offset += page.size();
+  }
+  // Voxels per page: the last level's node range of each subtree.
+  {
+    for (std::size_t p = 0; p < keys.size(); ++p) {
+      std::uint64_t b = p, e = p + 1;
+      for (std::uint32_t l = page_level; l < svo.depth; ++l) {
+        const auto& masks = svo.tree.masks[l];
+        const auto& firsts = svo.tree.first_child[l];
+        const std::uint64_t nb = firsts[b],
+                            ne = firsts[e - 1] + static_cast<unsigned>(std::popcount(masks[e - 1]));
+        b = nb;
+        e = ne;
+      }
+      const std::uint64_t voxels = e - b;
+      std::memcpy(table.bytes().data() + p * kPageEntry + 24, &voxels, 8);
+    }
+  }
+  container::Writer& file = out->file;
+  file.AddSection(kGrid, EncodeGridSection(svo.grid, svo.mode));
+  file.AddSection(kHead, std::move(head.bytes()));
+  if (!top.empty()) file.AddSection(kTop, std::move(top));
+  const Version2Writer* pages = out.get();
+  file.AddSectionProduced(kPages, [pages](const container::Writer::Emit& emit) {
+    for (const std::vector<std::uint8_t>& page : pages->pages) SVOKIT_RETURN_IF_ERROR(emit(page));
+    return Status::Ok();
+  });
+  file.AddSection(kPageTable, std::move(table.bytes()));
+  file.AddSection(kMetadata, std::vector<std::uint8_t>(svo.metadata.begin(), svo.metadata.end()));
+  if (stats != nullptr) {
+    *stats = {};
+    stats->page_level = page_level;
+    stats->pages = keys.size();
+    ChunkBytes all = top_bytes;
+    for (std::size_t p = 0; p < keys.size(); ++p) {
+      all.Add(page_bytes[p]);
+      const std::uint64_t size = out->pages[p].size();
+      stats->smallest_page = p == 0 ? size : std::min(stats->smallest_page, size);
+      stats->largest_page = std::max(stats->largest_page, size);
+    }
+    for (const auto& [name, v] : all.by_name) stats->sections.push_back({name, v.second, v.first});
+  }
+  return out;
+}
+
+// The frame's share of a written file: what the arrays do not take.
+void CompleteStats(std::uint64_t file_bytes, SvoFileStats& stats) {
+  stats.file_bytes = file_bytes;
+  std::uint64_t arrays = 0;
+  for (const SvoSectionBytes& s : stats.sections) arrays += s.stored;
+  stats.sections.push_back({"frame", file_bytes - arrays, file_bytes - arrays});
+}
+
+}  // namespace
+
+StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) {
+  const std::string& name = file.name();
+  Version2 v;
+  const auto grid = Loaded(file, kGrid);
+  const auto head_bytes = Loaded(file, kHead);
+  const auto table = Loaded(file, kPageTable);
+  const container::Frame::Section* pages = file.Find(kPages);
+  for (const auto& [present, tag] :
+       {std::pair{grid.has_value(), "GRID"}, std::pair{head_bytes.has_value(), "HEAD"},
+        std::pair{table.has_value(), "PTAB"}, std::pair{pages != nullptr, "PAGE"}}) {
+    if (!present) {
+      sink.Add("missing_section", name, "required section '{}' is missing", tag);
+      return Status::BadInput("missing section");
+    }
+  }
+  if (Status s = DecodeGridSection(*grid, name, v.grid, v.mode); !s.ok()) {
+    sink.Add("grid", name, "{}", s.message().substr(name.size() + 2));
+    return s;
+  }
+  const auto bad_head = [&](const std::string& what) {
+    sink.Add("head", name, "{}", what);
+    return Status::BadInput("{}", what);
+  };
+  ByteReader head(*head_bytes, "HEAD section");
+  std::uint32_t flags = 0, level_count = 0, codec = 0;
+  std::uint64_t page_count = 0;
+  HalfRgba shared;
+  if (!head.Get(v.shape.depth).ok() || !head.Get(v.shape.brick_side).ok() ||
+      !head.Get(flags).ok() || !head.Get(v.page_level).ok() || !head.Get(page_count).ok() ||
+      !head.Get(shared).ok() || !head.Get(level_count).ok() || !head.Get(codec).ok()) {
+    return bad_head("HEAD section is truncated");
+  }
+  const std::uint32_t depth = v.shape.depth;
+  if (depth == 0 || depth > kMaxDepth || depth != OctreeDepth(v.grid)) {
+    return bad_head(fmt::format("depth {} is not the {}-voxel grid's octree depth {}", depth,
+                                v.grid.max_dim(), OctreeDepth(v.grid)));
+  }
+  if (level_count != depth + 1 || head_bytes->size() != kHeadFixed + kHeadPerLevel * level_count) {
+    return bad_head(fmt::format("{} levels for depth {}", level_count, depth));
+  }
+  const std::uint32_t side = v.shape.brick_side;
+  if ((side != 0 && side != 2 && side != 3) ||
+      (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor)) ||
+      (side == 0 && (flags & (kHasColor | kHasNormal))) ||
+      ((flags & kSharedColor) && !(flags & kHasColor)) || codec > 1) {
+    return bad_head(
+        fmt::format("brick side {}, flags {:#x} or codec {} are invalid", side, flags, codec));
+  }
+  v.shape.has_color = flags & kHasColor;
+  v.shape.has_normal = flags & kHasNormal;
+  v.shape.has_contours = flags & kHasContours;
+  if (flags & kSharedColor) v.shape.shared_color = {shared};
+  if (v.page_level >= depth && !(v.page_level == 0 && depth == 0)) {
+    return bad_head(
+        fmt::format("page level {} is not above the voxels (depth {})", v.page_level, depth));
+  }
+  v.levels.resize(level_count);
+  for (std::array<std::uint64_t, 3>& counts : v.levels) {
+    for (std::uint64_t& c : counts) {
+      if (!head.Get(c).ok()) return bad_head("HEAD section is truncated");
+    }
+  }
+  for (std::uint32_t l = 0; l <= depth; ++l) {
+    const auto [nodes, contours, samples] = v.levels[l];
+    const std::uint64_t limit = l >= 21 ? ~std::uint64_t{0} : std::uint64_t{1} << (3 * l);
+    if (nodes == 0 || nodes > limit || contours > nodes || (l == 0 && nodes != 1) ||
+        (!v.shape.has_contours && contours != 0)) {
+      return bad_head(fmt::format("level {} counts ({} nodes, {} contours) are impossible", l,
+                                  nodes, contours));
+    }
+  }
+  if (page_count != v.levels[v.page_level][0]) {
+    return bad_head(fmt::format("{} pages, but level {} has {} nodes", page_count, v.page_level,
+                                v.levels[v.page_level][0]));
+  }
+  const auto top = Loaded(file, kTop);
+  if (v.page_level > 0 && !top) {
+    sink.Add("missing_section", name, "required section 'TOPL' is missing");
+    return Status::BadInput("missing TOPL");
+  }
+  if (top) v.top = *top;
+  v.page_bytes = pages->bytes;
+  if (table->size() != kPageEntry * page_count) {
+    sink.Add("page_table", name, "page table holds {} bytes for {} pages", table->size(),
+             page_count);
+    return Status::BadInput("page table size");
+  }
+  ByteReader entries(*table, "PTAB section");
+  std::uint64_t offset = 0;
+  v.pages.resize(page_count);
+  for (std::uint64_t p = 0; p < page_count; ++p) {
+    Version2::Page& e = v.pages[p];
+    (void)entries.Get(e.key);
+    (void)entries.Get(e.offset);
+    (void)entries.Get(e.size);
+    (void)entries.Get(e.crc);
+    (void)entries.Get(e.voxels);
+    if ((p > 0 && e.key <= v.pages[p - 1].key) ||
+        (3 * v.page_level < 64 && e.key >> (3 * v.page_level) != 0) || e.offset != offset ||
+        e.size > pages->size - offset) {
+      sink.Add("page_table", name, "page {}: key, offset or size out of sequence", p);
+      return Status::BadInput("page table");
+    }
+    offset += e.size;
+  }
+  if (offset != pages->size) {
+    sink.Add("page_table", name, "the pages take {} of the {} bytes of PAGE", offset, pages->size);
+    return Status::BadInput("page table");
+  }
+  if (const auto meta = Loaded(file, kMetadata)) v.metadata.assign(meta->begin(), meta->end());
+  return v;
+}
+
+StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name) {
+  if (v.page_level == 0) return SvoChunk{};
+  return DecodeChunk(v.top, v.shape, {0, 0, v.page_level, false}, name + ": top chunk");
+}
+
+StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::string& name,
+                              IssueSink* sink) {
+  const Version2::Page& e = v.pages[page];
+  const std::span<const std::uint8_t> bytes = v.page_bytes.subspan(e.offset, e.size);
+  const std::string page_name = fmt::format("{}: page {}", name, page);
+  if (Crc32c(bytes.data(), bytes.size()) != e.crc) {
+    if (sink != nullptr) {
+      sink->Add("page_checksum", page_name, "checksum mismatch (file is corrupt)");
+    }
+    return Status::BadInput("{}: checksum mismatch (file is corrupt)", page_name);
+  }
+  StatusOr<SvoChunk> chunk = DecodeChunk(
+      bytes, v.shape, {v.page_level, e.key, v.shape.depth - v.page_level + 1, true}, page_name);
+  if (!chunk.ok()) {
+    if (sink != nullptr) {
+      sink->Add("page_decode", name, "{}", chunk.status().message().substr(name.size() + 2));
+    }
+    return chunk.status();
+  }
+  if (chunk->tree.NodeCount(v.shape.depth) != e.voxels) {
+    if (sink != nullptr) {
+      sink->Add("page_decode", page_name, "holds {} voxels, the page table says {}",
+                chunk->tree.NodeCount(v.shape.depth), e.voxels);
+    }
+    return Status::BadInput("{}: voxel count differs from the page table", page_name);
+  }
+  return chunk;
+}
+
+bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
+                    IssueSink& sink, Svo& svo) {
+  const std::string& name = file.name();
+  StatusOr<Version2> parsed = ParseVersion2(file, sink);
+  if (!parsed.ok()) return false;
+  const Version2& v = *parsed;
+  const std::uint32_t last = std::min(v.shape.depth, max_level.value_or(v.shape.depth));
+  StatusOr<SvoChunk> top = DecodeTop(v, name);
+  if (!top.ok()) {
+    sink.Add("page_decode", name, "{}", top.status().message().substr(name.size() + 2));
+    return false;
+  }
+  // The top chunk's last masks name the pages: the page table's keys, in order.
+  const std::vector<std::uint64_t> roots =
+      v.page_level == 0 ? std::vector<std::uint64_t>{0} : KeysOfLevel(top->tree, v.page_level);
+  if (roots.size() != v.pages.size() ||
+      !std::equal(roots.begin(), roots.end(), v.pages.begin(),
+                  [](std::uint64_t k, const Version2::Page& p) { return k == p.key; })) {
+    sink.Add("page_table", name, "the page table's keys are not the top chunk's level {}",
+             v.page_level);
+    return false;
+  }
+  SvoAssembler assembler(v.shape, last);
+  assembler.Append(*top);
+  // Pages, if the levels asked for reach them (one level above, for its contour masks).
+  bool complete = true;
+  std::vector<std::uint64_t> voxel_keys;
+  struct Halo {
+    std::size_t page;
+    std::uint64_t key;
+    HalfRgba color;
+    OctNormal normal;
+  };
+  std::vector<Halo> halos;
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
+  if (last + 1 >= v.page_level) {
+    for (std::size_t p = 0; p < v.pages.size(); ++p) {
+      StatusOr<SvoChunk> page = DecodePage(v, p, name, &sink);
+      if (!page.ok()) {
+        complete = false;
+        if (sink.stops()) return false;
+        continue;
+      }
+      assembler.Append(*page);
+      if (last < v.shape.depth) continue;
+      // For the checks of the whole voxel set: keys, attributes, halos.
+      for (const std::uint64_t key : ChunkVoxelKeys(*page)) voxel_keys.push_back(key);
+      colors.insert(colors.end(), page->colors.begin(), page->colors.end());
+      normals.insert(normals.end(), page->normals.begin(), page->normals.end());
+      for (std::size_t h = 0; h < page->halo_keys.size(); ++h) {
+        halos.push_back({p, page->halo_keys[h],
+                         page->halo_colors.empty() ? HalfRgba() : page->halo_colors[h],
+                         page->halo_normals.empty() ? OctNormal() : page->halo_normals[h]});
+      }
+    }
+  }
+  if (!complete) return false;
+  svo = assembler.Finish(v.grid, v.mode, v.metadata);
+  bool consistent = true;
+  for (std::uint32_t l = 0; l <= last; ++l) {
+    const std::uint64_t contours = svo.levels[l].contours.size();
+    if (svo.levels[l].node_count != v.levels[l][0] || contours != v.levels[l][1]) {
+      consistent = false;
+      if (!sink.Add("level_counts", name,
+                    "level {} holds {} nodes and {} contours, HEAD says {} "
+                    "and {}",
+                    l, svo.levels[l].node_count, contours, v.levels[l][0], v.levels[l][1])) {
+        return false;
+      }
+    }
+  }
+  if (last < v.shape.depth) return consistent;
+  // Every voxel inside the grid (and so every node above it).
+  for (const std::uint64_t key : voxel_keys) {
+    const MortonCoord c = MortonDecode(key);
+    if (c.x >= v.grid.dims()[0] || c.y >= v.grid.dims()[1] || c.z >= v.grid.dims()[2]) {
+      consistent = false;
+      if (!sink.Add("node_outside_grid", name, "a voxel lies outside the grid")) return false;
+    }
+  }
+  // A page's halo voxels are voxels of other pages, with their attributes.
+  for (const Halo& h : halos) {
+    const auto it = std::lower_bound(voxel_keys.begin(), voxel_keys.end(), h.key);
+    const std::size_t i = static_cast<std::size_t>(it - voxel_keys.begin());
+    const bool same = it != voxel_keys.end() && *it == h.key &&
+                      (colors.empty() || colors[i] == h.color) &&
+                      (normals.empty() || normals[i].bits == h.normal.bits);
+    if (!same) {
+      consistent = false;
+      if (!sink.Add("halo", name, "page {}: halo voxel {} is not the voxel of its neighbour page",
+                    h.page, h.key)) {
+        return false;
+      }
+    }
+  }
+  return consistent;
+}
+
+}  // namespace svo_detail
+
+std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression,
+                                    SvoFileStats* stats) {
+  const auto writer = svo_detail::MakeVersion2(svo, compression, stats);
+  std::vector<std::uint8_t> bytes = writer->file.Serialize();
+  if (stats != nullptr) svo_detail::CompleteStats(bytes.size(), *stats);
+  return bytes;
+}
+
+StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
+                                const SvoCompression& compression) {
+  SvoFileStats stats;
+  const auto writer = svo_detail::MakeVersion2(svo, compression, &stats);
+  SVOKIT_RETURN_IF_ERROR(writer->file.WriteFile(path));
+  std::error_code ec;
+  svo_detail::CompleteStats(std::filesystem::file_size(path, ec), stats);
+  return stats;
+}
+
+}  // namespace svokit
