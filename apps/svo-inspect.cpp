@@ -8,6 +8,7 @@
 #include "apps/app.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"
@@ -84,6 +85,13 @@ int main(int argc, char** argv) {
     InspectReport report;
     report.file = input.string();
     report.file_bytes = std::filesystem::file_size(input);
+    report.version = 1;
+    if (StatusOr<SvoReader> reader = SvoReader::Open(input); reader.ok()) {
+      report.version = 2;
+      StatusOr<SvoFileStats> file_stats = reader->FileStats();
+      if (!file_stats.ok()) return app::Fail(tool, file_stats.status());
+      report.file_stats = std::move(*file_stats);
+    }
     report.levels = levels;
     report.histograms = histograms;
     if (!render_path.empty()) {

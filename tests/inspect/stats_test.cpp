@@ -98,6 +98,7 @@ TEST(SvoStats, JsonKeysAndValues) {
   }
   EXPECT_EQ(j["file"], "tiny.svo");
   EXPECT_EQ(j["file_bytes"], 1234);
+  EXPECT_TRUE(j["file_layout"].is_null());  // no file stats given
   EXPECT_EQ(j["grid"]["dims"], json({4, 4, 4}));
   EXPECT_EQ(j["grid"]["voxel_size"], 0.25);
   EXPECT_EQ(j["grid"]["origin"], json({-1.0, 2.0, 0.5}));
@@ -134,9 +135,9 @@ TEST(SvoStats, JsonKeysAndValues) {
 
   const std::string text = FormatStatsText(st, options);
   for (const char* key :
-       {"file               tiny.svo (1234 bytes)", "grid               4 x 4 x 4",
-        "voxels             3", "contours           none", "source", "children per inner node",
-        "bits/vox"}) {
+       {"file               tiny.svo (1234 bytes, 411.33 bytes per voxel",
+        "grid               4 x 4 x 4", "voxels             3", "contours           none", "source",
+        "children per inner node", "bits/vox"}) {
     EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
   }
 }

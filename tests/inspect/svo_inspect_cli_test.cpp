@@ -8,6 +8,7 @@
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "tests/cli/run_tool.hpp"
 
@@ -98,7 +99,17 @@ TEST(SvoInspectCli, JsonMatchesTheFile) {
     bytes += LevelBytes(*svo, l).total();
   }
   EXPECT_EQ(j["bytes"]["total"], bytes);
-  EXPECT_LT(bytes, j["file_bytes"].get<std::uint64_t>());
+  // The file: version 2, its sections adding up to its size, pages from the page table.
+  EXPECT_EQ(j["version"], 2);
+  const json& layout = j["file_layout"];
+  std::uint64_t stored = 0;
+  for (const json& section : layout["sections"]) stored += section["stored"].get<std::uint64_t>();
+  EXPECT_EQ(stored, j["file_bytes"].get<std::uint64_t>());
+  const StatusOr<SvoReader> reader = SvoReader::Open(TorusSvo());
+  ASSERT_TRUE(reader.ok());
+  EXPECT_EQ(layout["pages"], reader->page_count());
+  EXPECT_EQ(layout["page_level"], reader->page_level());
+  EXPECT_LE(layout["page_bytes"]["smallest"], layout["page_bytes"]["largest"]);
 }
 
 TEST(SvoInspectCli, RenderAndSlicePngs) {

@@ -229,7 +229,22 @@ std::string FormatStatsText(const SvoStats& st, const InspectReport& report) {
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z);
   };
   const auto& dims = st.grid.dims();
-  line("file", fmt::format("{} ({} bytes)", report.file, report.file_bytes));
+  line("file", fmt::format("{} ({} bytes, {:.2f} bytes per voxel, version {})", report.file,
+                           report.file_bytes, Share(report.file_bytes, st.voxels), report.version));
+  if (report.file_stats) {
+    const SvoFileStats& f = *report.file_stats;
+    line("pages",
+         fmt::format("{} below level {}, {} / {} / {} bytes (smallest / median / "
+                     "largest)",
+                     f.pages, f.page_level, f.smallest_page, f.median_page, f.largest_page));
+    std::string sections;
+    for (const SvoSectionBytes& sec : f.sections) {
+      fmt::format_to(std::back_inserter(sections), "{}{} {:.3f} ({:.3f} decoded)",
+                     sections.empty() ? "" : ", ", sec.name, Share(sec.stored, st.voxels),
+                     Share(sec.raw, st.voxels));
+    }
+    line("bytes per voxel", sections);
+  }
   line("grid", fmt::format("{} x {} x {} voxels of {:.6g}, {}", dims[0], dims[1], dims[2],
                            st.grid.voxel_size(), ModeName(st.mode)));
   const Box3d bounds = st.grid.GridBounds();
@@ -242,10 +257,10 @@ std::string FormatStatsText(const SvoStats& st, const InspectReport& report) {
   }
   line(st.loaded_levels == st.depth + 1 ? "voxels" : "finest nodes", fmt::format("{}", st.voxels));
   const auto bits = [&](std::uint64_t bytes) { return 8.0 * Share(bytes, st.voxels); };
-  line("size", fmt::format("{} bytes, {:.2f} bits per voxel (nodes {:.2f}, bricks {:.2f}, "
-                           "contours {:.2f})",
-                           st.bytes.total(), st.bits_per_voxel, bits(st.bytes.nodes),
-                           bits(st.bytes.bricks()), bits(st.bytes.contours)));
+  line("in memory", fmt::format("{} bytes, {:.2f} bits per voxel (nodes {:.2f}, bricks {:.2f}, "
+                                "contours {:.2f})",
+                                st.bytes.total(), st.bits_per_voxel, bits(st.bytes.nodes),
+                                bits(st.bytes.bricks()), bits(st.bytes.contours)));
   if (st.brick_side == 0) {
     line("bricks", "none");
   } else {
@@ -355,6 +370,25 @@ std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   json j;
   j["file"] = EscapeInvalidUtf8(report.file);
   j["file_bytes"] = report.file_bytes;
+  j["version"] = report.version;
+  j["file_layout"] = nullptr;
+  if (report.file_stats) {
+    const SvoFileStats& f = *report.file_stats;
+    json sections = json::array();
+    for (const SvoSectionBytes& sec : f.sections) {
+      sections.push_back({{"name", sec.name},
+                          {"stored", sec.stored},
+                          {"raw", sec.raw},
+                          {"stored_per_voxel", Share(sec.stored, st.voxels)},
+                          {"raw_per_voxel", Share(sec.raw, st.voxels)}});
+    }
+    j["file_layout"] = {
+        {"page_level", f.page_level},
+        {"pages", f.pages},
+        {"page_bytes",
+         {{"smallest", f.smallest_page}, {"median", f.median_page}, {"largest", f.largest_page}}},
+        {"sections", sections}};
+  }
   j["grid"] = {{"origin", Vec(st.grid.origin())},
                {"voxel_size", st.grid.voxel_size()},
                {"dims", {dims[0], dims[1], dims[2]}},

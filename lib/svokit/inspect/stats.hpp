@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "svokit/core/grid_transform.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/svo/contour.hpp"
 #include "svokit/svo/svo.hpp"
@@ -85,7 +86,7 @@ struct SvoStats {
   std::uint32_t loaded_levels = 0;  ///< levels 0 .. loaded_levels − 1 were read
   std::uint64_t voxels = 0;         ///< nodes of the finest loaded level
   std::vector<SvoLevelStats> levels;
-  SvoBytes bytes;  ///< of the loaded levels' arrays (no container overhead)
+  SvoBytes bytes;  ///< of the loaded levels' arrays in memory (what version 1 stored)
   double bits_per_voxel = 0;
   std::uint64_t contours = 0;  ///< contours of the loaded levels
   double contour_share = 0;    ///< contours / nodes over the loaded levels
@@ -120,8 +121,11 @@ struct SlicePicture {
 struct InspectReport {
   std::string file;              ///< the file's name as given
   std::uint64_t file_bytes = 0;  ///< its size on disk
-  bool levels = false;           ///< the per-level table / "levels" array
-  bool histograms = false;       ///< the histograms / "histograms" object
+  std::uint32_t version = 0;     ///< of the .svo format
+  /// A version-2 file's stored and decoded bytes per kind of array, and its pages.
+  std::optional<SvoFileStats> file_stats;
+  bool levels = false;      ///< the per-level table / "levels" array
+  bool histograms = false;  ///< the histograms / "histograms" object
   std::optional<RenderedPicture> render;
   std::optional<SlicePicture> slice;
 };

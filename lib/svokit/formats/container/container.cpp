@@ -397,6 +397,7 @@ StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std:
   ByteReader header(bytes.subspan(8, kHeaderSize - 8), name);
   Frame f;
   f.name_ = name;
+  f.file_size_ = bytes.size();
   std::uint64_t file_size = 0;
   std::uint32_t count = 0, header_crc = 0;
   SVOKIT_RETURN_IF_ERROR(header.Get(f.version_));

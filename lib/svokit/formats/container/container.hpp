@@ -177,6 +177,8 @@ class Frame {
   const std::string& name() const { return name_; }
   std::uint32_t version() const { return version_; }
   std::uint32_t flags() const { return flags_; }
+  /// The file's size in bytes.
+  std::uint64_t file_size() const { return file_size_; }
   const std::vector<Issue>& issues() const { return issues_; }
   const std::vector<Section>& sections() const { return sections_; }
   /// The first section with this tag that lies inside the file, whatever its checksum says.
@@ -188,6 +190,7 @@ class Frame {
   std::string name_;
   std::uint32_t version_ = 0;
   std::uint32_t flags_ = 0;
+  std::uint64_t file_size_ = 0;
   std::vector<Issue> issues_;
   std::vector<Section> sections_;
 };

@@ -376,6 +376,27 @@ Status ExpectSize(const StreamSet& set, Stream kind, std::uint64_t size, const s
 
 }  // namespace
 
+StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes,
+                                      const std::string& name) {
+  ChunkBytes out;
+  const std::uint8_t* p = bytes.data();
+  const std::uint8_t* end = p + bytes.size();
+  if (p == end) return Status::BadInput("{}: empty chunk", name);
+  const unsigned count = *p++;
+  for (unsigned i = 0; i < count; ++i) {
+    std::uint64_t raw = 0, stored = 0;
+    if (end - p < 2) return Status::BadInput("{}: stream directory runs past the chunk", name);
+    const auto kind = static_cast<Stream>(*p);
+    p += 2;
+    if (!GetVarint(p, end, raw) || !GetVarint(p, end, stored) || kind == 0 ||
+        kind >= kStreamKinds) {
+      return Status::BadInput("{}: stream directory is malformed", name);
+    }
+    out.Add(SectionOf(kind), raw, stored);
+  }
+  return out;
+}
+
 StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
                                const ChunkFrame& frame, const std::string& name) {
   StatusOr<StreamSet> read = StreamSet::Read(bytes, name);

@@ -32,6 +32,9 @@ std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& sha
                                       const SvoCompression& compression,
                                       ChunkBytes* bytes = nullptr);
 
+/// What each array of a chunk takes, from its stream directory alone (nothing decompressed).
+StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const std::string& name);
+
 /// What a decoder knows of a chunk before reading it: where its root is and which levels it holds
 /// (top chunk: root 0, levels 0 .. P − 1, masks down to P − 1; page: root at P, levels P ..
 /// depth, masks down to depth − 1).

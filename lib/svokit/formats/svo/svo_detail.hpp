@@ -86,6 +86,11 @@ StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name);
 /// Page `page`, its checksum verified; a problem also goes to `sink` when given.
 StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::string& name,
                               IssueSink* sink = nullptr);
+/// Fills the page count and smallest, median and largest page of `stats` from the pages' sizes.
+void SetPageSizes(std::vector<std::uint64_t> sizes, SvoFileStats& stats);
+/// Completes `stats` of a file of `file_bytes`: its size, and the frame's share ("frame").
+void CompleteStats(std::uint64_t file_bytes, SvoFileStats& stats);
+
 /// The Morton keys of a level of a tree, walked down from its root.
 std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level);
 

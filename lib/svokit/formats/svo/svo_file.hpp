@@ -45,7 +45,7 @@ struct SvoFileStats {
   std::uint64_t file_bytes = 0;
   std::uint32_t page_level = 0;
   std::uint64_t pages = 0;
-  std::uint64_t smallest_page = 0, largest_page = 0;  ///< stored bytes
+  std::uint64_t smallest_page = 0, median_page = 0, largest_page = 0;  ///< stored bytes
   std::vector<SvoSectionBytes> sections;
 };
 

@@ -128,26 +128,34 @@ std::unique_ptr<Version2Writer> MakeVersion2(const CompactSvo& svo,
     stats->page_level = page_level;
     stats->pages = keys.size();
     ChunkBytes all = top_bytes;
+    std::vector<std::uint64_t> sizes;
     for (std::size_t p = 0; p < keys.size(); ++p) {
       all.Add(page_bytes[p]);
-      const std::uint64_t size = out->pages[p].size();
-      stats->smallest_page = p == 0 ? size : std::min(stats->smallest_page, size);
-      stats->largest_page = std::max(stats->largest_page, size);
+      sizes.push_back(out->pages[p].size());
     }
+    SetPageSizes(sizes, *stats);
     for (const auto& [name, v] : all.by_name) stats->sections.push_back({name, v.second, v.first});
   }
   return out;
 }
 
-// The frame's share of a written file: what the arrays do not take.
+}  // namespace
+
+void SetPageSizes(std::vector<std::uint64_t> sizes, SvoFileStats& stats) {
+  std::sort(sizes.begin(), sizes.end());
+  stats.pages = sizes.size();
+  if (sizes.empty()) return;
+  stats.smallest_page = sizes.front();
+  stats.median_page = sizes[sizes.size() / 2];
+  stats.largest_page = sizes.back();
+}
+
 void CompleteStats(std::uint64_t file_bytes, SvoFileStats& stats) {
   stats.file_bytes = file_bytes;
   std::uint64_t arrays = 0;
   for (const SvoSectionBytes& s : stats.sections) arrays += s.stored;
   stats.sections.push_back({"frame", file_bytes - arrays, file_bytes - arrays});
 }
-
-}  // namespace
 
 StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) {
   const std::string& name = file.name();

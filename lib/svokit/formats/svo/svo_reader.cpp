@@ -1,0 +1,176 @@
+#include "svokit/formats/svo/svo_reader.hpp"
+
+#include "svokit/core/morton.hpp"
+#include "svokit/formats/svo/svo_detail.hpp"
+
+namespace svokit {
+
+struct SvoReader::State {
+  container::Frame frame;
+  svo_detail::Version2 v;
+};
+
+SvoReader::SvoReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
+SvoReader::SvoReader(SvoReader&&) noexcept = default;
+SvoReader& SvoReader::operator=(SvoReader&&) noexcept = default;
+SvoReader::~SvoReader() = default;
+
+namespace {
+
+// The checks Open and FromBytes share: a version-2 frame without issues, its tables parsed.
+StatusOr<svo_detail::Version2> ParseFrame(const StatusOr<container::Frame>& frame) {
+  if (!frame.ok()) return frame.status();
+  if (!frame->issues().empty()) {
+    return Status(StatusCode::kBadInput, frame->issues().front().message);
+  }
+  if (frame->version() != 2) {
+    return Status::BadInput("{}: a version-{} .svo has no pages (read it whole)", frame->name(),
+                            frame->version());
+  }
+  svo_detail::IssueSink sink(/*stop_at_first=*/true);
+  StatusOr<svo_detail::Version2> v = svo_detail::ParseVersion2(*frame, sink);
+  if (!v.ok()) return Status(StatusCode::kBadInput, sink.issues().front().message);
+  return v;
+}
+
+constexpr std::uint32_t kAllLevels = ~0u;
+
+}  // namespace
+
+StatusOr<SvoReader> SvoReader::Open(const std::filesystem::path& path) {
+  StatusOr<container::Frame> frame =
+      container::Frame::Open(path, kSvoFormat, &svo_detail::SectionsToLoad, &kAllLevels);
+  StatusOr<svo_detail::Version2> v = ParseFrame(frame);
+  if (!v.ok()) return v.status();
+  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v)}));
+}
+
+StatusOr<SvoReader> SvoReader::FromBytes(std::span<const std::uint8_t> bytes,
+                                         const std::string& name) {
+  StatusOr<container::Frame> frame = container::Frame::FromBytes(
+      bytes, name, kSvoFormat, &svo_detail::SectionsToLoad, &kAllLevels);
+  StatusOr<svo_detail::Version2> v = ParseFrame(frame);
+  if (!v.ok()) return v.status();
+  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v)}));
+}
+
+const std::string& SvoReader::name() const {
+  return state_->frame.name();
+}
+const GridTransform& SvoReader::grid() const {
+  return state_->v.grid;
+}
+VoxelMode SvoReader::mode() const {
+  return state_->v.mode;
+}
+const SvoShape& SvoReader::shape() const {
+  return state_->v.shape;
+}
+const std::string& SvoReader::metadata() const {
+  return state_->v.metadata;
+}
+std::uint32_t SvoReader::page_level() const {
+  return state_->v.page_level;
+}
+std::uint64_t SvoReader::NodeCount(std::uint32_t level) const {
+  return state_->v.levels[level][0];
+}
+std::uint64_t SvoReader::ContourCount(std::uint32_t level) const {
+  return state_->v.levels[level][1];
+}
+std::size_t SvoReader::page_count() const {
+  return state_->v.pages.size();
+}
+
+SvoPageInfo SvoReader::page(std::size_t i) const {
+  const svo_detail::Version2::Page& p = state_->v.pages[i];
+  return {p.key, p.voxels, p.size};
+}
+
+Box3d SvoReader::PageBox(std::size_t i) const {
+  const MortonCoord c = MortonDecode(state_->v.pages[i].key);
+  const double size =
+      grid().voxel_size() * static_cast<double>(std::uint64_t{1} << (depth() - page_level()));
+  const Vec3d lo = grid().origin() + Vec3d{c.x * size, c.y * size, c.z * size};
+  return {lo, lo + Vec3d{size, size, size}};
+}
+
+std::vector<std::size_t> SvoReader::PagesIn(const Box3d& box) const {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < page_count(); ++i) {
+    const Box3d p = PageBox(i);
+    if (p.lo.x <= box.hi.x && box.lo.x <= p.hi.x && p.lo.y <= box.hi.y && box.lo.y <= p.hi.y &&
+        p.lo.z <= box.hi.z && box.lo.z <= p.hi.z) {
+      out.push_back(i);
+    }
+  }
+  return out;
+}
+
+StatusOr<SvoFileStats> SvoReader::FileStats() const {
+  const svo_detail::Version2& v = state_->v;
+  SvoFileStats stats;
+  stats.page_level = v.page_level;
+  ChunkBytes all;
+  if (!v.top.empty()) {
+    StatusOr<ChunkBytes> top = ChunkStreamBytes(v.top, name() + ": top chunk");
+    if (!top.ok()) return top.status();
+    all.Add(*top);
+  }
+  std::vector<std::uint64_t> sizes;
+  for (std::size_t i = 0; i < v.pages.size(); ++i) {
+    const svo_detail::Version2::Page& p = v.pages[i];
+    StatusOr<ChunkBytes> page = ChunkStreamBytes(v.page_bytes.subspan(p.offset, p.size),
+                                                 fmt::format("{}: page {}", name(), i));
+    if (!page.ok()) return page.status();
+    all.Add(*page);
+    sizes.push_back(p.size);
+  }
+  svo_detail::SetPageSizes(std::move(sizes), stats);
+  for (const auto& [section, b] : all.by_name)
+    stats.sections.push_back({section, b.second, b.first});
+  svo_detail::CompleteStats(state_->frame.file_size(), stats);
+  return stats;
+}
+
+StatusOr<SvoChunk> SvoReader::Top() const {
+  return svo_detail::DecodeTop(state_->v, name());
+}
+
+StatusOr<SvoChunk> SvoReader::Page(std::size_t i) const {
+  if (i >= page_count()) {
+    return Status::BadInput("{}: page {} of {} does not exist", name(), i, page_count());
+  }
+  return svo_detail::DecodePage(state_->v, i, name());
+}
+
+SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,
+                                 std::uint32_t level) {
+  SvoChunkLevel out;
+  out.level = level;
+  const std::uint32_t k = level - chunk.root_level;
+  out.keys = {chunk.root_key};
+  for (std::uint32_t l = 0; l < k; ++l) {
+    std::vector<std::uint64_t> next;
+    const std::vector<std::uint8_t>& masks = chunk.tree.masks[l];
+    for (std::size_t i = 0; i < out.keys.size(); ++i) {
+      for (unsigned c = 0; c < 8; ++c) {
+        if (masks[i] >> c & 1u) next.push_back(out.keys[i] << 3 | c);
+      }
+    }
+    out.keys = std::move(next);
+  }
+  if (k < chunk.tree.masks.size()) out.masks = chunk.tree.masks[k];
+  out.contours = chunk.contours[k];
+  if (shape.brick_side != 0) {
+    if (level < shape.depth) {
+      AssembleBricks(chunk.tree, level, chunk.layouts[k], chunk.samples[k], out.bricks);
+    } else {
+      ChunkVoxelBricks(chunk, shape, out.bricks);
+    }
+  }
+  out.bricks.node_count = out.keys.size();
+  return out;
+}
+
+}  // namespace svokit

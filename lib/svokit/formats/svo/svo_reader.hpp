@@ -1,0 +1,88 @@
+#pragma once
+// Streaming a version-2 .svo, as a renderer does: open the file (mapped; only its header, tables
+// and top chunk are checked), load the top levels, then the pages it needs, by index or by a
+// world-space box, each checked (CRC-32C, streams, counts) when it is loaded. A page's bricks are
+// assembled into a brick pool, side³ samples per node, the bytes version 1 stored; its voxels'
+// colours and normals are at hand too. README.md here, "Reading pages", shows the loop.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "svokit/core/box.hpp"
+#include "svokit/core/grid_transform.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/svo_pages.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+/// One entry of the page table.
+struct SvoPageInfo {
+  std::uint64_t key = 0;           ///< the page root's Morton key at the page level
+  std::uint64_t voxels = 0;        ///< voxels in the page
+  std::uint64_t stored_bytes = 0;  ///< the page's bytes in the file
+};
+
+class SvoReader {
+ public:
+  /// Opens a version-2 file (version 1 has no pages: ReadSvo reads it whole).
+  static StatusOr<SvoReader> Open(const std::filesystem::path& path);
+  /// The same over bytes that outlive the reader; `name` is used in messages.
+  static StatusOr<SvoReader> FromBytes(std::span<const std::uint8_t> bytes,
+                                       const std::string& name);
+  SvoReader(SvoReader&&) noexcept;
+  SvoReader& operator=(SvoReader&&) noexcept;
+  ~SvoReader();
+
+  const std::string& name() const;
+  const GridTransform& grid() const;
+  VoxelMode mode() const;
+  const SvoShape& shape() const;
+  std::uint32_t depth() const { return shape().depth; }
+  const std::string& metadata() const;
+  /// Levels 0 .. page_level() − 1 are the top chunk's; each page holds page_level() .. depth().
+  std::uint32_t page_level() const;
+  std::uint64_t NodeCount(std::uint32_t level) const;
+  std::uint64_t ContourCount(std::uint32_t level) const;
+  std::size_t page_count() const;
+  SvoPageInfo page(std::size_t i) const;
+  /// The world-space cube of page i's root node.
+  Box3d PageBox(std::size_t i) const;
+  /// The pages whose cube meets `box` (closed), in page order.
+  std::vector<std::size_t> PagesIn(const Box3d& box) const;
+
+  /// What each kind of array takes in the file, stored and decoded, and the pages' sizes, read
+  /// from the chunks' stream directories (nothing is decompressed).
+  StatusOr<SvoFileStats> FileStats() const;
+
+  /// The top chunk (no levels when the page level is 0).
+  StatusOr<SvoChunk> Top() const;
+  /// Page i, checked.
+  StatusOr<SvoChunk> Page(std::size_t i) const;
+
+ private:
+  struct State;
+  explicit SvoReader(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+/// A level of a loaded chunk as a renderer uploads it: node keys (Morton at that level), child
+/// masks (empty at the voxel level), contour words (0 where none), and the brick pool, side³
+/// samples per node in node order (SvoLevel's opacity, colour and normal arrays).
+struct SvoChunkLevel {
+  std::uint32_t level = 0;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::uint8_t> masks;
+  std::vector<std::uint32_t> contours;
+  SvoLevel bricks;
+};
+
+/// Level `level` of `chunk` (root_level ≤ level < root_level + levels_held()), bricks assembled;
+/// a page's voxel level computed from its voxels and halo.
+SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape, std::uint32_t level);
+
+}  // namespace svokit
