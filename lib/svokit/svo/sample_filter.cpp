@@ -56,12 +56,14 @@ ChildBlock ChildrenOf(const MaskTree& tree, std::uint32_t level, const Neighbour
 // sees them, and the voxel-level samples there, each computed once per tile. Coordinates are
 // relative to the tile's corner: voxels from −2 to W + 1 (W voxels per tile edge), lattice points
 // in half voxels from −2 to 2W + 2. Entries are valid for the tile they were written in (stamps:
-// nothing is cleared between tiles).
+// nothing is cleared between tiles but a bitmap of the voxels present).
 class VoxelTile {
  public:
   explicit VoxelTile(std::uint32_t width) : width_(static_cast<int>(width)) {
-    const int voxels = width_ + 4, points = 2 * width_ + 5;
-    voxel_.resize(static_cast<std::size_t>(voxels * voxels * voxels));
+    const std::size_t voxels = static_cast<std::size_t>(VoxelSide() * VoxelSide() * VoxelSide());
+    const int points = 2 * width_ + 5;
+    present_.resize((voxels + 63) / 64);
+    voxel_.resize(voxels);
     point_.resize(static_cast<std::size_t>(points * points * points));
   }
   int width() const { return width_; }
@@ -71,6 +73,7 @@ class VoxelTile {
     source_ = &source;
     f_ = f;
     ++stamp_;
+    std::fill(present_.begin(), present_.end(), 0);
   }
 
   // The voxels of the block of a node above the voxels whose corner is voxel `corner` + (2, 2, 2)
@@ -81,77 +84,121 @@ class VoxelTile {
         for (int x = 0; x < kBlock; ++x) {
           const std::int64_t v = block[BlockIndex(x, y, z)];
           if (v < 0) continue;
-          Voxel& e = voxel_[VoxelAt(corner[0] + x, corner[1] + y, corner[2] + z)];
-          if (e.stamp == stamp_) continue;
-          e = {v, stamp_, false, {}, {}};
+          const std::size_t at = VoxelAt(corner[0] + x, corner[1] + y, corner[2] + z);
+          if (present_[at / 64] >> (at % 64) & 1u) continue;
+          present_[at / 64] |= std::uint64_t{1} << (at % 64);
+          voxel_[at] = {v, false, {}, {}, {}, {}};
         }
       }
     }
   }
 
-  struct Point {
-    EncodedSample encoded;
-    PremultipliedSample decoded;  // the encoded sample premultiplied again, as a tent reads it
-    std::uint32_t stamp = 0;
-  };
-  // The voxel-level sample at half-voxel coordinates h: the mean over the voxels whose closed cube
-  // holds it (absent ones count as empty), summed in z, y, x order and scaled, as FilterBricks
-  // computes it, then encoded.
-  const Point& At(int hx, int hy, int hz) {
-    const int points = 2 * width_ + 5;
-    Point& p = point_[static_cast<std::size_t>((hx + 2) + points * ((hy + 2) + points * (hz + 2)))];
-    if (p.stamp == stamp_) return p;
-    p.stamp = stamp_;
+  // The decoded voxel-level sample at half-voxel coordinates h, as a tent reads it; the zero
+  // sample where no voxel holds the point (most taps), without touching the point table.
+  const PremultipliedSample& Decoded(int hx, int hy, int hz) {
+    static const PremultipliedSample kEmpty{};
     const int h[3] = {hx, hy, hz};
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = FloorHalf(h[a] - 1);  // ⌈(h − 2)/2⌉
       hi[a] = FloorHalf(h[a]);
     }
-    Voxel* contributors[8];
-    int n = 0;
-    for (int z = lo[2]; z <= hi[2]; ++z) {
-      for (int y = lo[1]; y <= hi[1]; ++y) {
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          Voxel& v = voxel_[VoxelAt(x, y, z)];
-          if (v.stamp == stamp_) contributors[n++] = &v;
-        }
-      }
+    if (!AnyPresent(lo, hi)) return kEmpty;
+    return Compute(h, lo, hi).decoded;
+  }
+
+  // The encoded voxel-level sample at half-voxel coordinates h (a voxel brick's sample).
+  EncodedSample Encoded(int hx, int hy, int hz) {
+    const int h[3] = {hx, hy, hz};
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = FloorHalf(h[a] - 1);
+      hi[a] = FloorHalf(h[a]);
     }
-    const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
-    if (n == 0) {
-      p.encoded = {};
-    } else if (n == 1) {
-      // One voxel: its own colour and normal, exactly (the scaling by 1/count is a power of 2).
-      p.encoded = Alone(*contributors[0]);
-      p.encoded.opacity = EncodeUnorm8(1.f / static_cast<float>(count));
-    } else {
-      PremultipliedSample sum;
-      for (int i = 0; i < n; ++i) Accumulate(sum, Cell(*contributors[i]), 1.f);
-      PremultipliedSample mean;
-      Accumulate(mean, sum, 1.f / static_cast<float>(count));
-      p.encoded = Encode(f_.color, f_.normal, mean);
-    }
-    p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
-                                       : DecodePremultiplied(p.encoded, f_.color, f_.normal);
-    return p;
+    if (!AnyPresent(lo, hi)) return {};
+    return Compute(h, lo, hi).encoded;
   }
 
  private:
   struct Voxel {
     std::int64_t index = -1;
-    std::uint32_t stamp = 0;
     bool converted = false;
-    PremultipliedSample cell;
-    EncodedSample alone;
+    PremultipliedSample cell;  // opacity 1, colour and normal (premultiplied by 1)
+    EncodedSample alone;       // the voxel's own sample
+    Rgba alone_color;          // that sample's colour and normal decoded
+    Vec3f alone_normal;
+  };
+  struct Point {
+    EncodedSample encoded;
+    PremultipliedSample decoded;  // the encoded sample premultiplied again, as a tent reads it
+    std::uint32_t stamp = 0;
   };
 
+  int VoxelSide() const { return width_ + 4; }
   std::size_t VoxelAt(int x, int y, int z) const {
-    const int voxels = width_ + 4;
-    return static_cast<std::size_t>((x + 2) + voxels * ((y + 2) + voxels * (z + 2)));
+    return static_cast<std::size_t>((x + 2) + VoxelSide() * ((y + 2) + VoxelSide() * (z + 2)));
   }
-  void Convert(Voxel& v) {
-    if (v.converted) return;
+  bool Present(int x, int y, int z) const {
+    const std::size_t at = VoxelAt(x, y, z);
+    return present_[at / 64] >> (at % 64) & 1u;
+  }
+  bool AnyPresent(const int lo[3], const int hi[3]) const {
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          if (Present(x, y, z)) return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  // The mean over the voxels whose closed cube holds the point (absent ones count as empty),
+  // summed in z, y, x order and scaled, as FilterBricks computes it, then encoded.
+  const Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
+    const int points = 2 * width_ + 5;
+    Point& p =
+        point_[static_cast<std::size_t>((h[0] + 2) + points * ((h[1] + 2) + points * (h[2] + 2)))];
+    if (p.stamp == stamp_) return p;
+    p.stamp = stamp_;
+    Voxel* contributors[8];
+    int n = 0;
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          if (Present(x, y, z)) contributors[n++] = &Convert(voxel_[VoxelAt(x, y, z)]);
+        }
+      }
+    }
+    const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    if (n == 1) {
+      // One voxel: its own colour and normal, exactly (the scaling by 1/count is a power of 2),
+      // and decoded from what it decodes to alone.
+      const Voxel& v = *contributors[0];
+      p.encoded = v.alone;
+      p.encoded.opacity = EncodeUnorm8(1.f / static_cast<float>(count));
+      const float o = p.decoded.opacity = DecodeUnorm8(p.encoded.opacity);
+      p.decoded.r = v.alone_color.r * o;
+      p.decoded.g = v.alone_color.g * o;
+      p.decoded.b = v.alone_color.b * o;
+      p.decoded.a = v.alone_color.a * o;
+      p.decoded.nx = v.alone_normal.x * o;
+      p.decoded.ny = v.alone_normal.y * o;
+      p.decoded.nz = v.alone_normal.z * o;
+      return p;
+    }
+    PremultipliedSample sum;
+    for (int i = 0; i < n; ++i) Accumulate(sum, contributors[i]->cell, 1.f);
+    PremultipliedSample mean;
+    Accumulate(mean, sum, 1.f / static_cast<float>(count));
+    p.encoded = Encode(f_.color, f_.normal, mean);
+    p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
+                                       : DecodePremultiplied(p.encoded, f_.color, f_.normal);
+    return p;
+  }
+
+  Voxel& Convert(Voxel& v) {
+    if (v.converted) return v;
     BrickSample b;
     b.opacity = 1;
     const auto i = static_cast<std::size_t>(v.index);
@@ -159,15 +206,10 @@ class VoxelTile {
     if (f_.normal) b.normal = source_->normals[i];
     v.cell = Premultiply(b);
     v.alone = Encode(f_.color, f_.normal, v.cell);
+    v.alone_color = f_.color ? DecodeColor(v.alone.color) : Rgba{0, 0, 0, 0};
+    v.alone_normal = f_.normal ? DecodeNormal(v.alone.normal) : Vec3f{0, 0, 0};
     v.converted = true;
-  }
-  const PremultipliedSample& Cell(Voxel& v) {
-    Convert(v);
-    return v.cell;
-  }
-  const EncodedSample& Alone(Voxel& v) {
-    Convert(v);
-    return v.alone;
+    return v;
   }
 
   static int FloorHalf(int a) { return a >= 0 ? a / 2 : -((1 - a) / 2); }
@@ -176,6 +218,7 @@ class VoxelTile {
   const VoxelSamplesSource* source_ = nullptr;
   Flags f_{};
   std::uint32_t stamp_ = 0;
+  std::vector<std::uint64_t> present_;
   std::vector<Voxel> voxel_;
   std::vector<Point> point_;
 };
@@ -355,10 +398,8 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
         StoreNodeSamples(
             side, layout.orphans[i],
             [&](int x, int y, int z) -> const PremultipliedSample& {
-              return tile
-                  .At(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
-                      origin[2] + step * (z - 1))
-                  .decoded;
+              return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
+                                  origin[2] + step * (z - 1));
             },
             f, out, layout.first[i]);
       });
@@ -465,8 +506,8 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
           for (unsigned s = 0; s < n; ++s) {
             const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
                               static_cast<int>(s / (side * side))};
-            const EncodedSample& e =
-                tile.At(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]).encoded;
+            const EncodedSample e =
+                tile.Encoded(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]);
             const std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n + s;
             out.opacity[to] = e.opacity;
             if (f.color) out.color[to] = e.color;
