@@ -60,8 +60,11 @@ $(grep -F "libsvokit_oiio.so [0];  generating link map" "$work/mesh2svo.err")"
   fail "installed svo-inspect"
 "$work/example/read_svo" "$work/torus.svo" >"$work/svo.txt" || fail "read_svo torus.svo"
 "$work/example/read_svo" "$work/torus.vfrag" >"$work/vfrag.txt" || fail "read_svo torus.vfrag"
+# Streamed: the top chunk and every page meeting a box around the whole grid.
+"$work/example/read_svo" "$work/torus.svo" --box -1e9 -1e9 -1e9 1e9 1e9 1e9 >"$work/stream.txt" ||
+  fail "read_svo torus.svo --box"
 
-python3 - "$work/inspect.json" "$work/svo.txt" "$work/vfrag.txt" <<'PY'
+python3 - "$work/inspect.json" "$work/svo.txt" "$work/vfrag.txt" "$work/stream.txt" <<'PY'
 import json, sys
 inspect = json.load(open(sys.argv[1]))
 def fields(path):
@@ -70,12 +73,17 @@ def fields(path):
         key, *values = line.split()
         out.setdefault(key, []).append(values)
     return out
-svo, vfrag = fields(sys.argv[2]), fields(sys.argv[3])
+svo, vfrag, stream = fields(sys.argv[2]), fields(sys.argv[3]), fields(sys.argv[4])
 errors = []
 want = [(level["level"], level["nodes"]) for level in inspect["levels"]]
 got = [(int(l), int(n)) for l, _, n in svo["level"]]
 if got != want:
     errors.append(f"per-level nodes: read_svo {got}, svo-inspect {want}")
+streamed = [(int(l), int(n)) for l, _, n, _, _ in stream["streamed"]]
+if streamed != want:
+    errors.append(f"per-level nodes streamed page by page: read_svo {streamed}, svo-inspect {want}")
+if any(int(s) != 27 * int(n) for _, _, n, _, s in stream["streamed"]):
+    errors.append(f"streamed brick pools are not 27 samples per node: {stream['streamed']}")
 if int(svo["depth"][0][0]) != inspect["octree"]["depth"] or len(want) != inspect["octree"]["depth"] + 1:
     errors.append(f"depth: read_svo {svo['depth'][0][0]}, svo-inspect {inspect['octree']['depth']}")
 if int(svo["voxels"][0][0]) != inspect["voxels"]:

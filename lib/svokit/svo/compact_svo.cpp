@@ -26,8 +26,9 @@ StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
   svo.mode = voxels.mode;
   svo.depth = OctreeDepth(voxels.grid);
   svo.brick_side = options.brick_side;
-  svo.has_color = options.brick_side != 0 && voxels.has_colors();
-  svo.has_normal = options.brick_side != 0 && voxels.has_normals();
+  // Without bricks the voxels' own colours and normals are still kept.
+  svo.has_color = voxels.has_colors();
+  svo.has_normal = voxels.has_normals();
   svo.has_contours = options.contours;
   svo.metadata = std::move(metadata);
 

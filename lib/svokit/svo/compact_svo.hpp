@@ -37,7 +37,8 @@ struct CompactSvo {
   std::vector<SampleLayout> layouts;
   std::vector<LevelSamples> samples;
   /// The voxels' colours (empty, one shared, or one per voxel) and normals (empty or one per
-  /// voxel), in voxel order; the bricks' colour and normal follow has_color and has_normal.
+  /// voxel), in voxel order, kept with or without bricks; the bricks' colour and normal follow
+  /// has_color and has_normal.
   DefaultInitVector<HalfRgba> colors;
   DefaultInitVector<OctNormal> normals;
 

@@ -90,7 +90,7 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
     chunk.contours.emplace_back(svo.contours[l].begin() + static_cast<std::ptrdiff_t>(begin),
                                 svo.contours[l].begin() + static_cast<std::ptrdiff_t>(end));
   }
-  const auto [v0, v1] = ranges.back();
+  const std::uint64_t v0 = ranges.back().first, v1 = ranges.back().second;
   if (svo.colors.size() > 1) {
     chunk.colors.assign(svo.colors.begin() + static_cast<std::ptrdiff_t>(v0),
                         svo.colors.begin() + static_cast<std::ptrdiff_t>(v1));
@@ -142,6 +142,7 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
       }
     }
     if (l + 1 == svo.depth) {
+      if (!bricks) return;  // the halo is for voxel bricks
       const MortonCoord c = MortonDecode(node_key);
       const std::vector<std::uint8_t>& masks = svo.tree.masks[l];
       const std::vector<std::uint64_t>& first = svo.tree.first_child[l];
@@ -272,8 +273,9 @@ Svo SvoAssembler::Finish(const GridTransform& grid, VoxelMode mode, std::string 
   svo.mode = mode;
   svo.depth = shape_.depth;
   svo.brick_side = shape_.brick_side;
-  svo.has_color = shape_.has_color;
-  svo.has_normal = shape_.has_normal;
+  // An Svo's flags say what its bricks carry.
+  svo.has_color = shape_.brick_side != 0 && shape_.has_color;
+  svo.has_normal = shape_.brick_side != 0 && shape_.has_normal;
   svo.has_contours = shape_.has_contours;
   svo.metadata = std::move(metadata);
   svo.levels = std::move(levels_);

@@ -200,7 +200,6 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   const std::uint32_t side = v.shape.brick_side;
   if ((side != 0 && side != 2 && side != 3) ||
       (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor)) ||
-      (side == 0 && (flags & (kHasColor | kHasNormal))) ||
       ((flags & kSharedColor) && !(flags & kHasColor)) || codec > 1) {
     return bad_head(
         fmt::format("brick side {}, flags {:#x} or codec {} are invalid", side, flags, codec));
