@@ -35,7 +35,7 @@ std::uint64_t MaskTree::NodeCount(std::uint32_t level) const {
   if (level == first_level) return 1;
   const std::vector<std::uint8_t>& above = masks[level - 1 - first_level];
   const std::vector<std::uint64_t>& first = first_child[level - 1 - first_level];
-  return above.empty() ? 0 : first.back() + static_cast<unsigned>(std::popcount(above.back()));
+  return above.empty() ? 0 : first.back() + CountBits8(above.back());
 }
 
 void MaskTree::LinkChildren() {
@@ -45,7 +45,7 @@ void MaskTree::LinkChildren() {
     std::uint64_t next = 0;
     for (std::size_t i = 0; i < masks[k].size(); ++i) {
       first_child[k][i] = next;
-      next += static_cast<unsigned>(std::popcount(masks[k][i]));
+      next += CountBits8(masks[k][i]);
     }
   }
 }
@@ -78,10 +78,8 @@ Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
     const ChildStep step = kChildSteps[c][o];
     const std::int64_t p = parent[step.parent_slot];
     const unsigned m = p < 0 ? 0u : masks[p];
-    out[o] = (m >> step.bit & 1u)
-                 ? static_cast<std::int64_t>(
-                       first[p] + static_cast<unsigned>(std::popcount(m & ((1u << step.bit) - 1))))
-                 : -1;
+    out[o] =
+        (m >> step.bit & 1u) ? static_cast<std::int64_t>(first[p] + RankInByte(m, step.bit)) : -1;
   }
   return out;
 }

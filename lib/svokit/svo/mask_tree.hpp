@@ -14,6 +14,8 @@
 #include <span>
 #include <vector>
 
+#include "svokit/core/bit_count.hpp"
+
 #include <tbb/parallel_for.h>
 
 namespace svokit {
@@ -44,9 +46,7 @@ struct MaskTree {
   std::int64_t Child(std::uint32_t level, std::uint64_t i, unsigned c) const {
     const std::uint8_t m = masks[level - first_level][i];
     if (!(m >> c & 1u)) return -1;
-    return static_cast<std::int64_t>(
-        first_child[level - first_level][i] +
-        static_cast<unsigned>(std::popcount(static_cast<unsigned>(m) & ((1u << c) - 1))));
+    return static_cast<std::int64_t>(first_child[level - first_level][i] + RankInByte(m, c));
   }
 };
 

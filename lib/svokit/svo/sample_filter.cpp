@@ -104,7 +104,13 @@ class VoxelTile {
       hi[a] = FloorHalf(h[a]);
     }
     if (!AnyPresent(lo, hi)) return kEmpty;
-    return Compute(h, lo, hi).decoded;
+    Point& p = Compute(h, lo, hi);
+    if (p.decoded_stamp != stamp_) {
+      p.decoded_stamp = stamp_;
+      p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
+                                         : DecodePremultiplied(p.encoded, f_.color, f_.normal);
+    }
+    return p.decoded;
   }
 
   // The encoded voxel-level sample at half-voxel coordinates h (a voxel brick's sample).
@@ -130,8 +136,9 @@ class VoxelTile {
   };
   struct Point {
     EncodedSample encoded;
-    PremultipliedSample decoded;  // the encoded sample premultiplied again, as a tent reads it
-    std::uint32_t stamp = 0;
+    PremultipliedSample decoded;      // the encoded sample premultiplied again, as a tent reads it
+    std::uint32_t stamp = 0;          // `encoded` is this tile's
+    std::uint32_t decoded_stamp = 0;  // `decoded` is this tile's (only the filter reads it)
   };
 
   int VoxelSide() const { return width_ + 4; }
@@ -155,7 +162,7 @@ class VoxelTile {
 
   // The mean over the voxels whose closed cube holds the point (absent ones count as empty),
   // summed in z, y, x order and scaled, as FilterBricks computes it, then encoded.
-  const Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
+  Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
     const int points = 2 * width_ + 5;
     Point& p =
         point_[static_cast<std::size_t>((h[0] + 2) + points * ((h[1] + 2) + points * (h[2] + 2)))];
@@ -177,6 +184,7 @@ class VoxelTile {
       const Voxel& v = *contributors[0];
       p.encoded = v.alone;
       p.encoded.opacity = EncodeUnorm8(1.f / static_cast<float>(count));
+      p.decoded_stamp = stamp_;
       const float o = p.decoded.opacity = DecodeUnorm8(p.encoded.opacity);
       p.decoded.r = v.alone_color.r * o;
       p.decoded.g = v.alone_color.g * o;
@@ -192,8 +200,6 @@ class VoxelTile {
     PremultipliedSample mean;
     Accumulate(mean, sum, 1.f / static_cast<float>(count));
     p.encoded = Encode(f_.color, f_.normal, mean);
-    p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
-                                       : DecodePremultiplied(p.encoded, f_.color, f_.normal);
     return p;
   }
 

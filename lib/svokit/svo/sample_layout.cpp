@@ -102,7 +102,7 @@ SampleLayout LayOutSamples(const MaskTree& tree, std::uint32_t level, std::uint3
   std::uint64_t next = 0;
   for (std::uint64_t i = 0; i < n; ++i) {
     layout.first[i] = next;
-    next += home + static_cast<unsigned>(std::popcount(layout.orphans[i]));
+    next += home + CountBits32(layout.orphans[i]);
   }
   layout.first[n] = next;
   return layout;

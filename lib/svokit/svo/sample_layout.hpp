@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "svokit/core/bit_count.hpp"
 #include "svokit/svo/mask_tree.hpp"
 
 namespace svokit {
@@ -73,8 +74,7 @@ std::uint64_t PointIndex(const SampleLayout& layout, unsigned k, const NodeAt& n
     const std::int64_t o = node_at(static_cast<unsigned>(home.f[c]));
     if (o < 0) continue;
     const unsigned j = t.index[home.brick_sample[c]];
-    return layout.first[o] + t.home_count +
-           static_cast<unsigned>(std::popcount(layout.orphans[o] & ((1u << j) - 1)));
+    return layout.first[o] + t.home_count + CountBits32(layout.orphans[o] & ((1u << j) - 1));
   }
   return ~std::uint64_t{0};
 }

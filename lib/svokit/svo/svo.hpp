@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "svokit/core/bit_count.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/vec.hpp"
 #include "svokit/svo/sample_codec.hpp"
@@ -29,12 +30,10 @@ struct SvoNode {
   std::uint8_t reserved = 0;
 
   std::uint32_t Child(unsigned c) const {
-    return first_child + static_cast<std::uint32_t>(
-                             std::popcount(static_cast<unsigned>(child_mask) & ((1u << c) - 1)));
+    return first_child + static_cast<std::uint32_t>(RankInByte(child_mask, c));
   }
   std::uint32_t ChildContour(unsigned c) const {
-    return first_contour + static_cast<std::uint32_t>(std::popcount(
-                               static_cast<unsigned>(contour_mask) & ((1u << c) - 1)));
+    return first_contour + static_cast<std::uint32_t>(RankInByte(contour_mask, c));
   }
   bool operator==(const SvoNode&) const = default;
 };

@@ -11,7 +11,7 @@ namespace svokit {
 namespace {
 
 unsigned Popcount(std::uint8_t m) {
-  return static_cast<unsigned>(std::popcount(m));
+  return CountBits8(m);
 }
 
 // The nodes of levels first .. last of the subtree of node `root` of level first: a contiguous

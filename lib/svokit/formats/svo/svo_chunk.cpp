@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "svokit/core/bit_count.hpp"
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
 
@@ -426,7 +427,7 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
         return Status::BadInput("{}: a node of level {} has no children", name,
                                 frame.root_level + k);
       }
-      next += static_cast<unsigned>(std::popcount(m));
+      next += CountBits8(m);
     }
     nodes = next;
     counts.push_back(nodes);
@@ -442,7 +443,7 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   for (std::uint32_t k = 0; k < frame.levels; ++k) bit_bytes += (counts[k] + 7) / 8;
   if (shape.has_contours) SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourBits, bit_bytes, name));
   const Bytes& bits = set[kContourBits];
-  for (const std::uint8_t b : bits) contour_count += static_cast<unsigned>(std::popcount(b));
+  for (const std::uint8_t b : bits) contour_count += CountBits8(b);
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourThickness, contour_count, name));
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourPosition, contour_count, name));
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourNormals, 3 * contour_count, name));

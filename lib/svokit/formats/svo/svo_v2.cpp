@@ -8,6 +8,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "svokit/core/bit_count.hpp"
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/morton.hpp"
@@ -103,8 +104,7 @@ std::unique_ptr<Version2Writer> MakeVersion2(const CompactSvo& svo,
       for (std::uint32_t l = page_level; l < svo.depth; ++l) {
         const auto& masks = svo.tree.masks[l];
         const auto& firsts = svo.tree.first_child[l];
-        const std::uint64_t nb = firsts[b],
-                            ne = firsts[e - 1] + static_cast<unsigned>(std::popcount(masks[e - 1]));
+        const std::uint64_t nb = firsts[b], ne = firsts[e - 1] + CountBits8(masks[e - 1]);
         b = nb;
         e = ne;
       }
