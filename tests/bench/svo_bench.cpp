@@ -1,6 +1,7 @@
-// Octree build stages in one process, on voxels made once: the structure alone, 3³ bricks,
-// contours, and all together (what mesh2svo's "bricks" and "contours" stages time, without the
-// process, import, voxelization and write around them).
+// Octree build stages in one process, on voxels made once (colours and normals): the structure
+// alone, 3³ bricks, contours, and all together, as mesh2svo builds them (BuildCompactSvo: what its
+// "octree", "bricks" and "contours" stages time, without the process, import, voxelization and
+// write around them); and the per-node reference builder (BuildSvo, version 1's octree) in full.
 //
 //   svo_bench --resolution N MESH... [benchmark flags]
 
@@ -9,6 +10,7 @@
 
 #include "bench_main.hpp"
 #include "svokit/svo/build.hpp"
+#include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {
@@ -20,23 +22,29 @@ struct Scene {
 };
 std::vector<Scene> g_scenes;
 
-void Build(benchmark::State& state, const Scene* scene, std::uint32_t brick_side, bool contours) {
+void Build(benchmark::State& state, const Scene* scene, std::uint32_t brick_side, bool contours,
+           bool reference) {
   svokit::BuildOptions options;
   options.brick_side = brick_side;
   options.contours = contours;
-  std::size_t nodes = 0;
   for (auto _ : state) {
-    auto svo = svokit::BuildSvo(scene->voxels, &scene->mesh, options);
-    if (!svo.ok()) {
-      state.SkipWithError(svo.status().message().c_str());
-      return;
+    if (reference) {
+      auto svo = svokit::BuildSvo(scene->voxels, &scene->mesh, options);
+      if (!svo.ok()) {
+        state.SkipWithError(svo.status().message().c_str());
+        return;
+      }
+      benchmark::DoNotOptimize(svo->levels.data());
+    } else {
+      auto svo = svokit::BuildCompactSvo(scene->voxels, &scene->mesh, options);
+      if (!svo.ok()) {
+        state.SkipWithError(svo.status().message().c_str());
+        return;
+      }
+      benchmark::DoNotOptimize(svo->tree.masks.data());
     }
-    nodes = 0;
-    for (const auto& level : svo->levels) nodes += level.node_count;
-    benchmark::DoNotOptimize(svo->levels.data());
   }
   state.counters["voxels"] = static_cast<double>(scene->voxels.size());
-  state.counters["nodes"] = static_cast<double>(nodes);
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(scene->voxels.size()));
 }
 
@@ -47,7 +55,9 @@ int main(int argc, char** argv) {
     for (const std::string& f : inputs.files) {
       auto scene = svokit::bench::LoadScene(f, inputs.resolution);
       if (!scene.ok()) return scene.status();
-      auto voxels = svokit::Voxelize(scene->mesh, scene->grid, svokit::VoxelizeOptions{});
+      svokit::VoxelizeOptions vo;
+      vo.colors = vo.normals = true;
+      auto voxels = svokit::Voxelize(scene->mesh, scene->grid, vo);
       if (!voxels.ok()) return voxels.status();
       g_scenes.push_back({scene->name, std::move(scene->mesh), std::move(voxels).value()});
     }
@@ -59,8 +69,9 @@ int main(int argc, char** argv) {
       } variants[] = {
           {"octree", 0, false}, {"bricks", 3, false}, {"contours", 0, true}, {"full", 3, true}};
       for (const auto& v : variants) {
-        svokit::bench::Register(s.name + "/" + v.name, Build, &s, v.brick_side, v.contours);
+        svokit::bench::Register(s.name + "/" + v.name, Build, &s, v.brick_side, v.contours, false);
       }
+      svokit::bench::Register(s.name + "/reference_full", Build, &s, 3u, true, true);
     }
     return svokit::Status::Ok();
   });

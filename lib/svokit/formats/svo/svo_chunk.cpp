@@ -91,15 +91,20 @@ void FromDeltaLanes(std::span<const std::uint8_t> bytes, std::vector<T, A>& valu
   }
 }
 
-// Brick sample normals (two 8-bit octahedral codes) of the non-empty samples: per code, the
-// difference to the previous sample's, in two planes.
-Bytes DeltaCodes(std::span<const std::uint16_t> normals) {
-  Bytes out(normals.size() * 2);
-  std::uint16_t previous = 0;
-  for (std::size_t i = 0; i < normals.size(); ++i) {
-    out[i] = static_cast<std::uint8_t>((normals[i] & 0xff) - (previous & 0xff));
-    out[normals.size() + i] = static_cast<std::uint8_t>((normals[i] >> 8) - (previous >> 8));
-    previous = normals[i];
+// Brick sample colours (RGBA8) and normals (two 8-bit octahedral codes) of the non-empty
+// samples: per byte, the difference to the previous sample's (mod 256), in byte planes. Samples
+// follow the nodes' Morton order, so neighbours in the stream are near in space.
+template <class T>
+Bytes DeltaBytes(std::span<const T> values) {
+  Bytes out(values.size() * sizeof(T));
+  std::uint8_t previous[sizeof(T)] = {};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, &values[i], sizeof(T));
+    for (std::size_t k = 0; k < sizeof(T); ++k) {
+      out[k * values.size() + i] = static_cast<std::uint8_t>(b[k] - previous[k]);
+      previous[k] = b[k];
+    }
   }
   return out;
 }
@@ -213,8 +218,8 @@ SampleStreams SplitSamples(const SvoChunk& chunk) {
       if (!level.normal.empty()) normals.push_back(level.normal[i]);
     }
   }
-  s.colors = Planes(std::span<const std::uint32_t>(colors));
-  s.normals = DeltaCodes(normals);
+  s.colors = DeltaBytes(std::span<const std::uint32_t>(colors));
+  s.normals = DeltaBytes(std::span<const std::uint16_t>(normals));
   return s;
 }
 
@@ -493,7 +498,7 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kColors, shape.has_color ? 4 * filled : 0, name));
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kNormals, shape.has_normal ? 2 * filled : 0, name));
   std::uint64_t sample = 0, nonempty = 0;
-  std::uint16_t previous_normal = 0;
+  std::uint8_t color[4] = {}, normal[2] = {};  // the previous non-empty sample's bytes
   for (std::uint32_t k = 0; k < sample_levels; ++k) {
     LevelSamples& s = chunk.samples.emplace_back();
     const std::uint64_t n = chunk.layouts[k].size();
@@ -504,16 +509,16 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
     for (std::uint64_t i = 0; i < n; ++i) {
       if (s.opacity[i] == 0) continue;
       if (shape.has_color) {
-        std::uint8_t b[4];
-        for (int c = 0; c < 4; ++c) b[c] = set[kColors][c * filled + nonempty];
-        std::memcpy(&s.color[i], b, 4);
+        for (int c = 0; c < 4; ++c) {
+          color[c] = static_cast<std::uint8_t>(color[c] + set[kColors][c * filled + nonempty]);
+        }
+        std::memcpy(&s.color[i], color, 4);
       }
       if (shape.has_normal) {
-        const std::uint8_t lo =
-            static_cast<std::uint8_t>((previous_normal & 0xff) + set[kNormals][nonempty]);
-        const std::uint8_t hi =
-            static_cast<std::uint8_t>((previous_normal >> 8) + set[kNormals][filled + nonempty]);
-        s.normal[i] = previous_normal = static_cast<std::uint16_t>(lo | hi << 8);
+        for (int c = 0; c < 2; ++c) {
+          normal[c] = static_cast<std::uint8_t>(normal[c] + set[kNormals][c * filled + nonempty]);
+        }
+        std::memcpy(&s.normal[i], normal, 2);
       }
       ++nonempty;
     }
