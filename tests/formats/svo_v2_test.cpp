@@ -157,6 +157,31 @@ TEST(SvoReader, EveryPageTogetherIsTheWholeTree) {
   }
 }
 
+// Without bricks the voxels' own colours and normals are still the file's, page by page, and
+// no page carries a halo (it exists for the voxel bricks).
+TEST(SvoReader, BricksNoneKeepsTheVoxelsAttributes) {
+  const Built b = Build(test::DataDir() / "uv-torus.obj", 96, 0, true, false);
+  ASSERT_TRUE(b.voxels.has_colors() && b.voxels.colors.size() > 1 && b.voxels.has_normals());
+  const auto bytes = EncodeSvo(b.svo);
+  auto reader = SvoReader::FromBytes(bytes, "t.svo");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  EXPECT_TRUE(reader->shape().has_color && reader->shape().has_normal);
+  EXPECT_EQ(reader->shape().brick_side, 0u);
+  std::size_t voxel = 0;
+  for (std::size_t i = 0; i < reader->page_count(); ++i) {
+    auto page = reader->Page(i);
+    ASSERT_TRUE(page.ok()) << page.status().message();
+    EXPECT_TRUE(page->halo_keys.empty());
+    ASSERT_EQ(page->colors.size(), page->normals.size());
+    for (std::size_t v = 0; v < page->colors.size(); ++v, ++voxel) {
+      ASSERT_LT(voxel, b.voxels.size());
+      EXPECT_TRUE(page->colors[v] == b.voxels.color(voxel)) << voxel;
+      EXPECT_EQ(page->normals[v].bits, b.voxels.normals[voxel].bits) << voxel;
+    }
+  }
+  EXPECT_EQ(voxel, b.voxels.size());
+}
+
 // The pages a box selects hold exactly the tree's voxels inside the box (and others of their
 // pages): random boxes, against a filter of all the voxels.
 TEST(SvoReader, PagesInABoxHoldTheVoxelsInsideIt) {
