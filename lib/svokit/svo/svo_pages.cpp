@@ -118,31 +118,28 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
   const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t local,
                          std::uint64_t global, const Neighbourhood& local_nb,
                          const Neighbourhood& global_nb, std::uint64_t node_key) -> void {
-    if (bricks) {
-      const std::size_t k = l - page_level;
-      const SampleLayout& layout = chunk.layouts[k];
-      const layout_detail::SideTable& t = layout_detail::TableFor(side);
-      const std::uint32_t orphans = layout.orphans[local];
-      std::uint64_t next = layout.first[local] + t.home_count;
-      for (unsigned s = 0; s < n; ++s) {
-        std::uint64_t to;
-        if (t.is_home[s]) {
-          to = layout.first[local] + t.index[s];
-        } else if (orphans >> t.index[s] & 1u) {
-          to = next++;
-        } else {
-          continue;
-        }
-        const std::uint64_t from = SampleIndex(svo.layouts[l], global_nb, s);
-        const LevelSamples& in = svo.samples[l];
-        LevelSamples& out = chunk.samples[k];
-        out.opacity[to] = in.opacity[from];
-        if (!out.color.empty()) out.color[to] = in.color[from];
-        if (!out.normal.empty()) out.normal[to] = in.normal[from];
+    const std::size_t k = l - page_level;
+    const SampleLayout& layout = chunk.layouts[k];
+    const layout_detail::SideTable& t = layout_detail::TableFor(side);
+    const std::uint32_t orphans = layout.orphans[local];
+    std::uint64_t next = layout.first[local] + t.home_count;
+    for (unsigned s = 0; s < n; ++s) {
+      std::uint64_t to;
+      if (t.is_home[s]) {
+        to = layout.first[local] + t.index[s];
+      } else if (orphans >> t.index[s] & 1u) {
+        to = next++;
+      } else {
+        continue;
       }
+      const std::uint64_t from = SampleIndex(svo.layouts[l], global_nb, s);
+      const LevelSamples& in = svo.samples[l];
+      LevelSamples& out = chunk.samples[k];
+      out.opacity[to] = in.opacity[from];
+      if (!out.color.empty()) out.color[to] = in.color[from];
+      if (!out.normal.empty()) out.normal[to] = in.normal[from];
     }
     if (l + 1 == svo.depth) {
-      if (!bricks) return;  // the halo is for voxel bricks
       const MortonCoord c = MortonDecode(node_key);
       const std::vector<std::uint8_t>& masks = svo.tree.masks[l];
       const std::vector<std::uint64_t>& first = svo.tree.first_child[l];
@@ -190,6 +187,7 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
            ChildNeighbourhood(svo.tree, l, global_nb, ch), node_key << 3 | ch);
     }
   };
+  if (!bricks) return chunk;  // no samples to copy, no halo to find
   Neighbourhood root;
   root.fill(-1);
   root[NeighbourSlot(0, 0, 0)] = 0;
