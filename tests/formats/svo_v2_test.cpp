@@ -12,9 +12,11 @@
 #include <set>
 
 #include "svokit/core/crc32c.hpp"
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
@@ -307,6 +309,41 @@ TEST(SvoFileV2, ADamagedStreamIsAnErrorNamingThePage) {
     EXPECT_EQ(r.status().message().rfind(page_name + ": ", 0), 0u) << r.status().message();
   }
   EXPECT_GT(refused, 0);  // the stream checks do find some (40 of 200 here)
+}
+
+// Stated sizes are refused before anything is allocated for them: one stream over 1 GiB, or a
+// chunk whose streams add up to more than 4 GiB (five frames of 1 GiB, ~30 KB of zstd each,
+// would otherwise be a decompression bomb).
+TEST(SvoFileV2, StatedSizesBeyondTheLimitsAreRefusedFirst) {
+  const auto chunk = [](std::vector<std::uint64_t> raw) {
+    std::vector<std::uint8_t> bytes = {static_cast<std::uint8_t>(raw.size())};
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      std::uint8_t varint[10];
+      bytes.push_back(static_cast<std::uint8_t>(i + 1));  // kinds 1, 2, …
+      bytes.push_back(1);                                 // zstd
+      bytes.insert(bytes.end(), varint, varint + PutVarint(raw[i], varint));
+      bytes.insert(bytes.end(), varint, varint + PutVarint(4, varint));
+    }
+    bytes.resize(bytes.size() + 4 * raw.size(), 0);
+    return bytes;
+  };
+  SvoShape shape;
+  shape.depth = 4;
+  const ChunkFrame frame{0, 0, 4, false};
+  const std::uint64_t gib = std::uint64_t{1} << 30;
+  auto one = DecodeChunk(chunk({gib + 1}), shape, frame, "t.svo: top chunk");
+  ASSERT_FALSE(one.ok());
+  EXPECT_NE(one.status().message().find("a stream may hold"), std::string::npos)
+      << one.status().message();
+  auto five = DecodeChunk(chunk({gib, gib, gib, gib, gib}), shape, frame, "t.svo: top chunk");
+  ASSERT_FALSE(five.ok());
+  EXPECT_NE(five.status().message().find("a chunk may hold"), std::string::npos)
+      << five.status().message();
+  // Within the limits, the same garbage is refused as a stream that does not decompress.
+  auto small = DecodeChunk(chunk({64}), shape, frame, "t.svo: top chunk");
+  ASSERT_FALSE(small.ok());
+  EXPECT_NE(small.status().message().find("does not decompress"), std::string::npos)
+      << small.status().message();
 }
 
 TEST(SvoFileV2, VersionOneFilesStillRead) {

@@ -49,9 +49,14 @@ struct SvoChunk {
 /// holds at most this many (formats/svo/README.md, "Pages": why).
 inline constexpr std::uint64_t kPageVoxels = std::uint64_t{1} << 15;
 
+/// No page holds more nodes than this (all its levels): every stream of the largest page then
+/// decodes to well under a reader's per-stream limit (formats/svo/README.md, "Invariants").
+inline constexpr std::uint64_t kMaxPageNodes = std::uint64_t{1} << 22;
+
 /// The page level of an octree: the shallowest level (below depth) whose nodes hold at most
-/// kPageVoxels voxels on average, or 0 for a small octree.
-std::uint32_t PageLevel(const CompactSvo& svo);
+/// kPageVoxels voxels on average and whose largest subtree has at most `max_page_nodes` nodes,
+/// or 0 for a small octree.
+std::uint32_t PageLevel(const CompactSvo& svo, std::uint64_t max_page_nodes = kMaxPageNodes);
 
 /// The top chunk: levels 0 .. page_level − 1 with every level's samples and contours, and the
 /// masks of level page_level − 1, which name the pages. Empty (no levels) when page_level is 0.

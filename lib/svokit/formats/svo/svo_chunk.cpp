@@ -301,6 +301,7 @@ class StreamSet {
     };
     std::vector<Entry> entries;
     std::uint8_t last_kind = 0;
+    std::uint64_t total = 0;
     for (unsigned i = 0; i < count; ++i) {
       Entry e{};
       if (end - p < 2) return Status::BadInput("{}: stream directory runs past the chunk", name);
@@ -316,6 +317,18 @@ class StreamSet {
         return Status::BadInput("{}: stream {} has an unknown codec or inconsistent sizes", name,
                                 e.kind);
       }
+      // Sizes a damaged or hostile directory states must not allocate without bound: a stream
+      // decodes to at most kStreamLimit bytes, a chunk to kChunkLimit (writers keep pages far
+      // below: kMaxPageNodes).
+      if (e.raw > kStreamLimit) {
+        return Status::BadInput("{}: stream {} claims {} bytes, more than the {} a stream may hold",
+                                name, e.kind, e.raw, kStreamLimit);
+      }
+      total += e.raw;
+      if (total > kChunkLimit) {
+        return Status::BadInput("{}: streams claim more than the {} bytes a chunk may hold", name,
+                                kChunkLimit);
+      }
       last_kind = e.kind;
       entries.push_back(e);
     }
@@ -324,11 +337,6 @@ class StreamSet {
         return Status::BadInput("{}: stream {} runs past the chunk", name, e.kind);
       }
       Bytes& out = set.streams_[e.kind];
-      // A stream decodes to at most 1 GiB per chunk (pages are a few hundred kilobytes): a size
-      // read from a damaged directory must not allocate without bound.
-      if (e.raw > (std::uint64_t{1} << 30)) {
-        return Status::BadInput("{}: stream {} claims {} bytes", name, e.kind, e.raw);
-      }
       if (e.codec == kStored) {
         out.assign(p, p + e.stored);
       } else {

@@ -35,6 +35,11 @@ std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& sha
 /// What each array of a chunk takes, from its stream directory alone (nothing decompressed).
 StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const std::string& name);
 
+/// What one stream and one chunk may decode to: the bound on what a file's stated sizes can make
+/// a reader allocate (a page of kMaxPageNodes nodes stays far below).
+inline constexpr std::uint64_t kStreamLimit = std::uint64_t{1} << 30;
+inline constexpr std::uint64_t kChunkLimit = std::uint64_t{4} << 30;
+
 /// What a decoder knows of a chunk before reading it: where its root is and which levels it holds
 /// (top chunk: root 0, levels 0 .. P − 1, masks down to P − 1; page: root at P, levels P ..
 /// depth, masks down to depth − 1).
