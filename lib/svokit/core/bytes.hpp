@@ -60,6 +60,7 @@ class ByteReader {
     static_assert(std::is_trivially_copyable_v<T>);
     if (count > remaining() / sizeof(T)) return Overrun(count * sizeof(T));
     values.resize(count);
+    if (count == 0) return Status::Ok();  // an empty vector's data() may be null: no memcpy
     std::memcpy(values.data(), bytes_.data() + pos_, count * sizeof(T));
     pos_ += count * sizeof(T);
     return Status::Ok();
