@@ -1,7 +1,6 @@
 #include "svokit/svo/svo_pages.hpp"
 
 #include <algorithm>
-#include <bit>
 
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/build.hpp"
@@ -9,10 +8,6 @@
 namespace svokit {
 
 namespace {
-
-unsigned Popcount(std::uint8_t m) {
-  return CountBits8(m);
-}
 
 // The nodes of levels first .. last of the subtree of node `root` of level first: a contiguous
 // range per level (each level is in Morton order).
@@ -25,7 +20,7 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> SubtreeRanges(const MaskTre
     const auto [begin, end] = ranges.back();
     const std::vector<std::uint8_t>& masks = tree.masks[l - tree.first_level];
     const std::vector<std::uint64_t>& children = tree.first_child[l - tree.first_level];
-    ranges.push_back({children[begin], children[end - 1] + Popcount(masks[end - 1])});
+    ranges.push_back({children[begin], children[end - 1] + CountBits8(masks[end - 1])});
   }
   return ranges;
 }
