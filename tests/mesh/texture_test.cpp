@@ -2,6 +2,9 @@
 
 #include <unistd.h>
 
+#include <string>
+#include <string_view>
+
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
@@ -85,36 +88,83 @@ TEST(Texture, DecodesItsOwnBytesNotAFileOfTheSameName) {
   EXPECT_EQ(failure, "");
 }
 
-// A PNG header may declare any size: one over the limit is refused before any pixel is decoded.
+// A PNG header may declare any size: one over the limits is refused before any pixel is decoded.
 TEST(Texture, ImagesOverThePixelLimitAreRefusedUndecoded) {
-  // Signature and IHDR of a 100000 × 100000 RGB image, then an empty IDAT and IEND.
-  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
-  const auto chunk = [&](const char* type, std::vector<std::uint8_t> data) {
-    const std::uint32_t n = static_cast<std::uint32_t>(data.size());
-    for (int shift = 24; shift >= 0; shift -= 8)
-      png.push_back(static_cast<std::uint8_t>(n >> shift));
-    std::vector<std::uint8_t> body(type, type + 4);
-    body.insert(body.end(), data.begin(), data.end());
-    std::uint32_t crc = 0xffffffffu;  // zlib's CRC-32, bit by bit
-    for (std::uint8_t b : body) {
-      crc ^= b;
-      for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
-    }
-    crc ^= 0xffffffffu;
-    png.insert(png.end(), body.begin(), body.end());
-    for (int shift = 24; shift >= 0; shift -= 8)
-      png.push_back(static_cast<std::uint8_t>(crc >> shift));
+  // Signature and IHDR of a width × height RGB image, then an empty IDAT and IEND.
+  const auto png_header = [](std::uint32_t width, std::uint32_t height) {
+    std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+    const auto be32 = [](std::vector<std::uint8_t>& out, std::uint32_t v) {
+      for (int shift = 24; shift >= 0; shift -= 8)
+        out.push_back(static_cast<std::uint8_t>(v >> shift));
+    };
+    const auto chunk = [&](const char* type, std::vector<std::uint8_t> data) {
+      be32(png, static_cast<std::uint32_t>(data.size()));
+      std::vector<std::uint8_t> body(type, type + 4);
+      body.insert(body.end(), data.begin(), data.end());
+      std::uint32_t crc = 0xffffffffu;  // zlib's CRC-32, bit by bit
+      for (std::uint8_t b : body) {
+        crc ^= b;
+        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+      }
+      png.insert(png.end(), body.begin(), body.end());
+      be32(png, crc ^ 0xffffffffu);
+    };
+    std::vector<std::uint8_t> ihdr;
+    be32(ihdr, width), be32(ihdr, height);
+    ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});
+    chunk("IHDR", ihdr);
+    chunk("IDAT", {0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});  // an empty zlib stream
+    chunk("IEND", {});
+    return png;
   };
-  chunk("IHDR", {0, 1, 0x86, 0xa0, 0, 1, 0x86, 0xa0, 8, 2, 0, 0, 0});
-  chunk("IDAT", {0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});  // an empty zlib stream
-  chunk("IEND", {});
-  Texture t("bomb.png", png);
+  Texture t("bomb.png", png_header(100000, 100000));
   auto info = t.ReadInfo();
   ASSERT_FALSE(info.ok());
   EXPECT_EQ(info.status().message(),
             "texture 'bomb.png': 100000x100000 pixels with 3 channels, over the limit of "
-            "67108864 pixels and 4 channels");
+            "67108864 pixels, 65536 per side and 4 channels");
   EXPECT_FALSE(t.Decoded().ok());
+  // Few pixels but long rows: OIIO's row buffers would take gigabytes.
+  auto wide = Texture("wide.png", png_header(100000, 3)).ReadInfo();
+  ASSERT_FALSE(wide.ok());
+  EXPECT_EQ(wide.status().message(),
+            "texture 'wide.png': 100000x3 pixels with 3 channels, over the limit of "
+            "67108864 pixels, 65536 per side and 4 channels");
+  EXPECT_TRUE(Texture("limit.png", png_header(1u << 16, 3)).ReadInfo().ok());
+}
+
+// OIIO's BMP reader decodes RLE inside open(), and OpenEXR allocates each header attribute at its
+// declared size: both headers are checked against the limits before OIIO sees them.
+TEST(Texture, HeadersThatAllocateOnOpenAreCheckedFirst) {
+  const auto le32 = [](std::vector<std::uint8_t>& out, std::uint32_t v) {
+    for (int shift = 0; shift < 32; shift += 8)
+      out.push_back(static_cast<std::uint8_t>(v >> shift));
+  };
+  // An 8-bit RLE BMP of 4 × 2^28 pixels in 1,094 bytes: header, a 256-colour table, RLE codes.
+  std::vector<std::uint8_t> bmp = {'B', 'M'};
+  le32(bmp, 1094), le32(bmp, 0), le32(bmp, 1078), le32(bmp, 40), le32(bmp, 4), le32(bmp, 1u << 28);
+  bmp.insert(bmp.end(), {1, 0, 8, 0});  // planes, bits per pixel
+  le32(bmp, 1);                         // BI_RLE8
+  for (int k = 0; k < 5; ++k) le32(bmp, 0);
+  bmp.insert(bmp.end(), 1024, 0x80);
+  bmp.insert(bmp.end(), {4, 1, 0, 0, 4, 1, 0, 0, 4, 1, 0, 0, 4, 1, 0, 1});
+  auto bmp_info = Texture("bomb.bmp", bmp).ReadInfo();
+  ASSERT_FALSE(bmp_info.ok());
+  EXPECT_EQ(bmp_info.status().message(),
+            "texture 'bomb.bmp': cannot decode (BMP header declares 4x268435456 pixels, over the "
+            "limit of 67108864 pixels or 65536 per side)");
+
+  // An OpenEXR header whose first attribute, of a type OpenEXR keeps opaque, declares 2 GiB - 1.
+  std::vector<std::uint8_t> exr;
+  le32(exr, 20000630), le32(exr, 2);
+  for (const char c : std::string_view("bomb\0bombtype\0", 14)) exr.push_back(c);
+  le32(exr, 0x7fffffff);
+  exr.insert(exr.end(), 32, 0);
+  auto exr_info = Texture("bomb.exr", exr).ReadInfo();
+  ASSERT_FALSE(exr_info.ok());
+  EXPECT_EQ(exr_info.status().message(),
+            "texture 'bomb.exr': cannot decode (OpenEXR attribute 'bomb' declares 2147483647 "
+            "bytes, more than the file holds)");
 }
 
 }  // namespace

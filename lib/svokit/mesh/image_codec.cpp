@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <climits>
 #include <filesystem>
 #include <mutex>
@@ -85,7 +86,11 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
   char error[512] = {};
   if (plugin.decode(name.c_str(), bytes.data(), bytes.size(), &h, pixels, pixel_count, error,
                     sizeof error) != 0) {
-    return Status::BadInput("texture '{}': cannot decode ({})", name, error);
+    // Readers report one problem per line (OpenEXR's core a whole chain): the error is one line.
+    std::string message = error;
+    while (!message.empty() && message.back() == '\n') message.pop_back();
+    std::replace(message.begin(), message.end(), '\n', ';');
+    return Status::BadInput("texture '{}': cannot decode ({})", name, message);
   }
   header = {h.width, h.height, h.channels, h.is_float != 0, h.format};
   if (h.width <= 0 || h.height <= 0 || h.channels <= 0) {
@@ -93,11 +98,12 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
   }
   const auto pixels_in_image =
       static_cast<std::uint64_t>(h.width) * static_cast<std::uint64_t>(h.height);
-  if (pixels_in_image > kImagePixelLimit || h.channels > 4) {
+  if (pixels_in_image > kImagePixelLimit || h.width > kImageSideLimit ||
+      h.height > kImageSideLimit || h.channels > 4) {
     return Status::BadInput(
-        "texture '{}': {}x{} pixels with {} channels, over the limit of {} "
-        "pixels and 4 channels",
-        name, h.width, h.height, h.channels, kImagePixelLimit);
+        "texture '{}': {}x{} pixels with {} channels, over the limit of {} pixels, {} per side "
+        "and 4 channels",
+        name, h.width, h.height, h.channels, kImagePixelLimit, kImageSideLimit);
   }
   return Status::Ok();
 }

@@ -23,8 +23,12 @@ struct ImageHeader {
 /// The most pixels an image may have (8192², 1 GiB as floats with 4 channels): a few bytes of
 /// PNG header may declare any size, and decoding allocates before it reads.
 inline constexpr std::uint64_t kImagePixelLimit = std::uint64_t{1} << 26;
+/// The widest or tallest image: OIIO converts 64 rows at a time, so a 2^24 × 3 image would
+/// take 16 GB of scratch.
+inline constexpr std::int64_t kImageSideLimit = std::int64_t{1} << 16;
 
-/// Header only (no pixel decoding); an image over kImagePixelLimit or 4 channels is bad input.
+/// Header only (no pixel decoding); an image over kImagePixelLimit, kImageSideLimit or 4 channels
+/// is bad input.
 /// `name` is a format hint (file name or URI).
 StatusOr<ImageHeader> ReadImageHeader(const std::string& name, std::span<const std::uint8_t> bytes);
 /// All pixels as floats, width × height × channels, row 0 at the top.

@@ -10,14 +10,106 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "svokit/mesh/image_codec.hpp"
 
 namespace {
+
+std::uint32_t LoadLE32(const std::uint8_t* p) {
+  return p[0] | p[1] << 8 | p[2] << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+
+std::string OverLimit(const char* what, std::int64_t width, std::int64_t height) {
+  return std::string(what) + " declares " + std::to_string(width) + "x" + std::to_string(height) +
+         " pixels, over the limit of " + std::to_string(svokit::kImagePixelLimit) + " pixels or " +
+         std::to_string(svokit::kImageSideLimit) + " per side";
+}
+
+// A negative size is the reader's to refuse.
+bool TooManyPixels(std::int64_t width, std::int64_t height) {
+  return width > svokit::kImageSideLimit || height > svokit::kImageSideLimit ||
+         (width > 0 && height > 0 &&
+          static_cast<std::uint64_t>(width * height) > svokit::kImagePixelLimit);
+}
+
+// OIIO's BMP reader decodes an RLE image inside open(), sized by the header alone.
+std::string CheckBmpHeader(const std::uint8_t* bytes, std::size_t size) {
+  if (size < 26 || bytes[0] != 'B' || bytes[1] != 'M') return {};
+  std::int64_t width, height;
+  if (LoadLE32(bytes + 14) == 12) {  // OS/2 1.x: 16-bit sizes
+    width = bytes[18] | bytes[19] << 8;
+    height = static_cast<std::int16_t>(bytes[20] | bytes[21] << 8);
+  } else {
+    width = static_cast<std::int32_t>(LoadLE32(bytes + 18));
+    height = static_cast<std::int32_t>(LoadLE32(bytes + 22));
+  }
+  return TooManyPixels(width, std::abs(height)) ? OverLimit("BMP header", width, height)
+                                                : std::string();
+}
+
+// OpenEXR (its core library too) allocates each header attribute at its declared size before it
+// reads it: every attribute must fit in the bytes that are left, the windows and tiles in the
+// pixel limits.
+std::string CheckExrHeader(const std::uint8_t* bytes, std::size_t size) {
+  if (size < 8 || LoadLE32(bytes) != 20000630) return {};
+  const bool multipart = (LoadLE32(bytes + 4) & 0x1000) != 0;
+  std::size_t at = 8;
+  const auto read_name = [&](std::string& name) {
+    const auto* end = static_cast<const std::uint8_t*>(std::memchr(bytes + at, 0, size - at));
+    if (!end) return false;
+    name.assign(reinterpret_cast<const char*>(bytes + at), end - (bytes + at));
+    at = static_cast<std::size_t>(end - bytes) + 1;
+    return true;
+  };
+  std::string name, type;
+  for (int empty_names = 0; at < size;) {
+    if (!read_name(name)) return {};
+    if (name.empty()) {
+      // A single-part header ends at its first empty name; a multipart list at two in a row.
+      if (!multipart || ++empty_names == 2) return {};
+      continue;
+    }
+    empty_names = 0;
+    if (!read_name(type) || size - at < 4) return {};
+    const auto value_size = static_cast<std::int32_t>(LoadLE32(bytes + at));
+    at += 4;
+    if (value_size < 0 || static_cast<std::size_t>(value_size) > size - at) {
+      return "OpenEXR attribute '" + name + "' declares " + std::to_string(value_size) +
+             " bytes, more than the file holds";
+    }
+    const std::uint8_t* value = bytes + at;
+    if ((name == "dataWindow" || name == "displayWindow") && type == "box2i" && value_size == 16) {
+      const std::int64_t width = std::int64_t{static_cast<std::int32_t>(LoadLE32(value + 8))} -
+                                 static_cast<std::int32_t>(LoadLE32(value)) + 1;
+      const std::int64_t height = std::int64_t{static_cast<std::int32_t>(LoadLE32(value + 12))} -
+                                  static_cast<std::int32_t>(LoadLE32(value + 4)) + 1;
+      if (TooManyPixels(width, height))
+        return OverLimit(("OpenEXR " + name).c_str(), width, height);
+    }
+    if (name == "tiles" && type == "tiledesc" && value_size >= 8 &&
+        TooManyPixels(LoadLE32(value), LoadLE32(value + 4))) {
+      return OverLimit("OpenEXR tile", LoadLE32(value), LoadLE32(value + 4));
+    }
+    at += static_cast<std::size_t>(value_size);
+  }
+  return {};
+}
+
+// The headers whose readers allocate what they declare before OIIO returns the spec that
+// ReadImageHeader checks.
+std::string CheckDeclaredSizes(std::string_view format, const std::uint8_t* bytes,
+                               std::size_t size) {
+  if (format == "bmp") return CheckBmpHeader(bytes, size);
+  if (format == "openexr") return CheckExrHeader(bytes, size);
+  return {};
+}
 
 // The reader the name's extension picks decodes the bytes from memory, through an IOProxy, or,
 // for a format whose reader cannot, from an unnamed in-memory file (memfd): the bytes never go
@@ -26,12 +118,18 @@ class EncodedImageReader {
  public:
   EncodedImageReader(const std::string& name, const std::uint8_t* bytes, std::size_t size)
       : reader_(bytes, size) {
+    // OpenEXR's core library reads each attribute by its declared size (checked above); its C++
+    // reader reads known types by their own size and loses its place in a misdeclared header.
+    static const bool exr_core = OIIO::attribute("openexr:core", 1);
+    (void)exr_core;
     const std::string ext = OIIO::Filesystem::extension(name);
     // A format name ("png"): given a file name, create() would try to open that file.
     input_ = OIIO::ImageInput::create(ext.empty() ? name : ext.substr(1));
     OIIO::ImageSpec spec;
     if (!input_) {
       error_ = "unknown or unsupported image format";
+    } else if (error_ = CheckDeclaredSizes(input_->format_name(), bytes, size); !error_.empty()) {
+      input_.reset();
     } else if (input_->supports("ioproxy")) {
       if (!input_->set_ioproxy(&reader_) || !input_->open(name, spec)) Fail();
     } else {
