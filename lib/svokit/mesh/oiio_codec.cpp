@@ -54,9 +54,9 @@ std::string CheckBmpHeader(const std::uint8_t* bytes, std::size_t size) {
                                                 : std::string();
 }
 
-// OpenEXR (its core library too) allocates each header attribute at its declared size before it
-// reads it: every attribute must fit in the bytes that are left, the windows and tiles in the
-// pixel limits.
+// OpenEXR allocates each header attribute at its declared size before it reads it: in a header
+// whose attributes are framed as declared, each must fit in the bytes left, the windows and tiles
+// in the pixel limits. (Misframed, OpenEXR fails on a read into at most 2 GiB it never touches.)
 std::string CheckExrHeader(const std::uint8_t* bytes, std::size_t size) {
   if (size < 8 || LoadLE32(bytes) != 20000630) return {};
   const bool multipart = (LoadLE32(bytes + 4) & 0x1000) != 0;
@@ -118,10 +118,6 @@ class EncodedImageReader {
  public:
   EncodedImageReader(const std::string& name, const std::uint8_t* bytes, std::size_t size)
       : reader_(bytes, size) {
-    // OpenEXR's core library reads each attribute by its declared size (checked above); its C++
-    // reader reads known types by their own size and loses its place in a misdeclared header.
-    static const bool exr_core = OIIO::attribute("openexr:core", 1);
-    (void)exr_core;
     const std::string ext = OIIO::Filesystem::extension(name);
     // A format name ("png"): given a file name, create() would try to open that file.
     input_ = OIIO::ImageInput::create(ext.empty() ? name : ext.substr(1));
