@@ -93,17 +93,22 @@ class VoxelTile {
     }
   }
 
-  // The decoded voxel-level sample at half-voxel coordinates h, as a tent reads it; the zero
-  // sample where no voxel holds the point (most taps), without touching the point table.
+  // The decoded voxel-level sample at half-voxel coordinates h, as a tent reads it (the zero
+  // sample where no voxel holds the point), computed once per tile.
   const PremultipliedSample& Decoded(int hx, int hy, int hz) {
-    static const PremultipliedSample kEmpty{};
     const int h[3] = {hx, hy, hz};
+    Point& point = PointAt(h);
+    if (point.decoded_stamp == stamp_) return point.decoded;
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = FloorHalf(h[a] - 1);  // ⌈(h − 2)/2⌉
       hi[a] = FloorHalf(h[a]);
     }
-    if (!AnyPresent(lo, hi)) return kEmpty;
+    if (!AnyPresent(lo, hi)) {
+      point.decoded = {};
+      point.decoded_stamp = stamp_;
+      return point.decoded;
+    }
     Point& p = Compute(h, lo, hi);
     if (p.decoded_stamp != stamp_) {
       p.decoded_stamp = stamp_;
@@ -162,10 +167,14 @@ class VoxelTile {
 
   // The mean over the voxels whose closed cube holds the point (absent ones count as empty),
   // summed in z, y, x order and scaled, as FilterBricks computes it, then encoded.
-  Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
+  Point& PointAt(const int h[3]) {
     const int points = 2 * width_ + 5;
-    Point& p =
-        point_[static_cast<std::size_t>((h[0] + 2) + points * ((h[1] + 2) + points * (h[2] + 2)))];
+    return point_[static_cast<std::size_t>((h[0] + 2) +
+                                           points * ((h[1] + 2) + points * (h[2] + 2)))];
+  }
+
+  Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
+    Point& p = PointAt(h);
     if (p.stamp == stamp_) return p;
     p.stamp = stamp_;
     Voxel* contributors[8];
@@ -401,13 +410,13 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
         int origin[3];
         for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
         const int step = side == 3 ? 1 : 2;
-        StoreNodeSamples(
-            side, layout.orphans[i],
-            [&](int x, int y, int z) -> const PremultipliedSample& {
-              return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
-                                  origin[2] + step * (z - 1));
-            },
-            f, out, layout.first[i]);
+        const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
+          return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
+                              origin[2] + step * (z - 1));
+        };
+        // The orphans' tents share taps with the home samples' and each other's.
+        TapCache taps(decoded);
+        StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
       });
 }
 
