@@ -30,6 +30,15 @@ void AppendTo(std::vector<T, A>& to, const std::vector<T, A>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
+template <class T, class A>
+void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
+  if (to.empty()) {
+    to = std::move(from);
+  } else {
+    to.insert(to.end(), from.begin(), from.end());
+  }
+}
+
 }  // namespace
 
 std::vector<std::uint64_t> ChunkVoxelKeys(const SvoChunk& chunk) {
@@ -255,7 +264,22 @@ SvoAssembler::SvoAssembler(const SvoShape& shape, std::uint32_t max_level)
       words_(shape.depth + 1),
       levels_(shape.depth + 1) {}
 
-void SvoAssembler::Append(const SvoChunk& chunk) {
+std::vector<SvoLevel> SvoAssembler::Bricks(const SvoChunk& chunk) const {
+  std::vector<SvoLevel> bricks;
+  if (shape_.brick_side == 0) return bricks;
+  for (std::uint32_t k = 0; k < chunk.levels_held() && chunk.root_level + k <= max_level_; ++k) {
+    const std::uint32_t l = chunk.root_level + k;
+    SvoLevel& level = bricks.emplace_back();
+    if (l < shape_.depth) {
+      AssembleBricks(chunk.tree, l, chunk.layouts[k], chunk.samples[k], level);
+    } else {
+      ChunkVoxelBricks(chunk, shape_, level);
+    }
+  }
+  return bricks;
+}
+
+void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
   // Contours one level further than the octree: they say which children have one.
   const std::uint32_t held = chunk.levels_held();
   for (std::uint32_t k = 0; k < held && chunk.root_level + k <= max_level_ + 1; ++k) {
@@ -264,15 +288,9 @@ void SvoAssembler::Append(const SvoChunk& chunk) {
     if (l > max_level_) continue;
     if (l < shape_.depth) AppendTo(masks_[l], chunk.tree.masks[k]);
     if (shape_.brick_side == 0) continue;
-    SvoLevel bricks;
-    if (l < shape_.depth) {
-      AssembleBricks(chunk.tree, l, chunk.layouts[k], chunk.samples[k], bricks);
-    } else {
-      ChunkVoxelBricks(chunk, shape_, bricks);
-    }
-    AppendTo(levels_[l].opacity, bricks.opacity);
-    AppendTo(levels_[l].color, bricks.color);
-    AppendTo(levels_[l].normal, bricks.normal);
+    AppendTo(levels_[l].opacity, std::move(bricks[k].opacity));
+    AppendTo(levels_[l].color, std::move(bricks[k].color));
+    AppendTo(levels_[l].normal, std::move(bricks[k].normal));
   }
 }
 

@@ -83,8 +83,12 @@ class SvoAssembler {
  public:
   /// An octree of the levels 0 .. max_level (at most the depth).
   SvoAssembler(const SvoShape& shape, std::uint32_t max_level);
-  /// Appends the levels `chunk` holds, down to max_level.
-  void Append(const SvoChunk& chunk);
+  /// The bricks of the levels `chunk` holds, down to max_level: the costly part of Append, which
+  /// may run for several chunks at once (it only reads the assembler).
+  std::vector<SvoLevel> Bricks(const SvoChunk& chunk) const;
+  /// Appends the levels `chunk` holds, down to max_level, with their Bricks(chunk).
+  void Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks);
+  void Append(const SvoChunk& chunk) { Append(chunk, Bricks(chunk)); }
   Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
 
  private:

@@ -1,12 +1,15 @@
 // Version 2 of .svo (README.md): GRID, HEAD, the top chunk (TOPL), the pages back to back (PAGE),
-// the page table (PTAB) and META. Pages are encoded in parallel and written in order.
+// the page table (PTAB) and META. Pages are encoded in parallel and written in order; they are
+// decoded in parallel batches and joined in order.
 
 #include <algorithm>
 #include <bit>
 #include <cstring>
 #include <memory>
+#include <optional>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "svokit/core/bit_count.hpp"
 #include "svokit/core/bytes.hpp"
@@ -339,15 +342,28 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   std::vector<Halo> halos;
   DefaultInitVector<HalfRgba> colors;
   DefaultInitVector<OctNormal> normals;
-  if (last + 1 >= v.page_level) {
-    for (std::size_t p = 0; p < v.pages.size(); ++p) {
-      StatusOr<SvoChunk> page = DecodePage(v, p, name, &sink);
+  // Pages decode and assemble their bricks in parallel, a batch at a time, and join the octree
+  // in order; a failed page is decoded again to report it, so the report is in page order too.
+  const std::size_t batch = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  std::vector<std::optional<StatusOr<SvoChunk>>> decoded(batch);
+  std::vector<std::vector<SvoLevel>> bricks(batch);
+  for (std::size_t first = 0; last + 1 >= v.page_level && first < v.pages.size(); first += batch) {
+    const std::size_t count = std::min(batch, v.pages.size() - first);
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
+      decoded[i] = DecodePage(v, first + i, name, nullptr);
+      if (decoded[i]->ok()) bricks[i] = assembler.Bricks(**decoded[i]);
+    });
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t p = first + i;
+      StatusOr<SvoChunk> page = std::move(*decoded[i]);
+      decoded[i].reset();
       if (!page.ok()) {
+        (void)DecodePage(v, p, name, &sink);
         complete = false;
         if (sink.stops()) return false;
         continue;
       }
-      assembler.Append(*page);
+      assembler.Append(*page, std::move(bricks[i]));
       if (last < v.shape.depth) continue;
       // For the checks of the whole voxel set: keys, attributes, halos.
       for (const std::uint64_t key : ChunkVoxelKeys(*page)) voxel_keys.push_back(key);
