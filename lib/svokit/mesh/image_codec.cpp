@@ -96,10 +96,7 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
   if (h.width <= 0 || h.height <= 0 || h.channels <= 0) {
     return Status::BadInput("texture '{}': empty image", name);
   }
-  const auto pixels_in_image =
-      static_cast<std::uint64_t>(h.width) * static_cast<std::uint64_t>(h.height);
-  if (pixels_in_image > kImagePixelLimit || h.width > kImageSideLimit ||
-      h.height > kImageSideLimit || h.channels > 4) {
+  if (OverImageLimits(h.width, h.height) || h.channels > 4) {
     return Status::BadInput(
         "texture '{}': {}x{} pixels with {} channels, over the limit of {} pixels, {} per side "
         "and 4 channels",

@@ -27,6 +27,13 @@ inline constexpr std::uint64_t kImagePixelLimit = std::uint64_t{1} << 26;
 /// take 16 GB of scratch.
 inline constexpr std::int64_t kImageSideLimit = std::int64_t{1} << 16;
 
+/// Whether a width × height image passes kImagePixelLimit or kImageSideLimit (a negative size is
+/// the reader's to refuse).
+inline bool OverImageLimits(std::int64_t width, std::int64_t height) {
+  return width > kImageSideLimit || height > kImageSideLimit ||
+         (width > 0 && height > 0 && static_cast<std::uint64_t>(width * height) > kImagePixelLimit);
+}
+
 /// Header only (no pixel decoding); an image over kImagePixelLimit, kImageSideLimit or 4 channels
 /// is bad input.
 /// `name` is a format hint (file name or URI).

@@ -32,13 +32,6 @@ std::string OverLimit(const char* what, std::int64_t width, std::int64_t height)
          std::to_string(svokit::kImageSideLimit) + " per side";
 }
 
-// A negative size is the reader's to refuse.
-bool TooManyPixels(std::int64_t width, std::int64_t height) {
-  return width > svokit::kImageSideLimit || height > svokit::kImageSideLimit ||
-         (width > 0 && height > 0 &&
-          static_cast<std::uint64_t>(width * height) > svokit::kImagePixelLimit);
-}
-
 // OIIO's BMP reader decodes an RLE image inside open(), sized by the header alone.
 std::string CheckBmpHeader(const std::uint8_t* bytes, std::size_t size) {
   if (size < 26 || bytes[0] != 'B' || bytes[1] != 'M') return {};
@@ -50,8 +43,8 @@ std::string CheckBmpHeader(const std::uint8_t* bytes, std::size_t size) {
     width = static_cast<std::int32_t>(LoadLE32(bytes + 18));
     height = static_cast<std::int32_t>(LoadLE32(bytes + 22));
   }
-  return TooManyPixels(width, std::abs(height)) ? OverLimit("BMP header", width, height)
-                                                : std::string();
+  return svokit::OverImageLimits(width, std::abs(height)) ? OverLimit("BMP header", width, height)
+                                                          : std::string();
 }
 
 // OpenEXR allocates each header attribute at its declared size before it reads it: in a header
@@ -90,11 +83,11 @@ std::string CheckExrHeader(const std::uint8_t* bytes, std::size_t size) {
                                  static_cast<std::int32_t>(LoadLE32(value)) + 1;
       const std::int64_t height = std::int64_t{static_cast<std::int32_t>(LoadLE32(value + 12))} -
                                   static_cast<std::int32_t>(LoadLE32(value + 4)) + 1;
-      if (TooManyPixels(width, height))
+      if (svokit::OverImageLimits(width, height))
         return OverLimit(("OpenEXR " + name).c_str(), width, height);
     }
     if (name == "tiles" && type == "tiledesc" && value_size >= 8 &&
-        TooManyPixels(LoadLE32(value), LoadLE32(value + 4))) {
+        svokit::OverImageLimits(LoadLE32(value), LoadLE32(value + 4))) {
       return OverLimit("OpenEXR tile", LoadLE32(value), LoadLE32(value + 4));
     }
     at += static_cast<std::size_t>(value_size);
