@@ -97,19 +97,16 @@ class VoxelTile {
   // sample where no voxel holds the point), computed once per tile.
   const PremultipliedSample& Decoded(int hx, int hy, int hz) {
     const int h[3] = {hx, hy, hz};
-    Point& point = PointAt(h);
-    if (point.decoded_stamp == stamp_) return point.decoded;
+    Point& p = PointAt(h);
+    if (p.decoded_stamp == stamp_) return p.decoded;
     int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = FloorHalf(h[a] - 1);  // ⌈(h − 2)/2⌉
-      hi[a] = FloorHalf(h[a]);
-    }
+    CellsAround(h, lo, hi);
     if (!AnyPresent(lo, hi)) {
-      point.decoded = {};
-      point.decoded_stamp = stamp_;
-      return point.decoded;
+      p.decoded = {};
+      p.decoded_stamp = stamp_;
+      return p.decoded;
     }
-    Point& p = Compute(h, lo, hi);
+    Compute(p, lo, hi);
     if (p.decoded_stamp != stamp_) {
       p.decoded_stamp = stamp_;
       p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
@@ -122,12 +119,9 @@ class VoxelTile {
   EncodedSample Encoded(int hx, int hy, int hz) {
     const int h[3] = {hx, hy, hz};
     int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = FloorHalf(h[a] - 1);
-      hi[a] = FloorHalf(h[a]);
-    }
+    CellsAround(h, lo, hi);
     if (!AnyPresent(lo, hi)) return {};
-    return Compute(h, lo, hi).encoded;
+    return Compute(PointAt(h), lo, hi).encoded;
   }
 
  private:
@@ -165,16 +159,24 @@ class VoxelTile {
     return false;
   }
 
-  // The mean over the voxels whose closed cube holds the point (absent ones count as empty),
-  // summed in z, y, x order and scaled, as FilterBricks computes it, then encoded.
   Point& PointAt(const int h[3]) {
     const int points = 2 * width_ + 5;
     return point_[static_cast<std::size_t>((h[0] + 2) +
                                            points * ((h[1] + 2) + points * (h[2] + 2)))];
   }
 
-  Point& Compute(const int h[3], const int lo[3], const int hi[3]) {
-    Point& p = PointAt(h);
+  // The voxels lo .. hi (per axis) whose closed cube holds half-voxel point h.
+  static void CellsAround(const int h[3], int lo[3], int hi[3]) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = FloorHalf(h[a] - 1);  // ⌈(h − 2)/2⌉
+      hi[a] = FloorHalf(h[a]);
+    }
+  }
+
+  // Point p's sample (of the cells lo .. hi around it): the mean over the voxels whose closed cube
+  // holds the point (absent ones count as empty), summed in z, y, x order and scaled, as
+  // FilterBricks computes it, then encoded.
+  Point& Compute(Point& p, const int lo[3], const int hi[3]) {
     if (p.stamp == stamp_) return p;
     p.stamp = stamp_;
     Voxel* contributors[8];
