@@ -30,12 +30,13 @@ void AppendTo(std::vector<T, A>& to, const std::vector<T, A>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
+// The first part moves in whole.
 template <class T, class A>
 void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
   if (to.empty()) {
     to = std::move(from);
   } else {
-    to.insert(to.end(), from.begin(), from.end());
+    AppendTo(to, static_cast<const std::vector<T, A>&>(from));
   }
 }
 
