@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include <tbb/parallel_for.h>
@@ -427,6 +428,25 @@ TEST(TextureSampler, LargeFootprintsAreFilteredNotAliased) {
   const TexCoord tiny[3] = {{cu - e, cv - e}, {cu + e, cv - e}, {cu, cv + 2 * e}};
   const double w1[1] = {1};
   EXPECT_NEAR(s.PolygonMean(tiny, w1, 3).r, 1.0, 1e-6);  // (100 + 41) odd
+}
+
+TEST(TextureSampler, FootprintsOfAstronomicalUvAreaGiveTheTextureMean) {
+  // UVs of 1e10 (or beyond float range) cover 1e20+ texels: the sampler must fall back to its
+  // coarsest level, not convert the sample count to int (fuzz input, glb: UVs of 3.5e10).
+  std::vector<float> px(4 * 4 * 4);
+  for (std::size_t i = 0; i < px.size(); ++i) px[i] = (i / 4) % 2 == 0 ? 0.25f : 0.75f;
+  const Image img = MakeImage(4, 4, px);
+  const TextureSampler s(img);
+  for (const double big : {3.5e10, 1e200, std::numeric_limits<double>::infinity()}) {
+    const TexCoord uv[3] = {{0, 0}, {big, 0}, {0, big}};
+    const double w[1] = {1};
+    const Rgba m = s.PolygonMean(uv, w, 3);
+    if (std::isfinite(big)) {
+      EXPECT_NEAR(m.r, 0.5, 1e-6) << big;
+    } else {
+      EXPECT_FALSE(m.r > 1 || m.r < 0) << big;  // any value in range, or NaN: no UB
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

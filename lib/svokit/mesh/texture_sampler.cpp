@@ -158,7 +158,10 @@ Rgba TextureSampler::PolygonMean(const TexCoord* uv, const double* weights, int 
     const double w = weights[i - 1];
     if (!(w > 0)) continue;  // rounding slivers
     const double t = w * texels_per_weight;
-    const int k = t <= 1 ? 1 : std::min(kMaxSplit, static_cast<int>(std::ceil(std::sqrt(t))));
+    // Compared before the cast: UVs far outside [0, 1] can make t huge or infinite.
+    const int k = !(t > 1)                       ? 1
+                  : !(t < kMaxSplit * kMaxSplit) ? kMaxSplit
+                                                 : static_cast<int>(std::ceil(std::sqrt(t)));
     const Level& l = levels_[LevelFor(t / (k * k))];
     const float sw = static_cast<float>(w / (total * k * k));
     const TexCoord& a = uv[0];
