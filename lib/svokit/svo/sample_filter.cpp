@@ -416,9 +416,8 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
           return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
                               origin[2] + step * (z - 1));
         };
-        // The orphans' tents share taps with the home samples' and each other's.
-        TapCache taps(decoded);
-        StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
+        // No per-node cache of taps: the tile holds each point's decoded sample once already.
+        StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
       });
 }
 
