@@ -76,20 +76,16 @@ class VoxelTile {
     std::fill(present_.begin(), present_.end(), 0);
   }
 
-  // The voxels of the block of a node above the voxels whose corner is voxel `corner` + (2, 2, 2)
-  // of the tile (block voxel b is tile voxel corner + b).
-  void AddBlock(const ChildBlock& block, const int corner[3]) {
-    for (int z = 0; z < kBlock; ++z) {
-      for (int y = 0; y < kBlock; ++y) {
-        for (int x = 0; x < kBlock; ++x) {
-          const std::int64_t v = block[BlockIndex(x, y, z)];
-          if (v < 0) continue;
-          const std::size_t at = VoxelAt(corner[0] + x, corner[1] + y, corner[2] + z);
-          if (present_[at / 64] >> (at % 64) & 1u) continue;
-          present_[at / 64] |= std::uint64_t{1} << (at % 64);
-          voxel_[at] = {v, false, {}, {}, {}, {}};
-        }
-      }
+  // The children of a node above the voxels (mask, first voxel index) whose first child is tile
+  // voxel `at` (a child's bits add to it per axis); voxels already present are skipped.
+  void AddChildren(unsigned mask, std::int64_t first, const int at[3]) {
+    for (int c = 0; c < 8; ++c) {
+      if (!(mask >> c & 1u)) continue;
+      const std::size_t i = VoxelAt(at[0] + (c & 1), at[1] + (c >> 1 & 1), at[2] + (c >> 2 & 1));
+      const std::int64_t v = first++;
+      if (present_[i / 64] >> (i % 64) & 1u) continue;
+      present_[i / 64] |= std::uint64_t{1} << (i % 64);
+      voxel_[i] = {v, false, {}, {}, {}, {}};
     }
   }
 
@@ -263,13 +259,29 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
       int corner[3];
     };
     std::vector<Node> nodes;
+    const std::uint8_t* above_masks = tree.masks[above - tree.first_level].data();
+    const std::uint64_t* above_first = tree.first_child[above - tree.first_level].data();
     const auto descend = [&](const auto& self, std::uint32_t level, std::uint64_t i,
                              const Neighbourhood& nb, int x, int y, int z) -> void {
       if (level == above) {
-        // The node at (x, y, z) in its level's units: its first child is voxel 2·(x, y, z).
-        Node n{i, nb, {2 * x - 2, 2 * y - 2, 2 * z - 2}};
-        tile.AddBlock(ChildrenOf(tree, above, nb), n.corner);
-        nodes.push_back(n);
+        // The node at (x, y, z) in its level's units: its first child is voxel 2·(x, y, z). It adds
+        // its own voxels and those of its neighbours outside the tile (the ones inside add theirs).
+        const int nodes_per_edge = static_cast<int>(width / 2);
+        for (int oz = -1; oz <= 1; ++oz) {
+          for (int oy = -1; oy <= 1; ++oy) {
+            for (int ox = -1; ox <= 1; ++ox) {
+              const int p[3] = {x + ox, y + oy, z + oz};
+              const bool inside = p[0] >= 0 && p[0] < nodes_per_edge && p[1] >= 0 &&
+                                  p[1] < nodes_per_edge && p[2] >= 0 && p[2] < nodes_per_edge;
+              if (inside && (ox | oy | oz) != 0) continue;
+              const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
+              if (q < 0) continue;
+              const int at[3] = {2 * p[0], 2 * p[1], 2 * p[2]};
+              tile.AddChildren(above_masks[q], static_cast<std::int64_t>(above_first[q]), at);
+            }
+          }
+        }
+        nodes.push_back({i, nb, {2 * x - 2, 2 * y - 2, 2 * z - 2}});
         return;
       }
       const std::uint8_t m = tree.masks[level - tree.first_level][i];
