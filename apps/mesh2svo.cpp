@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
 
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    StatusOr<CompactSvo> svo = BuildCompactSvo(*voxels, &*mesh, build.Options(), meta, progress);
+    StatusOr<CompactSvo> svo =
+        BuildCompactSvo(std::move(*voxels), &*mesh, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
     StatusOr<SvoFileStats> written =
         app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
                grid->voxel_size(), svo->depth);
-    fmt::print("voxels      {} ({})\n", voxels->size(), voxelize.ModeName());
+    fmt::print("voxels      {} ({})\n", svo->voxel_count(), voxelize.ModeName());
     app::PrintOctreeSummary(*svo, *written);
     std::string times;
     double total = 0;

@@ -50,13 +50,13 @@ int main(int argc, char** argv) {
       mesh = std::move(*m);
     }
     const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
-    StatusOr<CompactSvo> svo =
-        BuildCompactSvo(*voxels, mesh ? &*mesh : nullptr, build.Options(), meta, progress);
+    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), mesh ? &*mesh : nullptr,
+                                               build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
     StatusOr<SvoFileStats> written =
         app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
     if (!written.ok()) return app::Fail(tool, written.status());
-    fmt::print("input       {} ({} voxels)\n", input.string(), voxels->size());
+    fmt::print("input       {} ({} voxels)\n", input.string(), svo->voxel_count());
     fmt::print("octree      depth {}, bricks {}, contours {}\n", svo->depth, build.bricks,
                build.contours ? "on" : "off");
     app::PrintOctreeSummary(*svo, *written);

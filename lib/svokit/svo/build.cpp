@@ -1,23 +1,31 @@
 #include "svokit/svo/build.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "svokit/svo/bricks.hpp"
 
 namespace svokit {
 
-std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
                                                             std::uint32_t depth) {
   std::vector<std::vector<std::uint64_t>> levels(depth + 1);
-  levels[depth].assign(keys.begin(), keys.end());
+  levels[depth] = std::move(keys);
   for (std::uint32_t l = depth; l-- > 0;) {
     const std::vector<std::uint64_t>& finer = levels[l + 1];
     std::vector<std::uint64_t>& coarser = levels[l];
+    // The most a level can hold, reserved once: pages past the keys written are never touched.
+    coarser.reserve(finer.size());
     for (std::uint64_t k : finer) {
       if (coarser.empty() || coarser.back() != k >> 3) coarser.push_back(k >> 3);
     }
   }
   return levels;
+}
+
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
+                                                            std::uint32_t depth) {
+  return LevelKeysFromVoxels(std::vector<std::uint64_t>(keys.begin(), keys.end()), depth);
 }
 
 namespace {

@@ -29,7 +29,10 @@ StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
 /// or 0, contours without the mesh, attribute arrays that do not match the voxels.
 Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options);
 
-/// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending.
+/// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending; the voxel
+/// level is `keys` itself (moved in, not copied, where the caller gives it up).
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
+                                                            std::uint32_t depth);
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
                                                             std::uint32_t depth);
 

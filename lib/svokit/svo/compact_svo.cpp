@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <iterator>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -17,9 +18,8 @@ VoxelSamplesSource CompactSvo::VoxelSource() const {
   return source;
 }
 
-StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
-                                     const BuildOptions& options, std::string metadata,
-                                     Progress& progress) {
+StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const BuildOptions& options,
+                                     std::string metadata, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckBuildInput(voxels, mesh, options));
   CompactSvo svo;
   svo.grid = voxels.grid;
@@ -35,12 +35,12 @@ StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
   std::vector<std::vector<std::uint64_t>> keys;
   {
     Progress::Stage stage(progress, "octree", 1);
-    keys = LevelKeysFromVoxels(voxels.keys, svo.depth);
+    keys = LevelKeysFromVoxels(std::move(voxels.keys), svo.depth);
     svo.tree = MaskTreeFromKeys(keys);
     stage.Advance();
   }
-  if (svo.has_color) svo.colors.assign(voxels.colors.begin(), voxels.colors.end());
-  if (svo.has_normal) svo.normals.assign(voxels.normals.begin(), voxels.normals.end());
+  if (svo.has_color) svo.colors = std::move(voxels.colors);
+  if (svo.has_normal) svo.normals = std::move(voxels.normals);
   if (svo.brick_side != 0) {
     Progress::Stage stage(progress, "bricks", 1);
     for (std::uint32_t l = 0; l < svo.depth; ++l) {

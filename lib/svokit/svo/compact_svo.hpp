@@ -50,9 +50,10 @@ struct CompactSvo {
 
 /// The octree of `voxels` (contours fitted to `mesh`, required with options.contours), the
 /// version-2 way: distinct samples, the voxel level's bricks not computed. Its assembled bricks,
-/// masks and contours equal BuildSvo's.
-StatusOr<CompactSvo> BuildCompactSvo(const VoxelSet& voxels, const Mesh* mesh,
-                                     const BuildOptions& options, std::string metadata = "{}",
+/// masks and contours equal BuildSvo's. The voxels' keys, colours and normals are moved into the
+/// octree: a caller done with them passes them with std::move and nothing is copied.
+StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const BuildOptions& options,
+                                     std::string metadata = "{}",
                                      Progress& progress = Progress::Silent());
 
 /// Every node's brick and the node records: the Svo the octree stands for.
