@@ -1,6 +1,7 @@
 #include "svokit/svo/svo_pages.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/build.hpp"
@@ -251,7 +252,7 @@ void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& ou
     if (shape.has_normal) normals.push_back(mine ? chunk.normals[a] : chunk.halo_normals[b]);
     (mine ? a : b)++;
   }
-  const auto level_keys = LevelKeysFromVoxels(keys, shape.depth);
+  const auto level_keys = LevelKeysFromVoxels(std::move(keys), shape.depth);
   const MaskTree tree = MaskTreeFromKeys(level_keys);
   if (per_voxel_colors) source.colors = colors;
   if (shape.has_normal) source.normals = normals;
