@@ -37,6 +37,7 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
     Progress::Stage stage(progress, "octree", 1);
     keys = LevelKeysFromVoxels(std::move(voxels.keys), svo.depth);
     svo.tree = MaskTreeFromKeys(keys);
+    if (!options.contours) keys = {};  // only contours read keys (8 B per voxel) after the masks
     stage.Advance();
   }
   if (svo.has_color) svo.colors = std::move(voxels.colors);
@@ -54,8 +55,7 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
     svo.contours = FitContours(*mesh, svo.grid, svo.depth, keys, options.contour);
     stage.Advance();
   } else {
-    svo.contours.resize(svo.depth + 1);
-    for (std::uint32_t l = 0; l <= svo.depth; ++l) svo.contours[l].assign(keys[l].size(), 0);
+    svo.contours.assign(svo.depth + 1, {});  // no word per node: 4 B per voxel not touched
   }
   return svo;
 }

@@ -30,8 +30,8 @@ struct CompactSvo {
   std::string metadata;
   /// Levels 0 .. depth: the child masks of levels 0 .. depth − 1.
   MaskTree tree;
-  /// Per level 0 .. depth, per node: its contour word, or 0 where it has none (all 0 without
-  /// contours).
+  /// Per level 0 .. depth, per node: its contour word, or 0 where it has none; without contours,
+  /// depth + 1 empty levels.
   std::vector<std::vector<std::uint32_t>> contours;
   /// Per level 0 .. depth − 1 (empty without bricks): where its samples are, and the samples.
   std::vector<SampleLayout> layouts;

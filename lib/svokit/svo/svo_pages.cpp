@@ -109,8 +109,11 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
   chunk.tree.LinkChildren();
   for (std::uint32_t l = page_level; l <= svo.depth; ++l) {
     const auto [begin, end] = ranges[l - page_level];
-    chunk.contours.emplace_back(svo.contours[l].begin() + static_cast<std::ptrdiff_t>(begin),
-                                svo.contours[l].begin() + static_cast<std::ptrdiff_t>(end));
+    std::vector<std::uint32_t>& words = chunk.contours.emplace_back();
+    if (svo.has_contours) {
+      words.assign(svo.contours[l].begin() + static_cast<std::ptrdiff_t>(begin),
+                   svo.contours[l].begin() + static_cast<std::ptrdiff_t>(end));
+    }
   }
   const std::uint64_t v0 = ranges.back().first, v1 = ranges.back().second;
   if (svo.colors.size() > 1) {
@@ -286,7 +289,11 @@ void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
   const std::uint32_t held = chunk.levels_held();
   for (std::uint32_t k = 0; k < held && chunk.root_level + k <= max_level_ + 1; ++k) {
     const std::uint32_t l = chunk.root_level + k;
-    AppendTo(words_[l], chunk.contours[k]);
+    if (shape_.has_contours) {
+      AppendTo(words_[l], chunk.contours[k]);
+    } else {  // a chunk may hold no words then: zeros, one per node, give the levels their sizes
+      words_[l].resize(words_[l].size() + chunk.tree.NodeCount(l), 0);
+    }
     if (l > max_level_) continue;
     if (l < shape_.depth) AppendTo(masks_[l], chunk.tree.masks[k]);
     if (shape_.brick_side == 0) continue;
