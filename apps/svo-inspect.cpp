@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
     report.version = 1;
     if (StatusOr<SvoReader> reader = SvoReader::Open(input); reader.ok()) {
       report.version = 2;
-      StatusOr<SvoFileStats> file_stats = reader->FileStats();
+      StatusOr<SvoFileStats> file_stats = reader->FileStats(levels);
       if (!file_stats.ok()) return app::Fail(tool, file_stats.status());
       report.file_stats = std::move(*file_stats);
     }

@@ -357,6 +357,72 @@ TEST(SvoFileV2, VersionOneFilesStillRead) {
   EXPECT_NE(reader.status().message().find("no pages"), std::string::npos);
 }
 
+// By level, each kind of array's bytes add up to its file-wide figures exactly, and the decoded
+// bytes land where the octree puts them: one mask byte per node above the voxels, one opacity
+// byte per distinct sample, the voxels' own normals on the voxel level only.
+TEST(SvoReader, FileStatsByLevelSplitEachKindOfArrayExactly) {
+  for (const bool zstd : {true, false}) {
+    const Built b = Build(test::DataDir() / "uv-torus.obj", 128);
+    SvoCompression compression;
+    compression.zstd = zstd;
+    const auto bytes = EncodeSvo(b.svo, compression);
+    auto reader = SvoReader::FromBytes(bytes, "t.svo");
+    ASSERT_TRUE(reader.ok()) << reader.status().message();
+    ASSERT_GT(reader->page_count(), 1u);
+    const auto whole = reader->FileStats();
+    const auto split = reader->FileStats(true);
+    ASSERT_TRUE(whole.ok() && split.ok());
+    EXPECT_TRUE(whole->levels.empty());
+    const std::uint32_t depth = b.svo.depth;
+    ASSERT_EQ(split->levels.size(), depth + 1);
+    ASSERT_EQ(split->sections.size(), whole->sections.size());
+    const auto at = [&](std::uint32_t level, const std::string& name) {
+      for (const SvoSectionBytes& s : split->levels[level]) {
+        if (s.name == name) return s;
+      }
+      return SvoSectionBytes{name, 0, 0};
+    };
+    for (std::size_t k = 0; k < whole->sections.size(); ++k) {
+      const SvoSectionBytes& sec = whole->sections[k];
+      EXPECT_EQ(split->sections[k].name, sec.name);
+      EXPECT_EQ(split->sections[k].stored, sec.stored);
+      if (sec.name == "frame") continue;
+      std::uint64_t stored = 0, raw = 0;
+      for (std::uint32_t l = 0; l <= depth; ++l) {
+        stored += at(l, sec.name).stored;
+        raw += at(l, sec.name).raw;
+        EXPECT_LE(at(l, sec.name).stored, sec.stored);
+      }
+      EXPECT_EQ(stored, sec.stored) << sec.name;
+      EXPECT_EQ(raw, sec.raw) << sec.name;
+      if (!zstd) {
+        EXPECT_EQ(stored, raw) << sec.name;
+      }
+    }
+    // Samples stored per level: the top chunk's, then each page's (a page also stores the samples
+    // on its border that a neighbouring page holds too).
+    std::vector<std::uint64_t> samples(depth + 1, 0);
+    for (std::size_t c = 0; c <= reader->page_count(); ++c) {
+      auto chunk = c == 0 ? reader->Top() : reader->Page(c - 1);
+      ASSERT_TRUE(chunk.ok());
+      for (std::size_t k = 0; k < chunk->samples.size(); ++k) {
+        samples[chunk->root_level + k] += chunk->samples[k].opacity.size();
+      }
+    }
+    for (std::uint32_t l = 0; l < depth; ++l) {
+      EXPECT_EQ(at(l, "masks").raw, b.svo.NodeCount(l)) << l;
+      EXPECT_EQ(at(l, "opacity").raw, samples[l]) << l;
+      EXPECT_GE(samples[l], b.svo.layouts[l].size()) << l;
+      EXPECT_EQ(at(l, "voxel normals").raw, 0u) << l;
+      EXPECT_GT(at(l, "contours").raw, 0u) << l;
+    }
+    EXPECT_EQ(at(depth, "masks").raw, 0u);
+    EXPECT_EQ(at(depth, "opacity").raw, 0u);
+    EXPECT_EQ(at(depth, "voxel normals").raw, 4 * b.svo.voxel_count());
+    EXPECT_GT(at(depth, "halo").raw, 0u);
+  }
+}
+
 TEST(SvoFileV2, WriteReplacesAndReportsTheFile) {
   test::TempDir dir;
   const Built& b = Torus();

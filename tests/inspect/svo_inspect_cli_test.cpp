@@ -64,7 +64,8 @@ TEST(SvoInspectCli, TextReport) {
   for (const char* key : {"file ", "grid ", "bounds ", "octree ", "voxels ", "bricks ", "opacity ",
                           "colour (linear) ", "normals ", "contours ", "mean thickness ",
                           "source             uv-torus.obj", "generator ", "voxelize ", "build ",
-                          "bits/vox", "children per inner node", "contour extent"}) {
+                          "bits/vox", "children per inner node", "contour extent",
+                          "file bytes per voxel by level, stored / decoded"}) {
     EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
   }
 }
@@ -110,6 +111,19 @@ TEST(SvoInspectCli, JsonMatchesTheFile) {
   EXPECT_EQ(layout["pages"], reader->page_count());
   EXPECT_EQ(layout["page_level"], reader->page_level());
   EXPECT_LE(layout["page_bytes"]["smallest"], layout["page_bytes"]["largest"]);
+  // By level (--levels): every level listed, the stored bytes adding up to the arrays'.
+  ASSERT_EQ(layout["levels"].size(), svo->depth + 1);
+  std::uint64_t by_level = 0;
+  for (const json& level : layout["levels"]) {
+    for (const json& section : level["sections"]) {
+      by_level += section["stored"].get<std::uint64_t>();
+    }
+  }
+  std::uint64_t frame = 0;
+  for (const json& section : layout["sections"]) {
+    if (section["name"] == "frame") frame = section["stored"].get<std::uint64_t>();
+  }
+  EXPECT_EQ(by_level + frame, j["file_bytes"].get<std::uint64_t>());
 }
 
 TEST(SvoInspectCli, RenderAndSlicePngs) {

@@ -149,6 +149,35 @@ double Share(std::uint64_t part, std::uint64_t whole) {
   return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
 }
 
+// The file's bytes per voxel by level and kind of array, stored / decoded (SvoFileStats::levels).
+std::string LevelBytesTable(const SvoFileStats& f, std::uint64_t voxels) {
+  std::vector<std::string> names;  // the file's kinds, in its order; the frame is no level's
+  for (const SvoSectionBytes& sec : f.sections) {
+    if (sec.name != "frame") names.push_back(sec.name);
+  }
+  std::string out = "\nfile bytes per voxel by level, stored / decoded\n";
+  fmt::format_to(std::back_inserter(out), "{:>5}", "level");
+  for (const std::string& name : names) fmt::format_to(std::back_inserter(out), " {:>15}", name);
+  fmt::format_to(std::back_inserter(out), " {:>15}\n", "all");
+  for (std::size_t l = 0; l < f.levels.size(); ++l) {
+    fmt::format_to(std::back_inserter(out), "{:>5}", l);
+    std::uint64_t stored = 0, raw = 0;
+    for (const std::string& name : names) {
+      const auto it = std::find_if(f.levels[l].begin(), f.levels[l].end(),
+                                   [&](const SvoSectionBytes& s) { return s.name == name; });
+      const SvoSectionBytes sec = it == f.levels[l].end() ? SvoSectionBytes{} : *it;
+      stored += sec.stored;
+      raw += sec.raw;
+      fmt::format_to(
+          std::back_inserter(out), " {:>15}",
+          fmt::format("{:.3f}/{:.3f}", Share(sec.stored, voxels), Share(sec.raw, voxels)));
+    }
+    fmt::format_to(std::back_inserter(out), " {:>15}\n",
+                   fmt::format("{:.3f}/{:.3f}", Share(stored, voxels), Share(raw, voxels)));
+  }
+  return out;
+}
+
 }  // namespace
 
 SvoStats ComputeSvoStats(const Svo& svo) {
@@ -321,6 +350,9 @@ std::string FormatStatsText(const SvoStats& st, const InspectReport& report) {
                      l.contours.with_contour, l.contour_share, l.contours.mean_relative_thickness,
                      l.bytes.nodes, l.bytes.bricks(), l.bytes.contours, l.bits_per_voxel);
     }
+    if (report.file_stats && !report.file_stats->levels.empty()) {
+      out += LevelBytesTable(*report.file_stats, st.voxels);
+    }
   }
   if (report.histograms) {
     const SvoHistograms& h = st.histograms;
@@ -374,20 +406,31 @@ std::string FormatStatsJson(const SvoStats& st, const InspectReport& report) {
   j["file_layout"] = nullptr;
   if (report.file_stats) {
     const SvoFileStats& f = *report.file_stats;
-    json sections = json::array();
-    for (const SvoSectionBytes& sec : f.sections) {
-      sections.push_back({{"name", sec.name},
-                          {"stored", sec.stored},
-                          {"raw", sec.raw},
-                          {"stored_per_voxel", Share(sec.stored, st.voxels)},
-                          {"raw_per_voxel", Share(sec.raw, st.voxels)}});
-    }
+    const auto sections = [&](const std::vector<SvoSectionBytes>& list) {
+      json out = json::array();
+      for (const SvoSectionBytes& sec : list) {
+        out.push_back({{"name", sec.name},
+                       {"stored", sec.stored},
+                       {"raw", sec.raw},
+                       {"stored_per_voxel", Share(sec.stored, st.voxels)},
+                       {"raw_per_voxel", Share(sec.raw, st.voxels)}});
+      }
+      return out;
+    };
     j["file_layout"] = {
         {"page_level", f.page_level},
         {"pages", f.pages},
         {"page_bytes",
          {{"smallest", f.smallest_page}, {"median", f.median_page}, {"largest", f.largest_page}}},
-        {"sections", sections}};
+        {"sections", sections(f.sections)},
+        {"levels", nullptr}};
+    if (!f.levels.empty()) {
+      json levels = json::array();
+      for (std::size_t l = 0; l < f.levels.size(); ++l) {
+        levels.push_back({{"level", l}, {"sections", sections(f.levels[l])}});
+      }
+      j["file_layout"]["levels"] = levels;
+    }
   }
   j["grid"] = {{"origin", Vec(st.grid.origin())},
                {"voxel_size", st.grid.voxel_size()},

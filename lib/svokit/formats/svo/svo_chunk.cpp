@@ -2,6 +2,8 @@
 
 #include <zstd.h>
 
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <string>
@@ -225,19 +227,37 @@ SampleStreams SplitSamples(const SvoChunk& chunk) {
 
 }  // namespace
 
-void ChunkBytes::Add(const std::string& name, std::uint64_t raw, std::uint64_t stored) {
-  for (auto& [n, v] : by_name) {
+namespace {
+
+void AddTo(ChunkBytes::Sections& sections, const std::string& name, std::uint64_t raw,
+           std::uint64_t stored) {
+  for (auto& [n, v] : sections) {
     if (n == name) {
       v.first += raw;
       v.second += stored;
       return;
     }
   }
-  by_name.push_back({name, {raw, stored}});
+  sections.push_back({name, {raw, stored}});
+}
+
+}  // namespace
+
+void ChunkBytes::Add(const std::string& name, std::uint64_t raw, std::uint64_t stored) {
+  AddTo(by_name, name, raw, stored);
+}
+
+void ChunkBytes::AddAtLevel(std::uint32_t level, const std::string& name, std::uint64_t raw,
+                            std::uint64_t stored) {
+  if (by_level.size() <= level) by_level.resize(level + 1);
+  AddTo(by_level[level], name, raw, stored);
 }
 
 void ChunkBytes::Add(const ChunkBytes& other) {
   for (const auto& [name, v] : other.by_name) Add(name, v.first, v.second);
+  for (std::uint32_t l = 0; l < other.by_level.size(); ++l) {
+    for (const auto& [name, v] : other.by_level[l]) AddAtLevel(l, name, v.first, v.second);
+  }
 }
 
 std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& shape,
@@ -390,9 +410,12 @@ Status ExpectSize(const StreamSet& set, Stream kind, std::uint64_t size, const s
 
 }  // namespace
 
-StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes,
-                                      const std::string& name) {
-  ChunkBytes out;
+namespace {
+
+// Decoded and stored bytes of each stream kind, from a chunk's stream directory.
+using StreamSizes = std::array<std::pair<std::uint64_t, std::uint64_t>, kStreamKinds>;
+StatusOr<StreamSizes> ReadDirectory(std::span<const std::uint8_t> bytes, const std::string& name) {
+  StreamSizes sizes{};
   const std::uint8_t* p = bytes.data();
   const std::uint8_t* end = p + bytes.size();
   if (p == end) return Status::BadInput("{}: empty chunk", name);
@@ -406,7 +429,89 @@ StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes,
         kind >= kStreamKinds) {
       return Status::BadInput("{}: stream directory is malformed", name);
     }
-    out.Add(SectionOf(kind), raw, stored);
+    sizes[kind] = {raw, stored};
+  }
+  return sizes;
+}
+
+ChunkBytes Totals(const StreamSizes& sizes) {
+  ChunkBytes out;
+  for (int kind = 1; kind < kStreamKinds; ++kind) {
+    const auto [raw, stored] = sizes[kind];
+    if (raw != 0) out.Add(SectionOf(static_cast<Stream>(kind)), raw, stored);
+  }
+  return out;
+}
+
+// How many values each level of the chunk puts in each stream, as EncodeChunk lays them out.
+// Within a stream every value has the same size, but for the halo keys, which all belong to the
+// voxel level.
+std::vector<std::array<std::uint64_t, kStreamKinds>> LevelValues(const SvoChunk& chunk,
+                                                                 const SvoShape& shape) {
+  const std::uint32_t held = chunk.levels_held();
+  std::vector<std::array<std::uint64_t, kStreamKinds>> values(held);
+  for (std::uint32_t k = 0; k < held; ++k) {
+    std::array<std::uint64_t, kStreamKinds>& v = values[k];
+    if (k < chunk.tree.masks.size()) v[kMasks] = chunk.tree.masks[k].size();
+    if (k < chunk.contours.size()) {
+      const std::vector<std::uint32_t>& words = chunk.contours[k];
+      if (shape.has_contours) v[kContourBits] = (words.size() + 7) / 8;
+      const auto n = static_cast<std::uint64_t>(
+          std::count_if(words.begin(), words.end(), [](std::uint32_t w) { return w != 0; }));
+      v[kContourThickness] = v[kContourPosition] = v[kContourNormals] = n;
+    }
+    if (k < chunk.samples.size()) {
+      const LevelSamples& s = chunk.samples[k];
+      const auto empty =
+          static_cast<std::uint64_t>(std::count(s.opacity.begin(), s.opacity.end(), 0));
+      v[kOpacity] = s.opacity.size();
+      if (!s.color.empty()) v[kColors] = s.opacity.size() - empty;
+      if (!s.normal.empty()) v[kNormals] = s.opacity.size() - empty;
+    }
+    if (chunk.root_level + k == shape.depth) {
+      v[kVoxelColors] = chunk.colors.size();
+      v[kVoxelNormals] = chunk.normals.size();
+      v[kHaloKeys] = chunk.halo_keys.size();
+      v[kHaloColors] = chunk.halo_colors.size();
+      v[kHaloNormals] = chunk.halo_normals.size();
+    }
+  }
+  return values;
+}
+
+}  // namespace
+
+StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes,
+                                      const std::string& name) {
+  StatusOr<StreamSizes> sizes = ReadDirectory(bytes, name);
+  if (!sizes.ok()) return sizes.status();
+  return Totals(*sizes);
+}
+
+StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const SvoChunk& decoded,
+                                      const SvoShape& shape, const std::string& name) {
+  StatusOr<StreamSizes> sizes = ReadDirectory(bytes, name);
+  if (!sizes.ok()) return sizes.status();
+  ChunkBytes out = Totals(*sizes);
+  const auto values = LevelValues(decoded, shape);
+  for (int kind = 1; kind < kStreamKinds; ++kind) {
+    const auto [raw, stored] = (*sizes)[kind];
+    std::uint64_t all = 0;
+    for (const auto& v : values) all += v[kind];
+    if (raw == 0 || all == 0) continue;
+    // Shares of the running sums, rounded down, so the levels' shares add up to the stream's.
+    // raw ≤ kStreamLimit (2^30) and all ≤ raw: the products stay below 2^60.
+    std::uint64_t before = 0, raw_done = 0, stored_done = 0;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      if (values[k][kind] == 0) continue;
+      before += values[k][kind];
+      const std::uint64_t raw_to = raw * before / all, stored_to = stored * before / all;
+      out.AddAtLevel(decoded.root_level + static_cast<std::uint32_t>(k),
+                     SectionOf(static_cast<Stream>(kind)), raw_to - raw_done,
+                     stored_to - stored_done);
+      raw_done = raw_to;
+      stored_done = stored_to;
+    }
   }
   return out;
 }

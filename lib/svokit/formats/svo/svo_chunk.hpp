@@ -20,10 +20,15 @@ struct SvoCompression {
   bool operator==(const SvoCompression&) const = default;
 };
 
-/// Raw and stored bytes of a chunk's arrays, by name (SvoSectionBytes' names), added up.
+/// Raw and stored bytes of a chunk's arrays, by name (SvoSectionBytes' names), added up; and the
+/// same per octree level where the chunk was decoded to tell (ChunkStreamBytes with the chunk).
 struct ChunkBytes {
-  std::vector<std::pair<std::string, std::pair<std::uint64_t, std::uint64_t>>> by_name;
+  using Sections = std::vector<std::pair<std::string, std::pair<std::uint64_t, std::uint64_t>>>;
+  Sections by_name;
+  std::vector<Sections> by_level;  ///< indexed by level; empty when not asked for
   void Add(const std::string& name, std::uint64_t raw, std::uint64_t stored);
+  void AddAtLevel(std::uint32_t level, const std::string& name, std::uint64_t raw,
+                  std::uint64_t stored);
   void Add(const ChunkBytes& other);
 };
 
@@ -34,6 +39,11 @@ std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& sha
 
 /// What each array of a chunk takes, from its stream directory alone (nothing decompressed).
 StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const std::string& name);
+/// The same, also per level, from the chunk `decoded` from these bytes. A stream holds the arrays
+/// of several levels compressed together: its decoded bytes split exactly by level, its stored
+/// bytes in proportion to them (the shares add up to the stream's).
+StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const SvoChunk& decoded,
+                                      const SvoShape& shape, const std::string& name);
 
 /// What one stream and one chunk may decode to: the bound on what a file's stated sizes can make
 /// a reader allocate (a page of kMaxPageNodes nodes stays far below).

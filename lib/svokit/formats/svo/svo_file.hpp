@@ -47,6 +47,10 @@ struct SvoFileStats {
   std::uint64_t pages = 0;
   std::uint64_t smallest_page = 0, median_page = 0, largest_page = 0;  ///< stored bytes
   std::vector<SvoSectionBytes> sections;
+  /// The same per level 0 .. depth, when asked for (SvoReader::FileStats): a stream holds several
+  /// levels' arrays compressed together, so its stored bytes are shared among its levels in
+  /// proportion to their decoded bytes. The frame belongs to no level.
+  std::vector<std::vector<SvoSectionBytes>> levels;
 };
 
 /// The version-2 file of `svo`, and what it holds.

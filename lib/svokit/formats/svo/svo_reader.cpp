@@ -1,6 +1,7 @@
 #include "svokit/formats/svo/svo_reader.hpp"
 
 #include "svokit/core/morton.hpp"
+#include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 
 namespace svokit {
@@ -107,28 +108,51 @@ std::vector<std::size_t> SvoReader::PagesIn(const Box3d& box) const {
   return out;
 }
 
-StatusOr<SvoFileStats> SvoReader::FileStats() const {
+StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
   const svo_detail::Version2& v = state_->v;
   SvoFileStats stats;
   stats.page_level = v.page_level;
+  // Chunk c: the top chunk (c = 0), then page c − 1; each one's bytes, decoded when by level.
+  const std::size_t chunks = v.pages.size() + 1;
+  std::vector<StatusOr<ChunkBytes>> parts(chunks, ChunkBytes{});
+  const auto measure = [&](std::size_t c) -> StatusOr<ChunkBytes> {
+    const bool top = c == 0;
+    if (top && v.top.empty()) return ChunkBytes{};
+    const std::string chunk_name =
+        top ? name() + ": top chunk" : fmt::format("{}: page {}", name(), c - 1);
+    const std::span<const std::uint8_t> bytes =
+        top ? v.top : v.page_bytes.subspan(v.pages[c - 1].offset, v.pages[c - 1].size);
+    if (!by_level) return ChunkStreamBytes(bytes, chunk_name);
+    StatusOr<SvoChunk> chunk = top ? Top() : Page(c - 1);
+    if (!chunk.ok()) return chunk.status();
+    return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
+  };
+  if (by_level) {
+    ParallelChunks(chunks, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t c = begin; c < end; ++c) parts[c] = measure(c);
+    });
+  } else {
+    for (std::size_t c = 0; c < chunks; ++c) parts[c] = measure(c);
+  }
   ChunkBytes all;
-  if (!v.top.empty()) {
-    StatusOr<ChunkBytes> top = ChunkStreamBytes(v.top, name() + ": top chunk");
-    if (!top.ok()) return top.status();
-    all.Add(*top);
+  for (const StatusOr<ChunkBytes>& part : parts) {  // in chunk order: the first error is reported
+    if (!part.ok()) return part.status();
+    all.Add(*part);
   }
   std::vector<std::uint64_t> sizes;
-  for (std::size_t i = 0; i < v.pages.size(); ++i) {
-    const svo_detail::Version2::Page& p = v.pages[i];
-    StatusOr<ChunkBytes> page = ChunkStreamBytes(v.page_bytes.subspan(p.offset, p.size),
-                                                 fmt::format("{}: page {}", name(), i));
-    if (!page.ok()) return page.status();
-    all.Add(*page);
-    sizes.push_back(p.size);
-  }
+  for (const svo_detail::Version2::Page& p : v.pages) sizes.push_back(p.size);
   svo_detail::SetPageSizes(std::move(sizes), stats);
-  for (const auto& [section, b] : all.by_name)
+  for (const auto& [section, b] : all.by_name) {
     stats.sections.push_back({section, b.second, b.first});
+  }
+  if (by_level) {
+    stats.levels.resize(shape().depth + 1);
+    for (std::uint32_t l = 0; l < all.by_level.size() && l <= shape().depth; ++l) {
+      for (const auto& [section, b] : all.by_level[l]) {
+        stats.levels[l].push_back({section, b.second, b.first});
+      }
+    }
+  }
   svo_detail::CompleteStats(state_->frame.file_size(), stats);
   return stats;
 }

@@ -56,8 +56,9 @@ class SvoReader {
   std::vector<std::size_t> PagesIn(const Box3d& box) const;
 
   /// What each kind of array takes in the file, stored and decoded, and the pages' sizes, read
-  /// from the chunks' stream directories (nothing is decompressed).
-  StatusOr<SvoFileStats> FileStats() const;
+  /// from the chunks' stream directories (nothing is decompressed); `by_level` also splits them
+  /// by level (SvoFileStats::levels), which decodes every chunk.
+  StatusOr<SvoFileStats> FileStats(bool by_level = false) const;
 
   /// The top chunk (no levels when the page level is 0).
   StatusOr<SvoChunk> Top() const;
