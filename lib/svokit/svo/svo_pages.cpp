@@ -147,22 +147,38 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
     const SampleLayout& layout = chunk.layouts[k];
     const layout_detail::SideTable& t = layout_detail::TableFor(side);
     const std::uint32_t orphans = layout.orphans[local];
-    std::uint64_t next = layout.first[local] + t.home_count;
-    for (unsigned s = 0; s < n; ++s) {
-      std::uint64_t to;
-      if (t.is_home[s]) {
-        to = layout.first[local] + t.index[s];
-      } else if (orphans >> t.index[s] & 1u) {
-        to = next++;
-      } else {
-        continue;
+    const SampleLayout& whole = svo.layouts[l];
+    const LevelSamples& in = svo.samples[l];
+    LevelSamples& out = chunk.samples[k];
+    const auto copy = [&](std::uint64_t from, std::uint64_t to, std::uint64_t count) {
+      std::copy_n(in.opacity.begin() + static_cast<std::ptrdiff_t>(from), count,
+                  out.opacity.begin() + static_cast<std::ptrdiff_t>(to));
+      if (!out.color.empty()) {
+        std::copy_n(in.color.begin() + static_cast<std::ptrdiff_t>(from), count,
+                    out.color.begin() + static_cast<std::ptrdiff_t>(to));
       }
-      const std::uint64_t from = SampleIndex(svo.layouts[l], global_nb, s);
-      const LevelSamples& in = svo.samples[l];
-      LevelSamples& out = chunk.samples[k];
-      out.opacity[to] = in.opacity[from];
-      if (!out.color.empty()) out.color[to] = in.color[from];
-      if (!out.normal.empty()) out.normal[to] = in.normal[from];
+      if (!out.normal.empty()) {
+        std::copy_n(in.normal.begin() + static_cast<std::ptrdiff_t>(from), count,
+                    out.normal.begin() + static_cast<std::ptrdiff_t>(to));
+      }
+    };
+    if (orphans == whole.orphans[global]) {
+      // Away from the page's border the node stores what it stores in the whole tree, in the
+      // same order: one run of samples.
+      copy(whole.first[global], layout.first[local], whole.first[global + 1] - whole.first[global]);
+    } else {
+      std::uint64_t next = layout.first[local] + t.home_count;
+      for (unsigned s = 0; s < n; ++s) {
+        std::uint64_t to;
+        if (t.is_home[s]) {
+          to = layout.first[local] + t.index[s];
+        } else if (orphans >> t.index[s] & 1u) {
+          to = next++;
+        } else {
+          continue;
+        }
+        copy(SampleIndex(whole, global_nb, s), to, 1);
+      }
     }
     if (l + 1 == svo.depth) {
       const MortonCoord c = MortonDecode(node_key);
