@@ -48,7 +48,7 @@ namespace {
 struct HomeOf {
   unsigned e, home_sample;
 };
-HomeOf HomeOfSample(std::uint32_t side, unsigned s) {
+constexpr HomeOf HomeOfSample(std::uint32_t side, unsigned s) {
   const unsigned top = side - 1;
   unsigned k[3] = {s % side, s / side % side, s / (side * side)};
   unsigned e = 0;
@@ -62,27 +62,57 @@ HomeOf HomeOfSample(std::uint32_t side, unsigned s) {
 }
 
 // Slot in a node's neighbourhood of the node at offset e − f from it (e, f ∈ {0,1}³ as bits).
-int SlotOf(unsigned e, unsigned f) {
+constexpr int SlotOf(unsigned e, unsigned f) {
   const auto d = [&](unsigned a) {
     return static_cast<int>(e >> a & 1u) - static_cast<int>(f >> a & 1u);
   };
   return NeighbourSlot(d(0), d(1), d(2));
 }
 
-}  // namespace
+// Per non-home brick sample: its bit in the orphan mask, the neighbourhood slot of its home node,
+// and the slots of the nodes that may store it in their order, this node at `self`.
+struct OrphanRule {
+  std::uint8_t bit = 0, home_slot = 0, candidates = 0, self = 0xff;
+  std::uint8_t slot[7] = {};
+};
+struct OrphanRules {
+  int count = 0;
+  OrphanRule rule[27];
+};
 
-std::uint32_t OrphanMask(std::uint32_t side, const Neighbourhood& nb) {
-  const layout_detail::SideTable& t = layout_detail::TableFor(side);
-  std::uint32_t mask = 0;
+constexpr OrphanRules MakeOrphanRules(std::uint32_t side) {
+  const layout_detail::SideTable t = layout_detail::MakeSideTable(static_cast<int>(side));
+  OrphanRules rules;
   for (unsigned s = 0; s < side * side * side; ++s) {
     if (t.is_home[s]) continue;
     const HomeOf h = HomeOfSample(side, s);
-    if (nb[SlotOf(h.e, 0)] >= 0) continue;
     const layout_detail::HomeSample& home = t.home[t.index[h.home_sample]];
-    // The first existing candidate stores it; this node (f = e) is one of them.
+    OrphanRule& r = rules.rule[rules.count++];
+    r.bit = t.index[s];
+    r.home_slot = static_cast<std::uint8_t>(SlotOf(h.e, 0));
+    r.candidates = home.candidates;
     for (int c = 0; c < home.candidates; ++c) {
-      if (nb[SlotOf(h.e, home.f[c])] < 0) continue;
-      if (home.f[c] == h.e) mask |= 1u << t.index[s];
+      r.slot[c] = static_cast<std::uint8_t>(SlotOf(h.e, home.f[c]));
+      if (home.f[c] == h.e) r.self = static_cast<std::uint8_t>(c);
+    }
+  }
+  return rules;
+}
+
+constexpr OrphanRules kOrphans2 = MakeOrphanRules(2), kOrphans3 = MakeOrphanRules(3);
+
+}  // namespace
+
+std::uint32_t OrphanMask(std::uint32_t side, const Neighbourhood& nb) {
+  const OrphanRules& rules = side == 2 ? kOrphans2 : kOrphans3;
+  std::uint32_t mask = 0;
+  for (int i = 0; i < rules.count; ++i) {
+    const OrphanRule& r = rules.rule[i];
+    if (nb[r.home_slot] >= 0) continue;
+    // The first existing candidate stores it; this node is one of them.
+    for (int c = 0; c < r.candidates; ++c) {
+      if (nb[r.slot[c]] < 0) continue;
+      if (c == r.self) mask |= 1u << r.bit;
       break;
     }
   }
