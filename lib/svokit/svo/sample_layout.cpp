@@ -101,6 +101,30 @@ constexpr OrphanRules MakeOrphanRules(std::uint32_t side) {
 
 constexpr OrphanRules kOrphans2 = MakeOrphanRules(2), kOrphans3 = MakeOrphanRules(3);
 
+// Per brick sample: its point's home sample, and the neighbourhood slot of node home − f for each
+// f ∈ {0,1}³ (x + 2y + 4z), as PointIndex asks for them.
+struct SampleHome {
+  std::uint8_t home_sample = 0;
+  std::uint8_t slot[8] = {};
+};
+struct SampleHomes {
+  SampleHome sample[27];
+};
+
+constexpr SampleHomes MakeSampleHomes(std::uint32_t side) {
+  SampleHomes homes;
+  for (unsigned s = 0; s < side * side * side; ++s) {
+    const HomeOf h = HomeOfSample(side, s);
+    homes.sample[s].home_sample = static_cast<std::uint8_t>(h.home_sample);
+    for (unsigned f = 0; f < 8; ++f) {
+      homes.sample[s].slot[f] = static_cast<std::uint8_t>(SlotOf(h.e, f));
+    }
+  }
+  return homes;
+}
+
+constexpr SampleHomes kHomes2 = MakeSampleHomes(2), kHomes3 = MakeSampleHomes(3);
+
 }  // namespace
 
 std::uint32_t OrphanMask(std::uint32_t side, const Neighbourhood& nb) {
@@ -139,8 +163,8 @@ SampleLayout LayOutSamples(const MaskTree& tree, std::uint32_t level, std::uint3
 }
 
 std::uint64_t SampleIndex(const SampleLayout& layout, const Neighbourhood& nb, unsigned sample) {
-  const HomeOf h = HomeOfSample(layout.side, sample);
-  return PointIndex(layout, h.home_sample, [&](unsigned f) { return nb[SlotOf(h.e, f)]; });
+  const SampleHome& h = (layout.side == 2 ? kHomes2 : kHomes3).sample[sample];
+  return PointIndex(layout, h.home_sample, [&](unsigned f) { return nb[h.slot[f]]; });
 }
 
 }  // namespace svokit
