@@ -236,10 +236,9 @@ class VoxelTile {
   std::vector<Point> point_;
 };
 
-// Calls body(tile, i, nb, corner) for every node i of the level above the voxels, with its
-// neighbourhood and its voxel block's corner in tile coordinates (the block's voxel (2, 2, 2) is
-// the node's first child), tile by tile: the nodes below one node up to four levels higher, which
-// `tile` gathers the voxels of.
+// Calls body(tile, i, corner) for every node i of the level above the voxels, with its voxel
+// block's corner in tile coordinates (the block's voxel (2, 2, 2) is the node's first child), tile
+// by tile: the nodes below one node up to four levels higher, which `tile` gathers the voxels of.
 template <class Body>
 void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, Flags f,
                         const Body& body) {
@@ -255,7 +254,6 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
     tile.Start(source, f);
     struct Node {
       std::uint64_t i;
-      Neighbourhood nb;
       int corner[3];
     };
     std::vector<Node> nodes;
@@ -281,7 +279,7 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
             }
           }
         }
-        nodes.push_back({i, nb, {2 * x - 2, 2 * y - 2, 2 * z - 2}});
+        nodes.push_back({i, {2 * x - 2, 2 * y - 2, 2 * z - 2}});
         return;
       }
       const std::uint8_t m = tree.masks[level - tree.first_level][i];
@@ -294,7 +292,7 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
       }
     };
     descend(descend, tile_level, t, tile_nb, 0, 0, 0);
-    for (const Node& n : nodes) body(tile, n.i, n.nb, n.corner);
+    for (const Node& n : nodes) body(tile, n.i, n.corner);
   });
 }
 
@@ -416,21 +414,19 @@ LevelSamples Allocate(std::uint64_t n, Flags f) {
 // as the voxel bricks would store them, then decoded), which its tile computes once.
 void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::uint32_t side,
                        const VoxelSamplesSource& source, Flags f, LevelSamples& out) {
-  ForEachAboveVoxels(
-      tree, source, f,
-      [&](VoxelTile& tile, std::uint64_t i, const Neighbourhood&, const int corner[3]) {
-        // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
-        // voxels.
-        int origin[3];
-        for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
-        const int step = side == 3 ? 1 : 2;
-        const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
-          return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
-                              origin[2] + step * (z - 1));
-        };
-        // No per-node cache of taps: the tile holds each point's decoded sample once already.
-        StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
-      });
+  ForEachAboveVoxels(tree, source, f, [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
+    // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
+    // voxels.
+    int origin[3];
+    for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
+    const int step = side == 3 ? 1 : 2;
+    const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
+      return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
+                          origin[2] + step * (z - 1));
+    };
+    // No per-node cache of taps: the tile holds each point's decoded sample once already.
+    StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
+  });
 }
 
 // An inner level's samples from the stored samples of the level below.
@@ -518,31 +514,29 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
   out.opacity.resize(static_cast<std::uint64_t>(kept) * n);
   out.color.resize(f.color ? out.opacity.size() : 0);
   out.normal.resize(f.normal ? out.opacity.size() : 0);
-  ForEachAboveVoxels(
-      tree, source, f,
-      [&](VoxelTile& tile, std::uint64_t i, const Neighbourhood&, const int corner[3]) {
-        const std::uint8_t m = tree.masks[level - tree.first_level][i];
-        std::uint64_t voxel = tree.first_child[level - tree.first_level][i];
-        for (int c = 0; c < 8; ++c) {
-          if (!(m >> c & 1u)) continue;
-          const std::int64_t to_voxel = slot[voxel++];
-          if (to_voxel < 0) continue;
-          // The voxel's corner in half voxels.
-          const int h[3] = {2 * (corner[0] + 2 + (c & 1)), 2 * (corner[1] + 2 + (c >> 1 & 1)),
-                            2 * (corner[2] + 2 + (c >> 2 & 1))};
-          const int step = side == 3 ? 1 : 2;
-          for (unsigned s = 0; s < n; ++s) {
-            const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
-                              static_cast<int>(s / (side * side))};
-            const EncodedSample e =
-                tile.Encoded(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]);
-            const std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n + s;
-            out.opacity[to] = e.opacity;
-            if (f.color) out.color[to] = e.color;
-            if (f.normal) out.normal[to] = e.normal;
-          }
-        }
-      });
+  ForEachAboveVoxels(tree, source, f, [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
+    const std::uint8_t m = tree.masks[level - tree.first_level][i];
+    std::uint64_t voxel = tree.first_child[level - tree.first_level][i];
+    for (int c = 0; c < 8; ++c) {
+      if (!(m >> c & 1u)) continue;
+      const std::int64_t to_voxel = slot[voxel++];
+      if (to_voxel < 0) continue;
+      // The voxel's corner in half voxels.
+      const int h[3] = {2 * (corner[0] + 2 + (c & 1)), 2 * (corner[1] + 2 + (c >> 1 & 1)),
+                        2 * (corner[2] + 2 + (c >> 2 & 1))};
+      const int step = side == 3 ? 1 : 2;
+      for (unsigned s = 0; s < n; ++s) {
+        const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
+                          static_cast<int>(s / (side * side))};
+        const EncodedSample e =
+            tile.Encoded(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]);
+        const std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n + s;
+        out.opacity[to] = e.opacity;
+        if (f.color) out.color[to] = e.color;
+        if (f.normal) out.normal[to] = e.normal;
+      }
+    }
+  });
 }
 
 }  // namespace svokit

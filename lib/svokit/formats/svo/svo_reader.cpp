@@ -127,13 +127,9 @@ StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
     if (!chunk.ok()) return chunk.status();
     return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
   };
-  if (by_level) {
-    ParallelChunks(chunks, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t c = begin; c < end; ++c) parts[c] = measure(c);
-    });
-  } else {
-    for (std::size_t c = 0; c < chunks; ++c) parts[c] = measure(c);
-  }
+  ParallelChunks(chunks, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) parts[c] = measure(c);
+  });
   ChunkBytes all;
   for (const StatusOr<ChunkBytes>& part : parts) {  // in chunk order: the first error is reported
     if (!part.ok()) return part.status();
