@@ -58,6 +58,12 @@ const Built& Torus() {
   return b;
 }
 
+// The torus over several pages (pages are 128³ voxels).
+const Built& PagedTorus() {
+  static const Built b = Build(test::DataDir() / "uv-torus.obj", 256);
+  return b;
+}
+
 TEST(SvoFileV2, ReadsBackAsTheOctreeForEveryOption) {
   struct Case {
     std::filesystem::path mesh;
@@ -121,7 +127,7 @@ TEST(SvoFileV2, LevelsDownToAnyLevel) {
 
 // Loading every page gives the whole tree: each level is the pages' parts in page order.
 TEST(SvoReader, EveryPageTogetherIsTheWholeTree) {
-  const Built b = Build(test::DataDir() / "uv-torus.obj", 128);
+  const Built& b = PagedTorus();
   const auto bytes = EncodeSvo(b.svo);
   auto reader = SvoReader::FromBytes(bytes, "t.svo");
   ASSERT_TRUE(reader.ok()) << reader.status().message();
@@ -362,7 +368,7 @@ TEST(SvoFileV2, VersionOneFilesStillRead) {
 // byte per distinct sample, the voxels' own normals on the voxel level only.
 TEST(SvoReader, FileStatsByLevelSplitEachKindOfArrayExactly) {
   for (const bool zstd : {true, false}) {
-    const Built b = Build(test::DataDir() / "uv-torus.obj", 128);
+    const Built& b = PagedTorus();
     SvoCompression compression;
     compression.zstd = zstd;
     const auto bytes = EncodeSvo(b.svo, compression);

@@ -175,12 +175,15 @@ TEST(SvoPages, PagesAtEveryLevelJoinToTheOctree) {
   }
 }
 
-// The page level also bounds the largest page: with a smaller bound it goes deeper, and every
-// page of the level it picks has at most that many nodes.
-TEST(SvoPages, ThePageLevelBoundsTheLargestPage) {
+// Pages are the subtrees of 128³ voxels: the page level follows from the depth alone, and every
+// voxel of a page lies in its root's cube.
+TEST(SvoPages, PagesAreSubtreesOf128CubedVoxels) {
+  for (std::uint32_t depth = 0; depth <= 20; ++depth) {
+    EXPECT_EQ(PageLevel(depth), depth > 7 ? depth - 7 : 0) << depth;
+  }
   auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
   ASSERT_TRUE(mesh.ok());
-  auto grid = GridTransform::FitResolution(mesh->Bounds(), 128);
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), 512);
   auto voxels = Voxelize(*mesh, *grid, VoxelizeOptions{});
   ASSERT_TRUE(voxels.ok());
   BuildOptions bo;
@@ -188,25 +191,18 @@ TEST(SvoPages, ThePageLevelBoundsTheLargestPage) {
   bo.contours = false;
   auto compact = BuildCompactSvo(*voxels, nullptr, bo);
   ASSERT_TRUE(compact.ok());
-  const auto largest = [&](std::uint32_t level) {
-    std::uint64_t most = 0;
-    const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->tree, level);
-    for (std::size_t p = 0; p < nbs.size(); ++p) {
-      const SvoChunk page = PageChunk(*compact, level, p, nbs[p], 0);
-      std::uint64_t nodes = 0;
-      for (std::uint32_t l = level; l <= compact->depth; ++l) nodes += page.tree.NodeCount(l);
-      most = std::max(most, nodes);
-    }
-    return most;
-  };
-  const std::uint32_t mean_level = PageLevel(*compact);
-  ASSERT_GT(mean_level, 0u);
-  ASSERT_LT(mean_level + 2, compact->depth);
-  const std::uint64_t bound = largest(mean_level) - 1;
-  const std::uint32_t level = PageLevel(*compact, bound);
-  EXPECT_GT(level, mean_level);
-  EXPECT_LE(largest(level), bound);
-  EXPECT_GT(largest(level - 1), bound);  // the shallowest such level
+  const std::uint32_t level = PageLevel(compact->depth);
+  ASSERT_EQ(level, 2u);
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->tree, level);
+  ASSERT_GT(nbs.size(), 8u);
+  std::uint64_t voxels_in_pages = 0;
+  for (std::size_t p = 0; p < nbs.size(); ++p) {
+    const SvoChunk page = PageChunk(*compact, level, p, nbs[p], 0);
+    const std::uint64_t n = page.tree.NodeCount(compact->depth);
+    EXPECT_GT(n, 0u);
+    voxels_in_pages += n;
+  }
+  EXPECT_EQ(voxels_in_pages, compact->voxel_count());
 }
 
 // A page carries the voxels outside it that touch one of its voxels, and no others.

@@ -57,29 +57,6 @@ std::vector<std::uint64_t> ChunkVoxelKeys(const SvoChunk& chunk) {
   return keys;
 }
 
-std::uint32_t PageLevel(const CompactSvo& svo, std::uint64_t max_page_nodes) {
-  // A dense region among sparse ones can leave one page far above the mean: the level also
-  // bounds the largest page.
-  const auto largest_page = [&](std::uint32_t level) {
-    std::uint64_t largest = 0;
-    for (std::uint64_t i = 0; i < svo.NodeCount(level); ++i) {
-      std::uint64_t nodes = 0;
-      for (const auto& [begin, end] : SubtreeRanges(svo.tree, level, svo.depth, i)) {
-        nodes += end - begin;
-      }
-      largest = std::max(largest, nodes);
-    }
-    return largest;
-  };
-  for (std::uint32_t level = 0; level + 1 < svo.depth; ++level) {
-    if (svo.voxel_count() <= kPageVoxels * svo.NodeCount(level) &&
-        largest_page(level) <= max_page_nodes) {
-      return level;
-    }
-  }
-  return svo.depth == 0 ? 0 : svo.depth - 1;
-}
-
 SvoChunk TopChunk(const CompactSvo& svo, std::uint32_t page_level) {
   SvoChunk top;
   if (page_level == 0) return top;

@@ -45,18 +45,17 @@ struct SvoChunk {
   std::uint32_t levels_held() const { return static_cast<std::uint32_t>(contours.size()); }
 };
 
-/// Pages of about this many voxels on average: the page level is the shallowest whose mean page
-/// holds at most this many (formats/svo/README.md, "Pages": why).
-inline constexpr std::uint64_t kPageVoxels = std::uint64_t{1} << 15;
+/// A page is the subtree of a node 2^kPageSideBits voxels on a side (or the whole tree, when it is
+/// no larger). Fixed, so the page level follows from the depth alone: a build that makes the
+/// pages one at a time knows it before any voxel exists (formats/svo/README.md, "Pages": why
+/// 128). A full page of that side has 2.4 M nodes, so its streams stay far below a reader's
+/// limits.
+inline constexpr std::uint32_t kPageSideBits = 7;
 
-/// No page holds more nodes than this (all its levels): every stream of the largest page then
-/// decodes to well under a reader's per-stream limit (formats/svo/README.md, "Invariants").
-inline constexpr std::uint64_t kMaxPageNodes = std::uint64_t{1} << 22;
-
-/// The page level of an octree: the shallowest level (below depth) whose nodes hold at most
-/// kPageVoxels voxels on average and whose largest subtree has at most `max_page_nodes` nodes,
-/// or 0 for a small octree.
-std::uint32_t PageLevel(const CompactSvo& svo, std::uint64_t max_page_nodes = kMaxPageNodes);
+/// The page level of an octree of `depth` levels below the root: depth − kPageSideBits, or 0.
+constexpr std::uint32_t PageLevel(std::uint32_t depth) {
+  return depth > kPageSideBits ? depth - kPageSideBits : 0;
+}
 
 /// The top chunk: levels 0 .. page_level − 1 with every level's samples and contours, and the
 /// masks of level page_level − 1, which name the pages. Empty (no levels) when page_level is 0.

@@ -339,7 +339,7 @@ class StreamSet {
       }
       // Sizes a damaged or hostile directory states must not allocate without bound: a stream
       // decodes to at most kStreamLimit bytes, a chunk to kChunkLimit (writers keep pages far
-      // below: kMaxPageNodes).
+      // below: a full page of 128³ voxels).
       if (e.raw > kStreamLimit) {
         return Status::BadInput("{}: stream {} claims {} bytes, more than the {} a stream may hold",
                                 name, e.kind, e.raw, kStreamLimit);

@@ -46,7 +46,7 @@ StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const
                                       const SvoShape& shape, const std::string& name);
 
 /// What one stream and one chunk may decode to: the bound on what a file's stated sizes can make
-/// a reader allocate (a page of kMaxPageNodes nodes stays far below).
+/// a reader allocate (a full page, 2.4 M nodes, stays far below).
 inline constexpr std::uint64_t kStreamLimit = std::uint64_t{1} << 30;
 inline constexpr std::uint64_t kChunkLimit = std::uint64_t{4} << 30;
 

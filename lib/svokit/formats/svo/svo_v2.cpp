@@ -57,7 +57,7 @@ std::unique_ptr<Version2Writer> MakeVersion2(const CompactSvo& svo,
                                              SvoFileStats* stats) {
   auto out = std::make_unique<Version2Writer>();
   const SvoShape shape = Shape(svo);
-  const std::uint32_t page_level = PageLevel(svo);
+  const std::uint32_t page_level = PageLevel(svo.depth);
   const std::vector<std::uint64_t> keys = KeysOfLevel(svo.tree, page_level);
   const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
   ChunkBytes top_bytes;
