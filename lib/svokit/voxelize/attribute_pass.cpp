@@ -28,13 +28,11 @@ namespace {
 // 16³ pay off: fewer pairs, and fewer column runs split between bricks along the dominant axis.
 using PassBrick = MortonBrick<5>;
 constexpr std::int64_t kPassSide = PassBrick::kSide;
+constexpr int kPassBits = std::countr_zero(std::uint64_t{kPassSide});
 
 // Which triangles touch which pass brick: attributes are accumulated brick by brick, each voxel's
 // contributions summed in triangle order, so the result does not depend on threads or method.
-struct BrickTriangle {
-  std::uint64_t brick;
-  std::uint32_t triangle;
-};
+using BrickTriangle = CellTriangle;
 
 // Appends (brick, triangle) for the pass bricks the triangle may have voxels in: a superset,
 // which is all the brick pass needs (a brick the triangle misses costs a walk of its columns
@@ -43,8 +41,10 @@ struct BrickTriangle {
 // the plane's lowest and highest point over the window's part of the box, widened by the voxels
 // a closed box can touch and one more for rounding. Doubles are exact on the snapped vertices'
 // differences, and rounding elsewhere is far below those one-voxel margins.
-void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std::uint32_t triangle,
-                 std::vector<BrickTriangle>& out) {
+}  // namespace
+
+void BinToCells(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std::uint32_t triangle,
+                int cell_bits, std::int64_t grow, std::vector<CellTriangle>& out) {
   if (tv.empty()) return;
   const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
   double pu[3], pv[3];
@@ -56,14 +56,17 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
   // A (nearly) degenerate triangle, whose rounded normal may point anywhere: its whole box.
   const bool plane = std::abs(nw) > 1e-9 * Length(e1) * Length(e2);
   const std::int64_t lo_u = tv.lo(u), hi_u = tv.hi(u), lo_v = tv.lo(v), hi_v = tv.hi(v);
-  constexpr int kB = std::countr_zero(PassBrick::kSide);
-  constexpr std::int64_t kS = kPassSide;
-  for (std::int64_t bv = lo_v >> kB; bv <= (hi_v - 1) >> kB; ++bv) {
-    for (std::int64_t bu = lo_u >> kB; bu <= (hi_u - 1) >> kB; ++bu) {
-      const double u0 = static_cast<double>(std::max(bu * kS, lo_u));
-      const double u1 = static_cast<double>(std::min(bu * kS + kS, hi_u));
-      const double v0 = static_cast<double>(std::max(bv * kS, lo_v));
-      const double v1 = static_cast<double>(std::min(bv * kS + kS, hi_v));
+  const int kB = cell_bits;
+  const std::int64_t kS = std::int64_t{1} << cell_bits;
+  // Cells whose box grown by `grow` voxels meets the candidate columns (none below 0).
+  for (std::int64_t bv = std::max<std::int64_t>(0, (lo_v - grow) >> kB);
+       bv <= (hi_v - 1 + grow) >> kB; ++bv) {
+    for (std::int64_t bu = std::max<std::int64_t>(0, (lo_u - grow) >> kB);
+         bu <= (hi_u - 1 + grow) >> kB; ++bu) {
+      const double u0 = static_cast<double>(std::max(bu * kS - grow, lo_u));
+      const double u1 = static_cast<double>(std::min(bu * kS + kS + grow, hi_u));
+      const double v0 = static_cast<double>(std::max(bv * kS - grow, lo_v));
+      const double v1 = static_cast<double>(std::min(bv * kS + kS + grow, hi_v));
       std::int64_t w_lo = tv.lo(w), w_hi = tv.hi(w) - 1;
       if (plane) {
         bool apart = false;  // an edge separates the triangle from the window grown by a voxel
@@ -86,7 +89,8 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
         w_lo = std::max(w_lo, static_cast<std::int64_t>(std::floor(h_lo)) - 2);
         w_hi = std::min(w_hi, static_cast<std::int64_t>(std::floor(h_hi)) + 1);
       }
-      for (std::int64_t bw = w_lo >> kB; bw <= w_hi >> kB && w_lo <= w_hi; ++bw) {
+      for (std::int64_t bw = std::max<std::int64_t>(0, (w_lo - grow) >> kB);
+           bw <= (w_hi + grow) >> kB && w_lo <= w_hi; ++bw) {
         std::uint32_t c[3];
         c[u] = Coord(bu), c[v] = Coord(bv), c[w] = Coord(bw);
         out.push_back({MortonEncode(c[0], c[1], c[2]), triangle});
@@ -94,6 +98,8 @@ void BinToBricks(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& p, std
     }
   }
 }
+
+namespace {
 
 // A triangle's walk set-up and sampler part, kept per thread for the last triangles seen: a
 // triangle spans a few bricks and a task's bricks are Morton neighbours, so set-ups repeat.
@@ -111,7 +117,7 @@ class TriangleCache {
     if (e.triangle != t) {
       e.triangle = t;
       e.tv.emplace(voxelizer.Triangle(t));
-      e.prepared = sampler.Prepare(t);
+      e.prepared = sampler.Prepare(voxelizer.Global(t));
     }
     return e;
   }
@@ -244,13 +250,15 @@ class BrickOutput {
 // in an array of their own that is otherwise never touched.
 class BrickAccumulator {
  public:
-  BrickAccumulator(bool colors, bool normals)
-      : color_sums_(colors ? kVoxels : 0), colors_(colors), normals_(normals) {}
+  BrickAccumulator(bool colors, bool normals, bool sums)
+      : color_sums_(colors ? kVoxels : 0), colors_(colors), normals_(normals), sums_on_(sums) {}
   static constexpr std::size_t kVoxels = PassBrick::kVoxels;
   // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
   // only that way still averages its contacts.
   static constexpr double kMinWeight = 1.0 / (1 << 20);
 
+  // A voxel without sums (a walk for the voxels alone).
+  void Mark(std::uint32_t local) { bits_[local >> 6] |= std::uint64_t{1} << (local & 63); }
   void Add(std::uint32_t local, double area, const Rgba& color, const Vec3f& normal) {
     bits_[local >> 6] |= std::uint64_t{1} << (local & 63);
     Sum& sum = sums_[local];
@@ -277,6 +285,10 @@ class BrickAccumulator {
     const std::size_t at = out.keys.size();
     const std::uint64_t base = brick << PassBrick::kCodeBits;
     out.keys.resize(at + n);
+    if (!sums_on_) {
+      for (std::size_t i = 0; i < n; ++i) out.keys[at + i] = base | locals[i];
+      return;
+    }
     out.coverage.resize(at + n);
     for (std::size_t i = 0; i < n; ++i) {
       Sum& sum = sums_[locals[i]];
@@ -324,7 +336,7 @@ class BrickAccumulator {
   std::array<std::uint16_t, kVoxels> locals_;
   std::array<Sum, kVoxels> sums_{};
   std::vector<ColorSum> color_sums_;
-  bool colors_, normals_;
+  bool colors_, normals_, sums_on_;
 };
 
 // Voxels with attributes, brick by brick: every triangle of a brick's bin, in index order, walks
@@ -334,10 +346,10 @@ class BrickAccumulator {
 class BrickPass {
  public:
   BrickPass(const MeshVoxelizer& voxelizer, const AttributeSampler& sampler, bool colors,
-            bool normals)
-      : voxelizer_(voxelizer), sampler_(sampler), colors_(colors), normals_(normals) {}
+            bool normals, bool sums)
+      : voxelizer_(voxelizer), sampler_(sampler), colors_(colors), normals_(normals), sums_(sums) {}
 
-  /// `bins`: the (brick, triangle) pairs BinToBricks listed, per chunk of triangles in index
+  /// `bins`: the (brick, triangle) pairs BinToCells listed, per chunk of triangles in index
   /// order (each brick of a triangle once); `reserve`: room for the voxels to reserve up front
   /// (more only costs a reallocation).
   Status Run(std::vector<std::vector<BrickTriangle>>& bins, std::size_t reserve,
@@ -346,14 +358,14 @@ class BrickPass {
     std::uint64_t last_brick = 0;
     for (auto& b : bins) {
       pairs.insert(pairs.end(), b.begin(), b.end());
-      for (const BrickTriangle& p : b) last_brick = std::max(last_brick, p.brick);
+      for (const BrickTriangle& p : b) last_brick = std::max(last_brick, p.cell);
       std::vector<BrickTriangle>().swap(b);
     }
     // In triangle order already: a stable sort by brick orders them by (brick, triangle).
-    RadixSortByKey(pairs, KeyBits(last_brick), [](const BrickTriangle& p) { return p.brick; });
+    RadixSortByKey(pairs, KeyBits(last_brick), [](const BrickTriangle& p) { return p.cell; });
     std::vector<std::size_t> starts;  // first pair of each brick, and the end
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (i == 0 || pairs[i].brick != pairs[i - 1].brick) starts.push_back(i);
+      if (i == 0 || pairs[i].cell != pairs[i - 1].cell) starts.push_back(i);
     }
     starts.push_back(pairs.size());
     const std::size_t bricks = starts.size() - 1;
@@ -361,7 +373,7 @@ class BrickPass {
     SVOKIT_RETURN_IF_ERROR(output.Reserve(reserve, bricks));
     Progress::Stage stage(progress, "attributes", bricks);
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
-        [&] { return std::make_unique<BrickAccumulator>(colors_, normals_); });
+        [&] { return std::make_unique<BrickAccumulator>(colors_, normals_, sums_); });
     tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
         [] { return std::make_unique<TriangleCache>(); });
     // Groups of kGroupBricks bricks: numbered in order, filled in parallel into a free buffer,
@@ -428,7 +440,7 @@ class BrickPass {
 
   void FillBrick(const std::vector<BrickTriangle>& pairs, std::size_t first, std::size_t last,
                  BrickAccumulator& acc, TriangleCache& cache, VoxelRun& out) const {
-    const std::uint64_t brick = pairs[first].brick;
+    const std::uint64_t brick = pairs[first].cell;
     const MortonCoord bc = MortonDecode(brick);
     const std::int64_t lo[3] = {bc.x * kPassSide, bc.y * kPassSide, bc.z * kPassSide};
     AttributeSample samples[kPassSide];  // one run's samples (built once: a run is often one voxel)
@@ -439,6 +451,19 @@ class BrickPass {
         voxelizer_.Prefetch(pairs[i + 1].triangle, MeshVoxelizer::kVertices);
       const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
       const TriangleVoxelizer& tv = *entry.tv;
+      if (!sums_) {
+        const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
+        tv.RunsAlongAxis(
+            lo[u], lo[u] + kPassSide, lo[v], lo[v] + kPassSide, lo[w], lo[w] + kPassSide,
+            [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k, bool) {
+              std::uint32_t local = PassBrick::LocalCode(Coord(x), Coord(y), Coord(z));
+              for (std::int64_t s = 0; s < k; ++s) {
+                acc.Mark(local);
+                local = PassBrick::NextLocal(local, axis);
+              }
+            });
+        continue;
+      }
       const AttributeSampler::Prepared& p = entry.prepared;
       const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
       // A uniform triangle's samples differ only in area (most meshes: scans, CAD, STL).
@@ -469,14 +494,15 @@ class BrickPass {
 
   const MeshVoxelizer& voxelizer_;
   const AttributeSampler& sampler_;
-  bool colors_, normals_;
+  bool colors_, normals_, sums_;
 };
 
 }  // namespace
 
-Status VoxelizeWithAttributes(const MeshVoxelizer& voxelizer, const VoxelizeOptions& options,
-                              double projected_area, VoxelAttributes attributes,
-                              VoxelOutput& output, Progress& progress) {
+Status VoxelizeWithSampler(const MeshVoxelizer& voxelizer, const AttributeSampler& sampler,
+                           const std::optional<Rgba>& shared_color, const VoxelizeOptions& options,
+                           std::size_t reserve, VoxelAttributes attributes, VoxelOutput& output,
+                           Progress& progress) {
   const std::size_t n = voxelizer.size();
   // Voxels and attributes come out of one walk per brick (BrickPass), whatever the method:
   // first the bricks each triangle may touch.
@@ -486,26 +512,34 @@ Status VoxelizeWithAttributes(const MeshVoxelizer& voxelizer, const VoxelizeOpti
     ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
       std::vector<BrickTriangle>& pairs = bins[begin / kTrianglesPerTask];
       for (std::size_t t = begin; t < end; ++t) {
-        BinToBricks(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
-                    pairs);
+        BinToCells(voxelizer.Triangle(t), voxelizer.Corners(t), static_cast<std::uint32_t>(t),
+                   kPassBits, 0, pairs);
       }
       stage.Advance(end - begin);
     });
   }
+  const bool sums = options.colors || options.normals;
+  if (sums && shared_color) attributes.colors.assign(1, *shared_color);
+  const bool colors = options.colors && !shared_color;
+  const PackedVoxelContents contents{colors, options.normals, sums,
+                                     sums && shared_color.has_value()};
+  BrickPass pass(voxelizer, sampler, colors, options.normals, sums);
+  BrickOutput brick_output(output, contents);
+  SVOKIT_RETURN_IF_ERROR(pass.Run(bins, reserve, brick_output, progress));
+  output.Finish(std::move(attributes), contents, brick_output.count(), brick_output.bytes());
+  return Status::Ok();
+}
+
+Status VoxelizeWithAttributes(const MeshVoxelizer& voxelizer, const VoxelizeOptions& options,
+                              double projected_area, VoxelAttributes attributes,
+                              VoxelOutput& output, Progress& progress) {
   const AttributeSampler sampler(voxelizer.mesh(), voxelizer.vertices(), options.colors,
                                  options.normals);
   attributes.warnings = sampler.warnings();
-  const std::optional<Rgba> shared_color = sampler.SharedColor();
-  if (shared_color) attributes.colors.assign(1, *shared_color);
-  const bool colors = options.colors && !shared_color;
-  const PackedVoxelContents contents{colors, options.normals, true, shared_color.has_value()};
-  BrickPass pass(voxelizer, sampler, colors, options.normals);
-  BrickOutput brick_output(output, contents);
   // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-  SVOKIT_RETURN_IF_ERROR(
-      pass.Run(bins, static_cast<std::size_t>(2.0 * projected_area) + n, brick_output, progress));
-  output.Finish(std::move(attributes), contents, brick_output.count(), brick_output.bytes());
-  return Status::Ok();
+  return VoxelizeWithSampler(voxelizer, sampler, sampler.SharedColor(), options,
+                             static_cast<std::size_t>(2.0 * projected_area) + voxelizer.size(),
+                             std::move(attributes), output, progress);
 }
 
 }  // namespace svokit::voxelize_detail

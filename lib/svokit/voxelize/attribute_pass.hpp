@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,19 +28,31 @@ inline std::uint32_t Coord(std::int64_t c) {
   return static_cast<std::uint32_t>(c);
 }
 
-// The mesh's triangles over their snapped voxel-space corners.
+// The mesh's triangles over their snapped voxel-space corners, clipped to a box of voxels (the
+// grid's, or a region of it); all of them, or a subset (ascending triangle indices). Triangles
+// are numbered 0 .. size() − 1 within the subset; Global() gives the mesh's index.
 class MeshVoxelizer {
  public:
-  MeshVoxelizer(const Mesh& mesh, const std::vector<FixedPoint3>& vertices,
-                const GridTransform& grid, VoxelMode mode)
-      : mesh_(mesh), vertices_(vertices), box_(grid.IndexBox()), mode_(mode) {}
+  MeshVoxelizer(const Mesh& mesh, const std::vector<FixedPoint3>& vertices, const IBox3& box,
+                VoxelMode mode)
+      : mesh_(mesh), vertices_(vertices), box_(box), mode_(mode) {}
+  MeshVoxelizer(const Mesh& mesh, const std::vector<FixedPoint3>& vertices, const IBox3& box,
+                VoxelMode mode, std::span<const std::uint32_t> subset)
+      : mesh_(mesh),
+        vertices_(vertices),
+        box_(box),
+        mode_(mode),
+        subset_(subset),
+        has_subset_(true) {}
 
   const Mesh& mesh() const { return mesh_; }
   const std::vector<FixedPoint3>& vertices() const { return vertices_; }
-  std::size_t size() const { return mesh_.triangles.size(); }
+  const IBox3& box() const { return box_; }
+  std::size_t size() const { return has_subset_ ? subset_.size() : mesh_.triangles.size(); }
+  std::size_t Global(std::size_t t) const { return has_subset_ ? subset_[t] : t; }
 
   TriangleVoxelizer Triangle(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
+    const svokit::Triangle& tri = mesh_.triangles[Global(t)];
     return TriangleVoxelizer(vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]], mode_, box_);
   }
 
@@ -47,7 +60,7 @@ class MeshVoxelizer {
   /// the cache: the brick pass sets triangles up in brick order, far apart in memory.
   enum PrefetchWhat { kCorners, kVertices };
   void Prefetch(std::size_t t, PrefetchWhat what) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
+    const svokit::Triangle& tri = mesh_.triangles[Global(t)];
     if (what == kCorners) {
       __builtin_prefetch(&tri);
     } else {
@@ -57,14 +70,14 @@ class MeshVoxelizer {
 
   /// The snapped corners in voxel coordinates (exact in doubles).
   std::array<Vec3d, 3> Corners(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
+    const svokit::Triangle& tri = mesh_.triangles[Global(t)];
     return {FixedToVoxel(vertices_[tri[0]]), FixedToVoxel(vertices_[tri[1]]),
             FixedToVoxel(vertices_[tri[2]])};
   }
 
   // Projected dominant-axis area in voxel², in doubles: only a scheduling decision.
   double ProjectedArea(std::size_t t) const {
-    const svokit::Triangle& tri = mesh_.triangles[t];
+    const svokit::Triangle& tri = mesh_.triangles[Global(t)];
     const Vec3d a = FixedToVoxel(vertices_[tri[0]]), b = FixedToVoxel(vertices_[tri[1]]),
                 c = FixedToVoxel(vertices_[tri[2]]);
     const Vec3d n = Cross(b - a, c - a);
@@ -76,6 +89,8 @@ class MeshVoxelizer {
   const std::vector<FixedPoint3>& vertices_;
   IBox3 box_;
   VoxelMode mode_;
+  std::span<const std::uint32_t> subset_;
+  bool has_subset_ = false;
 };
 
 /// The arrays a pass fills: 64-bit keys, or their varint gaps when packed, and the per-voxel
@@ -107,5 +122,30 @@ class VoxelOutput {
 Status VoxelizeWithAttributes(const MeshVoxelizer& voxelizer, const VoxelizeOptions& options,
                               double projected_area, VoxelAttributes attributes,
                               VoxelOutput& output, Progress& progress);
+
+/// A triangle that may have voxels in a cell (a cube of 2^cell_bits voxels, by Morton key).
+struct CellTriangle {
+  std::uint64_t cell;
+  std::uint32_t triangle;
+};
+/// Appends (cell, triangle) for the cells the triangle may have voxels in or within `grow` voxels
+/// of: a superset, from its candidate box and its plane's height over each cell's columns.
+void BinToCells(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& corners,
+                std::uint32_t triangle, int cell_bits, std::int64_t grow,
+                std::vector<CellTriangle>& out);
+
+}  // namespace svokit::voxelize_detail
+namespace svokit {
+class AttributeSampler;
+}
+namespace svokit::voxelize_detail {
+
+/// The same walk with a sampler prepared once for many calls (RegionVoxelizer), whose shared
+/// colour, if any, is `shared_color`. Without colours and normals in `options` it finds the
+/// voxels alone: no coverage, no sums.
+Status VoxelizeWithSampler(const MeshVoxelizer& voxelizer, const AttributeSampler& sampler,
+                           const std::optional<Rgba>& shared_color, const VoxelizeOptions& options,
+                           std::size_t reserve, VoxelAttributes attributes, VoxelOutput& output,
+                           Progress& progress);
 
 }  // namespace svokit::voxelize_detail

@@ -13,6 +13,7 @@
 #include "svokit/core/radix_sort.hpp"
 #include "svokit/core/release_pages.hpp"
 #include "svokit/voxelize/attribute_pass.hpp"
+#include "svokit/voxelize/attributes.hpp"
 #include "svokit/voxelize/voxel_bitset.hpp"
 
 namespace svokit {
@@ -161,7 +162,7 @@ Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& gri
     const IBox3 box = grid.IndexBox();
     ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
-        const FixedPoint3& p = vertices[mesh.triangles[t][0]];
+        const FixedPoint3& p = vertices[mesh.triangles[voxelizer.Global(t)][0]];
         std::uint32_t c[3];
         for (int a = 0; a < 3; ++a) {
           c[a] = Coord(std::clamp(p[a] >> kFixedPointBits, box.lo[a], box.hi[a] - 1) >> 4);
@@ -249,11 +250,10 @@ Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& gri
   return Status::Ok();
 }
 
-// Voxelize() and VoxelizePacked(): checks, then the geometry or the attribute pass.
-Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
-                    Progress& progress, VoxelOutput& output) {
+// The mesh's vertices snapped to `grid`, if the voxelizer can take them.
+StatusOr<std::vector<FixedPoint3>> SnapChecked(const Mesh& mesh, const GridTransform& grid) {
   if (mesh.triangles.empty()) return Status::BadInput("the mesh has no triangles to voxelize");
-  const std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
+  std::vector<FixedPoint3> vertices = SnapToVoxelSpace(mesh, grid);
   for (const FixedPoint3& v : vertices) {
     for (int a = 0; a < 3; ++a) {
       if (v[a] <= -kCoordinateLimit || v[a] >= kCoordinateLimit) {
@@ -262,7 +262,16 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
       }
     }
   }
-  const MeshVoxelizer voxelizer(mesh, vertices, grid, options.mode);
+  return vertices;
+}
+
+// Voxelize() and VoxelizePacked(): checks, then the geometry or the attribute pass.
+Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options,
+                    Progress& progress, VoxelOutput& output) {
+  StatusOr<std::vector<FixedPoint3>> snapped = SnapChecked(mesh, grid);
+  if (!snapped.ok()) return snapped.status();
+  const std::vector<FixedPoint3>& vertices = *snapped;
+  const MeshVoxelizer voxelizer(mesh, vertices, grid.IndexBox(), options.mode);
   const std::size_t n = mesh.triangles.size();
 
   // A surface of area A voxel² fills roughly 1.5·A voxels (at most ~3·A): refuse, up front, grids
@@ -316,6 +325,88 @@ StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& g
   PackedVoxelSet set;
   SetOutput<PackedVoxelSet> output(set);
   SVOKIT_RETURN_IF_ERROR(VoxelizeInto(mesh, grid, options, progress, output));
+  return set;
+}
+
+RegionVoxelizer::RegionVoxelizer(const Mesh& mesh, const GridTransform& grid,
+                                 const VoxelizeOptions& options)
+    : mesh_(mesh), grid_(grid), options_(options) {}
+
+RegionVoxelizer::~RegionVoxelizer() = default;
+
+StatusOr<std::unique_ptr<RegionVoxelizer>> RegionVoxelizer::Create(const Mesh& mesh,
+                                                                   const GridTransform& grid,
+                                                                   const VoxelizeOptions& options) {
+  StatusOr<std::vector<FixedPoint3>> snapped = SnapChecked(mesh, grid);
+  if (!snapped.ok()) return snapped.status();
+  std::unique_ptr<RegionVoxelizer> r(new RegionVoxelizer(mesh, grid, options));
+  r->vertices_ = std::move(*snapped);
+  r->sampler_ =
+      std::make_unique<AttributeSampler>(mesh, r->vertices_, options.colors, options.normals);
+  r->shared_color_ = r->sampler_->SharedColor();
+  return r;
+}
+
+const std::vector<std::string>& RegionVoxelizer::warnings() const {
+  return sampler_->warnings();
+}
+
+RegionVoxelizer::Bins RegionVoxelizer::BinTriangles(int cell_bits, std::int64_t grow) const {
+  const MeshVoxelizer voxelizer(mesh_, vertices_, grid_.IndexBox(), options_.mode);
+  const std::size_t n = voxelizer.size();
+  std::vector<std::vector<voxelize_detail::CellTriangle>> parts((n + kTrianglesPerTask - 1) /
+                                                                kTrianglesPerTask);
+  ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+    auto& pairs = parts[begin / kTrianglesPerTask];
+    for (std::size_t t = begin; t < end; ++t) {
+      voxelize_detail::BinToCells(voxelizer.Triangle(t), voxelizer.Corners(t),
+                                  static_cast<std::uint32_t>(t), cell_bits, grow, pairs);
+    }
+  });
+  std::vector<voxelize_detail::CellTriangle> pairs;
+  std::uint64_t last = 0;
+  for (auto& part : parts) {
+    for (const auto& p : part) last = std::max(last, p.cell);
+    pairs.insert(pairs.end(), part.begin(), part.end());
+    std::vector<voxelize_detail::CellTriangle>().swap(part);
+  }
+  // Listed in triangle order: a stable sort by cell keeps each cell's triangles ascending.
+  RadixSortByKey(pairs, KeyBits(last),
+                 [](const voxelize_detail::CellTriangle& p) { return p.cell; });
+  Bins bins;
+  bins.triangles.resize(pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    if (i == 0 || pairs[i].cell != pairs[i - 1].cell) {
+      bins.cells.push_back(pairs[i].cell);
+      bins.starts.push_back(i);
+    }
+    bins.triangles[i] = pairs[i].triangle;
+  }
+  bins.starts.push_back(pairs.size());
+  return bins;
+}
+
+StatusOr<VoxelSet> RegionVoxelizer::Voxelize(const IBox3& box,
+                                             std::span<const std::uint32_t> triangles) const {
+  VoxelSet set;
+  const IBox3 clipped = box.Intersect(grid_.IndexBox());
+  VoxelAttributes attributes;
+  attributes.grid = grid_;
+  attributes.mode = options_.mode;
+  if (clipped.empty() || triangles.empty()) {
+    set.grid = grid_;
+    set.mode = options_.mode;
+    if (options_.colors && shared_color_) set.colors.assign(1, *shared_color_);
+    return set;
+  }
+  const MeshVoxelizer voxelizer(mesh_, vertices_, clipped, options_.mode, triangles);
+  SetOutput<VoxelSet> output(set);
+  // Room for a surface crossing the box: about 2 voxels per voxel² of its largest face.
+  std::int64_t side = 1;
+  for (int a = 0; a < 3; ++a) side = std::max(side, clipped.hi[a] - clipped.lo[a]);
+  SVOKIT_RETURN_IF_ERROR(voxelize_detail::VoxelizeWithSampler(
+      voxelizer, *sampler_, shared_color_, options_, static_cast<std::size_t>(2 * side * side),
+      std::move(attributes), output, Progress::Silent()));
   return set;
 }
 

@@ -4,10 +4,18 @@
 // all thread counts produce the identical set: they only split the same exact per-column work
 // differently (see triangle_voxelizer.hpp).
 
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "svokit/core/box.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
+#include "svokit/voxelize/voxel_space.hpp"
 
 namespace svokit {
 
@@ -44,5 +52,53 @@ StatusOr<PackedVoxelization> VoxelizePacked(const Mesh& mesh, const GridTransfor
                                             const VoxelizeOptions& options,
                                             PackedVoxelStorage& storage,
                                             Progress& progress = Progress::Silent());
+
+class AttributeSampler;
+
+/// A mesh voxelized one box at a time, for builds that never hold the whole grid: the triangles
+/// are snapped and their textures decoded once, binned to cells once, and each box's voxels and
+/// attributes are exactly those Voxelize() gives inside it (same bytes: every voxel sums its
+/// triangles in index order wherever its box is cut). No bound on the whole grid's voxel count.
+class RegionVoxelizer {
+ public:
+  /// Fails as Voxelize() does for a mesh it cannot voxelize in `grid`.
+  static StatusOr<std::unique_ptr<RegionVoxelizer>> Create(const Mesh& mesh,
+                                                           const GridTransform& grid,
+                                                           const VoxelizeOptions& options);
+  ~RegionVoxelizer();
+
+  /// The cubes of 2^cell_bits voxels (cells, by Morton key at that size, ascending) that a
+  /// triangle may have voxels in or within `grow` voxels of, each with those triangles
+  /// (ascending): a superset, found from each triangle's plane over the cell's columns.
+  struct Bins {
+    std::vector<std::uint64_t> cells;
+    std::vector<std::uint64_t> starts;  ///< cells.size() + 1 offsets into `triangles`
+    std::vector<std::uint32_t> triangles;
+    std::span<const std::uint32_t> Of(std::size_t i) const {
+      return std::span<const std::uint32_t>(triangles).subspan(starts[i],
+                                                               starts[i + 1] - starts[i]);
+    }
+    std::size_t bytes() const { return 8 * (cells.size() + starts.size()) + 4 * triangles.size(); }
+  };
+  Bins BinTriangles(int cell_bits, std::int64_t grow) const;
+
+  /// The voxels inside `box` (clipped to the grid), from `triangles` (ascending; every triangle
+  /// with a voxel in the box must be among them). Thread-safe.
+  StatusOr<VoxelSet> Voxelize(const IBox3& box, std::span<const std::uint32_t> triangles) const;
+
+  const GridTransform& grid() const { return grid_; }
+  const VoxelizeOptions& options() const { return options_; }
+  /// Non-fatal findings (textures that could not be decoded), as VoxelSet::warnings.
+  const std::vector<std::string>& warnings() const;
+
+ private:
+  RegionVoxelizer(const Mesh& mesh, const GridTransform& grid, const VoxelizeOptions& options);
+  const Mesh& mesh_;
+  GridTransform grid_;
+  VoxelizeOptions options_;
+  std::vector<FixedPoint3> vertices_;
+  std::unique_ptr<AttributeSampler> sampler_;
+  std::optional<Rgba> shared_color_;
+};
 
 }  // namespace svokit
