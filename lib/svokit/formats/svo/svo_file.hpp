@@ -4,14 +4,17 @@
 // a page, compressed; version 1 (still read): levels breadth-first with every node's brick.
 // Layout: README.md here. A renderer that streams pages uses svo_reader.hpp.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "svokit/core/bytes.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
@@ -51,6 +54,64 @@ struct SvoFileStats {
   /// levels' arrays compressed together, so its stored bytes are shared among its levels in
   /// proportion to their decoded bytes. The frame belongs to no level.
   std::vector<std::vector<SvoSectionBytes>> levels;
+};
+
+/// What a version-2 file says of the whole octree, besides its pages.
+struct SvoFrame {
+  GridTransform grid;
+  VoxelMode mode = VoxelMode::kConservative;
+  std::uint32_t depth = 0;
+  SvoShape shape;
+  std::string metadata;  ///< the META section's JSON
+};
+
+/// Writes a version-2 file as its pages arrive, in key order, from a build that may never hold
+/// the whole octree: each page's bytes go to the file at once; the header, the top chunk (made
+/// from the page keys once all are in) and the page table follow them. Every build, held whole
+/// or made page by page, writes through it, so they write the same bytes.
+class PagedSvoWriter {
+ public:
+  PagedSvoWriter(const SvoFrame& frame, const SvoCompression& compression);
+  PagedSvoWriter(const PagedSvoWriter&) = delete;
+  PagedSvoWriter& operator=(const PagedSvoWriter&) = delete;
+
+  std::uint32_t page_level() const { return page_level_; }
+
+  /// A page encoded (thread-safe: encode pages in parallel, hand them on in order).
+  struct EncodedPage {
+    std::uint64_t key = 0;
+    std::vector<std::uint8_t> bytes;
+    ChunkBytes stats;
+    std::vector<std::array<std::uint64_t, 3>> levels;  ///< per level held: nodes, contours, samples
+  };
+  EncodedPage Encode(const SvoChunk& page) const;
+
+  /// Hands every page to `take`, in ascending key order, and stops at its first error.
+  using Take = std::function<Status(EncodedPage)>;
+  using PageSource = std::function<Status(const Take& take)>;
+  /// The top chunk (levels 0 .. page level − 1) of the pages with these root keys.
+  using TopMaker = std::function<SvoChunk(std::span<const std::uint64_t> page_keys)>;
+
+  StatusOr<SvoFileStats> Write(const std::filesystem::path& path, PageSource pages, TopMaker top);
+  std::vector<std::uint8_t> Serialize(PageSource pages, TopMaker top, SvoFileStats* stats);
+
+ private:
+  Status ProducePages(const container::Writer::Emit& emit);
+  Status Finish();
+  SvoFileStats Stats(std::uint64_t file_bytes) const;
+
+  SvoFrame frame_;
+  SvoCompression compression_;
+  std::uint32_t page_level_ = 0;
+  container::Writer file_{kSvoFormat, 0};
+  PageSource pages_;
+  TopMaker top_maker_;
+  std::uint64_t offset_ = 0;
+  ByteWriter table_;
+  std::vector<std::uint64_t> keys_, sizes_;
+  std::vector<std::array<std::uint64_t, 3>> levels_;
+  ChunkBytes stats_bytes_, top_stats_;
+  std::vector<std::uint8_t> head_, top_;
 };
 
 /// The version-2 file of `svo`, and what it holds.

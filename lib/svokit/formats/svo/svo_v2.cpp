@@ -46,100 +46,166 @@ constexpr Tag kPages = MakeTag("PAGE");
 constexpr Tag kPageTable = MakeTag("PTAB");
 constexpr std::size_t kHeadFixed = 40, kHeadPerLevel = 24, kPageEntry = 32;
 
-// A version-2 file being written: the container and the bytes it borrows.
-struct Version2Writer {
-  container::Writer file{kSvoFormat, 0};
-  std::vector<std::vector<std::uint8_t>> pages;
-};
+}  // namespace
+}  // namespace svo_detail
 
-std::unique_ptr<Version2Writer> MakeVersion2(const CompactSvo& svo,
-                                             const SvoCompression& compression,
-                                             SvoFileStats* stats) {
-  auto out = std::make_unique<Version2Writer>();
-  const SvoShape shape = Shape(svo);
-  const std::uint32_t page_level = PageLevel(svo.depth);
-  const std::vector<std::uint64_t> keys = KeysOfLevel(svo.tree, page_level);
-  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
-  ChunkBytes top_bytes;
-  std::vector<std::uint8_t> top =
-      page_level == 0 ? std::vector<std::uint8_t>{}
-                      : EncodeChunk(TopChunk(svo, page_level), shape, compression, &top_bytes);
-  out->pages.resize(keys.size());
-  std::vector<ChunkBytes> page_bytes(keys.size());
-  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t p) {
-    out->pages[p] = EncodeChunk(PageChunk(svo, page_level, p, nbs[p], keys[p]), shape, compression,
-                                &page_bytes[p]);
-  });
+using svo_detail::kGrid;
+using svo_detail::kHasColor;
+using svo_detail::kHasContours;
+using svo_detail::kHasNormal;
+using svo_detail::kHead;
+using svo_detail::kMetadata;
+using svo_detail::kPages;
+using svo_detail::kPageTable;
+using svo_detail::kSharedColor;
+using svo_detail::kTop;
 
-  ByteWriter head;
-  const bool shared = svo.has_color && svo.colors.size() == 1;
-  head.Put(svo.depth);
-  head.Put(svo.brick_side);
-  head.Put((svo.has_color ? kHasColor : 0) | (svo.has_normal ? kHasNormal : 0) |
-           (svo.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0));
-  head.Put(page_level);
-  head.Put(static_cast<std::uint64_t>(keys.size()));
-  head.Put(shared ? svo.colors[0] : HalfRgba(0, 0, 0, 0));
-  head.Put(svo.depth + 1);
-  head.Put(std::uint32_t{compression.zstd ? 1u : 0u});
-  for (std::uint32_t l = 0; l <= svo.depth; ++l) {
-    head.Put(svo.NodeCount(l));
-    head.Put(static_cast<std::uint64_t>(std::count_if(
-        svo.contours[l].begin(), svo.contours[l].end(), [](std::uint32_t w) { return w != 0; })));
-    head.Put(l < svo.layouts.size() ? svo.layouts[l].size() : std::uint64_t{0});
-  }
-  ByteWriter table;
-  std::uint64_t offset = 0;
-  for (std::size_t p = 0; p < keys.size(); ++p) {
-    const std::vector<std::uint8_t>& page = out->pages[p];
-    table.Put(keys[p]);
-    table.Put(offset);
-    table.Put(static_cast<std::uint32_t>(page.size()));
-    table.Put(Crc32c(page.data(), page.size()));
-    // The page's voxels: the voxels of the subtree of its root.
-    table.Put(std::uint64_t{0});  // patched below
-    offset += page.size();
-  }
-  // Voxels per page: the last level's node range of each subtree.
-  {
-    for (std::size_t p = 0; p < keys.size(); ++p) {
-      std::uint64_t b = p, e = p + 1;
-      for (std::uint32_t l = page_level; l < svo.depth; ++l) {
-        const auto& masks = svo.tree.masks[l];
-        const auto& firsts = svo.tree.first_child[l];
-        const std::uint64_t nb = firsts[b], ne = firsts[e - 1] + CountBits8(masks[e - 1]);
-        b = nb;
-        e = ne;
-      }
-      const std::uint64_t voxels = e - b;
-      std::memcpy(table.bytes().data() + p * kPageEntry + 24, &voxels, 8);
-    }
-  }
-  container::Writer& file = out->file;
-  file.AddSection(kGrid, EncodeGridSection(svo.grid, svo.mode));
-  file.AddSection(kHead, std::move(head.bytes()));
-  if (!top.empty()) file.AddSection(kTop, std::move(top));
-  const Version2Writer* pages = out.get();
-  file.AddSectionProduced(kPages, [pages](const container::Writer::Emit& emit) {
-    for (const std::vector<std::uint8_t>& page : pages->pages) SVOKIT_RETURN_IF_ERROR(emit(page));
-    return Status::Ok();
+PagedSvoWriter::PagedSvoWriter(const SvoFrame& frame, const SvoCompression& compression)
+    : frame_(frame), compression_(compression) {
+  page_level_ = PageLevel(frame_.depth);
+  levels_.assign(frame_.depth + 1, {0, 0, 0});
+  file_.AddSection(kGrid, EncodeGridSection(frame_.grid, frame_.mode));
+  file_.AddSectionProduced(
+      kPages, [this](const container::Writer::Emit& emit) { return ProducePages(emit); });
+  // The header and the top chunk follow the pages: their counts are the pages' sums.
+  file_.AddSectionProduced(kHead, [this](const container::Writer::Emit& emit) {
+    SVOKIT_RETURN_IF_ERROR(Finish());
+    return emit(head_);
   });
-  file.AddSection(kPageTable, std::move(table.bytes()));
-  file.AddSection(kMetadata, std::vector<std::uint8_t>(svo.metadata.begin(), svo.metadata.end()));
-  if (stats != nullptr) {
-    *stats = {};
-    stats->page_level = page_level;
-    stats->pages = keys.size();
-    ChunkBytes all = top_bytes;
-    std::vector<std::uint64_t> sizes;
-    for (std::size_t p = 0; p < keys.size(); ++p) {
-      all.Add(page_bytes[p]);
-      sizes.push_back(out->pages[p].size());
-    }
-    SetPageSizes(sizes, *stats);
-    for (const auto& [name, v] : all.by_name) stats->sections.push_back({name, v.second, v.first});
+  if (page_level_ > 0) {
+    file_.AddSectionProduced(kTop, [this](const container::Writer::Emit& emit) {
+      return emit(top_);
+    });
+  }
+  file_.AddSectionProduced(
+      kPageTable, [this](const container::Writer::Emit& emit) { return emit(table_.bytes()); });
+  file_.AddSection(kMetadata,
+                   std::vector<std::uint8_t>(frame_.metadata.begin(), frame_.metadata.end()));
+}
+
+PagedSvoWriter::EncodedPage PagedSvoWriter::Encode(const SvoChunk& page) const {
+  EncodedPage out;
+  out.key = page.root_key;
+  out.bytes = EncodeChunk(page, frame_.shape, compression_, &out.stats);
+  for (std::uint32_t l = page_level_; l <= frame_.depth; ++l) {
+    const std::uint64_t k = l - page_level_;
+    const std::uint64_t contours = k < page.contours.size()
+                                       ? static_cast<std::uint64_t>(std::count_if(
+                                             page.contours[k].begin(), page.contours[k].end(),
+                                             [](std::uint32_t w) { return w != 0; }))
+                                       : 0;
+    const std::uint64_t samples = k < page.layouts.size() ? page.layouts[k].size() : 0;
+    out.levels.push_back({page.tree.NodeCount(l), contours, samples});
   }
   return out;
+}
+
+Status PagedSvoWriter::ProducePages(const container::Writer::Emit& emit) {
+  return pages_([&](EncodedPage page) -> Status {
+    SVOKIT_RETURN_IF_ERROR(emit(page.bytes));
+    table_.Put(page.key);
+    table_.Put(offset_);
+    table_.Put(static_cast<std::uint32_t>(page.bytes.size()));
+    table_.Put(Crc32c(page.bytes.data(), page.bytes.size()));
+    table_.Put(page.levels.back()[0]);  // the page's voxels
+    offset_ += page.bytes.size();
+    keys_.push_back(page.key);
+    sizes_.push_back(page.bytes.size());
+    for (std::size_t k = 0; k < page.levels.size(); ++k) {
+      for (int j = 0; j < 3; ++j) levels_[page_level_ + k][j] += page.levels[k][j];
+    }
+    stats_bytes_.Add(page.stats);
+    return Status::Ok();
+  });
+}
+
+Status PagedSvoWriter::Finish() {
+  if (keys_.empty()) return Status::BadInput("the octree has no voxels");
+  if (page_level_ > 0) {
+    const SvoChunk top = top_maker_(keys_);
+    top_ = EncodeChunk(top, frame_.shape, compression_, &top_stats_);
+    for (std::uint32_t l = 0; l < page_level_; ++l) {
+      levels_[l][0] = top.tree.NodeCount(l);
+      levels_[l][1] = static_cast<std::uint64_t>(std::count_if(
+          top.contours[l].begin(), top.contours[l].end(), [](std::uint32_t w) { return w != 0; }));
+      levels_[l][2] = l < top.layouts.size() ? top.layouts[l].size() : 0;
+    }
+  }
+  ByteWriter head;
+  const SvoShape& shape = frame_.shape;
+  const bool shared = !shape.shared_color.empty();
+  head.Put(frame_.depth);
+  head.Put(shape.brick_side);
+  head.Put((shape.has_color ? kHasColor : 0) | (shape.has_normal ? kHasNormal : 0) |
+           (shape.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0));
+  head.Put(page_level_);
+  head.Put(static_cast<std::uint64_t>(keys_.size()));
+  head.Put(shared ? shape.shared_color[0] : HalfRgba(0, 0, 0, 0));
+  head.Put(frame_.depth + 1);
+  head.Put(std::uint32_t{compression_.zstd ? 1u : 0u});
+  for (const auto& level : levels_) {
+    for (const std::uint64_t v : level) head.Put(v);
+  }
+  head_ = std::move(head.bytes());
+  return Status::Ok();
+}
+
+SvoFileStats PagedSvoWriter::Stats(std::uint64_t file_bytes) const {
+  SvoFileStats stats;
+  stats.page_level = page_level_;
+  ChunkBytes all = top_stats_;
+  all.Add(stats_bytes_);
+  svo_detail::SetPageSizes(sizes_, stats);
+  for (const auto& [name, v] : all.by_name) stats.sections.push_back({name, v.second, v.first});
+  svo_detail::CompleteStats(file_bytes, stats);
+  return stats;
+}
+
+StatusOr<SvoFileStats> PagedSvoWriter::Write(const std::filesystem::path& path, PageSource pages,
+                                             TopMaker top) {
+  pages_ = std::move(pages);
+  top_maker_ = std::move(top);
+  SVOKIT_RETURN_IF_ERROR(file_.WriteFile(path));
+  std::error_code ec;
+  return Stats(std::filesystem::file_size(path, ec));
+}
+
+std::vector<std::uint8_t> PagedSvoWriter::Serialize(PageSource pages, TopMaker top,
+                                                    SvoFileStats* stats) {
+  pages_ = std::move(pages);
+  top_maker_ = std::move(top);
+  std::vector<std::uint8_t> bytes = file_.Serialize();
+  if (stats != nullptr) *stats = Stats(bytes.size());
+  return bytes;
+}
+
+namespace svo_detail {
+namespace {
+
+// The pages of an octree held whole, encoded in parallel batches and handed on in order.
+PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& writer) {
+  return [&svo, &writer](const PagedSvoWriter::Take& take) -> Status {
+    const std::uint32_t page_level = writer.page_level();
+    const std::vector<std::uint64_t> keys = KeysOfLevel(svo.tree, page_level);
+    const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
+    const std::size_t batch = 64;
+    std::vector<PagedSvoWriter::EncodedPage> encoded;
+    for (std::size_t first = 0; first < keys.size(); first += batch) {
+      const std::size_t n = std::min(batch, keys.size() - first);
+      encoded.assign(n, {});
+      tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+        const std::size_t p = first + i;
+        encoded[i] = writer.Encode(PageChunk(svo, page_level, p, nbs[p], keys[p]));
+      });
+      for (PagedSvoWriter::EncodedPage& page : encoded)
+        SVOKIT_RETURN_IF_ERROR(take(std::move(page)));
+    }
+    return Status::Ok();
+  };
+}
+
+SvoFrame FrameOf(const CompactSvo& svo) {
+  return {svo.grid, svo.mode, svo.depth, Shape(svo), svo.metadata};
 }
 
 }  // namespace
@@ -422,20 +488,18 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
 
 std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression,
                                     SvoFileStats* stats) {
-  const auto writer = svo_detail::MakeVersion2(svo, compression, stats);
-  std::vector<std::uint8_t> bytes = writer->file.Serialize();
-  if (stats != nullptr) svo_detail::CompleteStats(bytes.size(), *stats);
-  return bytes;
+  PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
+  return writer.Serialize(
+      svo_detail::PagesOf(svo, writer),
+      [&](std::span<const std::uint64_t>) { return TopChunk(svo, writer.page_level()); }, stats);
 }
 
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
                                 const SvoCompression& compression) {
-  SvoFileStats stats;
-  const auto writer = svo_detail::MakeVersion2(svo, compression, &stats);
-  SVOKIT_RETURN_IF_ERROR(writer->file.WriteFile(path));
-  std::error_code ec;
-  svo_detail::CompleteStats(std::filesystem::file_size(path, ec), stats);
-  return stats;
+  PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
+  return writer.Write(path, svo_detail::PagesOf(svo, writer), [&](std::span<const std::uint64_t>) {
+    return TopChunk(svo, writer.page_level());
+  });
 }
 
 }  // namespace svokit
