@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -211,9 +212,8 @@ inline StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem
 
 /// The octree part of svo-build's and mesh2svo's summary: the levels, then what each kind of array
 /// takes in the file (stored and decoded, per voxel) and the pages.
-inline void PrintOctreeSummary(const CompactSvo& svo, const SvoFileStats& stats) {
-  fmt::print("{}", LevelTable(svo));
-  const double voxels = static_cast<double>(svo.voxel_count());
+inline void PrintFileSummary(const SvoFileStats& stats) {
+  const double voxels = static_cast<double>(stats.voxels);
   fmt::print("{:<14} {:>12} {:>12} {:>11}\n", "section", "stored B", "raw B", "B/voxel");
   for (const SvoSectionBytes& s : stats.sections) {
     fmt::print("{:<14} {:>12} {:>12} {:>11.3f}\n", s.name, s.stored, s.raw,
@@ -223,6 +223,58 @@ inline void PrintOctreeSummary(const CompactSvo& svo, const SvoFileStats& stats)
              static_cast<double>(stats.file_bytes) / voxels);
   fmt::print("pages       {} below level {} ({} to {} bytes)\n", stats.pages, stats.page_level,
              stats.smallest_page, stats.largest_page);
+}
+
+inline void PrintOctreeSummary(const CompactSvo& svo, const SvoFileStats& stats) {
+  fmt::print("{}", LevelTable(svo));
+  PrintFileSummary(stats);
+}
+
+/// The summary's line of stage times.
+inline void PrintTimes(const Progress& progress) {
+  std::string times;
+  double total = 0;
+  for (const Progress::Timing& t : progress.timings()) {
+    times += fmt::format("{} {:.2f} s, ", t.stage, t.seconds);
+    total += t.seconds;
+  }
+  fmt::print("time        {}total {:.2f} s\n", times, total);
+}
+
+/// "4G", "512M", "64K" or a byte count: the bytes it names.
+inline StatusOr<std::uint64_t> ParseByteSize(const std::string& option, const std::string& text) {
+  std::uint64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  int shift = 0;
+  if (ptr != end && ptr + 1 == end) {
+    switch (*ptr) {
+      case 'K':
+      case 'k':
+        shift = 10;
+        break;
+      case 'M':
+      case 'm':
+        shift = 20;
+        break;
+      case 'G':
+      case 'g':
+        shift = 30;
+        break;
+      case 'T':
+      case 't':
+        shift = 40;
+        break;
+      default:
+        shift = -1;
+    }
+  }
+  if (ec != std::errc() || ptr == text.data() || shift < 0 || (ptr != end && shift == 0) ||
+      value == 0 || value > (~std::uint64_t{0} >> shift)) {
+    return Status::BadInput("{} '{}': expected a size such as 4G, 512M or a byte count", option,
+                            text);
+  }
+  return value << shift;
 }
 
 /// Prints each of `warnings` as one line on stderr.

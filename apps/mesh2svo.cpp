@@ -19,11 +19,17 @@ int main(int argc, char** argv) {
   app::VoxelizeCli voxelize;
   app::BuildCli build;
   app::CommonOptions common;
+  std::string memory_limit;
   app::AddFile(cli, "input", input, "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
       ->required();
   app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
   voxelize.Add(cli);
   build.Add(cli);
+  cli.add_option("--memory-limit", memory_limit,
+                 "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
+                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none "
+                 "--no-contours")
+      ->option_text("SIZE");
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -38,12 +44,32 @@ int main(int argc, char** argv) {
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
     StatusOr<GridTransform> grid = voxelize.Grid(mesh->Bounds());
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
+    const std::string meta =
+        SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
+    if (!memory_limit.empty()) {
+      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+      if (!limit.ok()) return app::Fail(tool, limit.status());
+      StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
+          RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
+      if (!regions.ok()) return app::Fail(tool, regions.status().WithContext(input.string()));
+      app::Warn(tool, (*regions)->warnings());
+      StatusOr<SvoFileStats> written =
+          BuildSvoByPages(**regions, build.Options(), meta, output, *compression, *limit, progress);
+      if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
+      const auto& d = grid->dims();
+      fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
+      fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
+                 grid->voxel_size(), OctreeDepth(*grid));
+      fmt::print("voxels      {} ({})\n", written->voxels, voxelize.ModeName());
+      app::PrintFileSummary(*written);
+      app::PrintTimes(progress);
+      fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
+      return 0;
+    }
     StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.Options(), progress);
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
     app::Warn(tool, voxels->warnings);
 
-    const std::string meta =
-        SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
     StatusOr<CompactSvo> svo =
         BuildCompactSvo(std::move(*voxels), &*mesh, build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
@@ -57,13 +83,7 @@ int main(int argc, char** argv) {
                grid->voxel_size(), svo->depth);
     fmt::print("voxels      {} ({})\n", svo->voxel_count(), voxelize.ModeName());
     app::PrintOctreeSummary(*svo, *written);
-    std::string times;
-    double total = 0;
-    for (const Progress::Timing& t : progress.timings()) {
-      times += fmt::format("{} {:.2f} s, ", t.stage, t.seconds);
-      total += t.seconds;
-    }
-    fmt::print("time        {}total {:.2f} s\n", times, total);
+    app::PrintTimes(progress);
     fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
     return 0;
   });

@@ -130,6 +130,41 @@ TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
   ExpectValidSvo((dir / "m1.svo").string(), Torus());
 }
 
+// mesh2svo --memory-limit builds page by page into the same file; sizes it cannot parse, limits
+// too small for one page and bricks or contours (not yet built by pages) are one-line errors
+// that leave no file.
+TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
+  TempDir dir;
+  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "--no-contours", "-q"};
+  auto run = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {Torus(), "-o", (dir / name).string()};
+    args.insert(args.end(), options.begin(), options.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunTool("mesh2svo", args);
+  };
+  ASSERT_EQ(run("whole.svo", {}).exit_code, 0);
+  for (const char* limit : {"64M", "1G", "100000000"}) {
+    const ToolResult r = run("paged.svo", {"--memory-limit", limit});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(ReadText(dir / "paged.svo") == ReadText(dir / "whole.svo")) << limit;
+  }
+  ExpectValidSvo((dir / "paged.svo").string(), Torus());
+  for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--memory-limit", "4Q"}, "expected a size"},
+           {{"--memory-limit", "0"}, "expected a size"},
+           {{"--memory-limit", "1M"}, "too small"},
+           {{"--memory-limit", "1G"}, "--bricks none --no-contours"}}) {
+    const ToolResult r = message.starts_with("--bricks")
+                             ? RunTool("mesh2svo", {Torus(), "-o", (dir / "bad.svo").string(), "-r",
+                                                    "300", "-q", args[0], args[1]})
+                             : run("bad.svo", args);
+    EXPECT_NE(r.exit_code, 0) << args[1];
+    ASSERT_EQ(r.ErrLines().size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.svo"));
+  }
+}
+
 TEST(SvoBuildCli, Mesh2svoPrintsOneLinePerStageAndASummary) {
   TempDir dir;
   const std::string out = (dir / "t.svo").string();

@@ -347,6 +347,10 @@ StatusOr<std::unique_ptr<RegionVoxelizer>> RegionVoxelizer::Create(const Mesh& m
   return r;
 }
 
+std::size_t RegionVoxelizer::bytes() const {
+  return vertices_.size() * sizeof(FixedPoint3);
+}
+
 const std::vector<std::string>& RegionVoxelizer::warnings() const {
   return sampler_->warnings();
 }

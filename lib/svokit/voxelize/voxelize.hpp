@@ -88,6 +88,12 @@ class RegionVoxelizer {
 
   const GridTransform& grid() const { return grid_; }
   const VoxelizeOptions& options() const { return options_; }
+  /// The colour every voxel has, when colours are asked for and all triangles share one.
+  std::optional<Rgba> shared_color() const {
+    return options_.colors ? shared_color_ : std::nullopt;
+  }
+  /// Bytes held for the whole run besides the mesh: the snapped vertices.
+  std::size_t bytes() const;
   /// Non-fatal findings (textures that could not be decoded), as VoxelSet::warnings.
   const std::vector<std::string>& warnings() const;
 

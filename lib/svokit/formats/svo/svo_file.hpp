@@ -20,6 +20,7 @@
 #include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/voxelize.hpp"
 
 namespace svokit {
 
@@ -46,6 +47,7 @@ struct SvoSectionBytes {
 /// What writing a version-2 file made.
 struct SvoFileStats {
   std::uint64_t file_bytes = 0;
+  std::uint64_t voxels = 0;
   std::uint32_t page_level = 0;
   std::uint64_t pages = 0;
   std::uint64_t smallest_page = 0, median_page = 0, largest_page = 0;  ///< stored bytes
@@ -119,6 +121,18 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
                                     SvoFileStats* stats = nullptr);
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
                                 const SvoCompression& compression = {});
+/// The octree of the mesh `voxelizer` holds, built and written one page at a time (subtrees of
+/// 128³ voxels, each voxelized from the triangles binned to it, with the voxel around it its
+/// halo needs), pages in parallel, in at most `memory_limit` bytes besides the mesh (0: no
+/// limit); the same bytes as the octree built whole and written with WriteSvo. Without bricks
+/// and contours for now; a limit too small for one page is an error naming the smallest.
+StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
+                                       const BuildOptions& options, const std::string& metadata,
+                                       const std::filesystem::path& path,
+                                       const SvoCompression& compression,
+                                       std::uint64_t memory_limit,
+                                       Progress& progress = Progress::Silent());
+
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);

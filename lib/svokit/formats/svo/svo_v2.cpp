@@ -73,9 +73,8 @@ PagedSvoWriter::PagedSvoWriter(const SvoFrame& frame, const SvoCompression& comp
     return emit(head_);
   });
   if (page_level_ > 0) {
-    file_.AddSectionProduced(kTop, [this](const container::Writer::Emit& emit) {
-      return emit(top_);
-    });
+    file_.AddSectionProduced(kTop,
+                             [this](const container::Writer::Emit& emit) { return emit(top_); });
   }
   file_.AddSectionProduced(
       kPageTable, [this](const container::Writer::Emit& emit) { return emit(table_.bytes()); });
@@ -153,6 +152,7 @@ Status PagedSvoWriter::Finish() {
 SvoFileStats PagedSvoWriter::Stats(std::uint64_t file_bytes) const {
   SvoFileStats stats;
   stats.page_level = page_level_;
+  stats.voxels = levels_.empty() ? 0 : levels_.back()[0];
   ChunkBytes all = top_stats_;
   all.Add(stats_bytes_);
   svo_detail::SetPageSizes(sizes_, stats);
