@@ -27,8 +27,7 @@ int main(int argc, char** argv) {
   build.Add(cli);
   cli.add_option("--memory-limit", memory_limit,
                  "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
-                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none "
-                 "--no-contours")
+                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none")
       ->option_text("SIZE");
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 

@@ -131,11 +131,11 @@ TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
 }
 
 // mesh2svo --memory-limit builds page by page into the same file; sizes it cannot parse, limits
-// too small for one page and bricks or contours (not yet built by pages) are one-line errors
-// that leave no file.
+// too small for one page and bricks (not yet built by pages) are one-line errors that leave no
+// file.
 TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
   TempDir dir;
-  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "--no-contours", "-q"};
+  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "-q"};
   auto run = [&](const std::string& name, std::vector<std::string> extra) {
     std::vector<std::string> args = {Torus(), "-o", (dir / name).string()};
     args.insert(args.end(), options.begin(), options.end());
@@ -153,7 +153,7 @@ TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
            {{"--memory-limit", "4Q"}, "expected a size"},
            {{"--memory-limit", "0"}, "expected a size"},
            {{"--memory-limit", "1M"}, "too small"},
-           {{"--memory-limit", "1G"}, "--bricks none --no-contours"}}) {
+           {{"--memory-limit", "1G"}, "--bricks none"}}) {
     const ToolResult r = message.starts_with("--bricks")
                              ? RunTool("mesh2svo", {Torus(), "-o", (dir / "bad.svo").string(), "-r",
                                                     "300", "-q", args[0], args[1]})

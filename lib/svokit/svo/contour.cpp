@@ -338,13 +338,15 @@ std::array<int, 3> QuantizeNormal(const Vec3d& n) {
 
 struct Context {
   const Mesh* mesh;
-  std::vector<Vec3d> vox;  // mesh positions in voxel space
+  const std::vector<Vec3d>* vox;  // mesh positions in voxel space
   std::uint32_t depth;
+  // The levels first .. last held: keys[l − first] are level l's keys, out[l − first] its words.
+  std::uint32_t first = 0, last = 0;
   std::span<const std::vector<std::uint64_t>> keys;
   ContourOptions options;
   double eps;  // overlap of clipping half-spaces, voxel units
   std::vector<std::vector<std::uint32_t>>* out;
-  // Per level below the voxels: index in the next level of node i's first child (i + 1: end).
+  // Per level held but the last: index in the next level of node i's first child (i + 1: end).
   std::vector<std::vector<std::size_t>> first_child;
 };
 
@@ -364,7 +366,7 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
         area = area + Cross(v[i] - v[0], v[i + 1] - v[0]);
     } else {
       const Triangle& t = ctx.mesh->triangles[pc.tri];
-      const Vec3d &a = ctx.vox[t[0]], &b = ctx.vox[t[1]], &c = ctx.vox[t[2]];
+      const Vec3d &a = (*ctx.vox)[t[0]], &b = (*ctx.vox)[t[1]], &c = (*ctx.vox)[t[2]];
       s.u.push_back(to_u(a));
       s.u.push_back(to_u(b));
       s.u.push_back(to_u(c));
@@ -441,16 +443,16 @@ struct Workspace {
 
 void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const Pieces& pieces,
                Workspace& ws) {
-  const std::uint64_t key = ctx.keys[level][index];
+  const std::uint64_t key = ctx.keys[level - ctx.first][index];
   const double size = std::ldexp(1.0, static_cast<int>(ctx.depth - level));
   const MortonCoord mc = MortonDecode(key);
   const Vec3d lo{mc.x * size, mc.y * size, mc.z * size};
   const Vec3d center = lo + Vec3d{size, size, size} * 0.5;
-  (*ctx.out)[level][index] = FitNode(ctx, pieces, center, size, ws.scratch);
-  if (level == ctx.depth) return;
+  (*ctx.out)[level - ctx.first][index] = FitNode(ctx, pieces, center, size, ws.scratch);
+  if (level == ctx.last) return;
 
-  const auto& next = ctx.keys[level + 1];
-  auto it = next.begin() + static_cast<std::ptrdiff_t>(ctx.first_child[level][index]);
+  const auto& next = ctx.keys[level + 1 - ctx.first];
+  auto it = next.begin() + static_cast<std::ptrdiff_t>(ctx.first_child[level - ctx.first][index]);
   std::array<std::size_t, 8> child_index{};
   std::array<Pieces*, 8> dst{};
   std::array<unsigned, 8> present{};
@@ -483,57 +485,95 @@ void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const
 
 }  // namespace
 
-std::vector<std::vector<std::uint32_t>> FitContours(
-    const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
-    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options) {
-  std::vector<std::vector<std::uint32_t>> out(level_keys.size());
-  for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
-  if (level_keys.size() != std::size_t{depth} + 1 || level_keys[0].empty()) return out;
-
-  Context ctx;
-  ctx.mesh = &mesh;
-  ctx.depth = depth;
-  ctx.keys = level_keys;
-  ctx.options = options;
-  ctx.out = &out;
-  const double extent = std::ldexp(1.0, static_cast<int>(depth));
+ContourFitter::ContourFitter(const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
+                             const ContourOptions& options)
+    : mesh_(mesh), depth_(depth), options_(options) {
+  vox_.resize(mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    vox_[i] = grid.WorldToVoxel(mesh.positions[i]);
+  }
   // Rounding in clipping is ~2^depth·2^-52 voxels per cut; the overlap is far above that yet
   // negligible against the slab quantization (≥ 1/256 of a node).
-  ctx.eps = std::max(1e-7, extent * 0x1p-36);
-  ctx.first_child.resize(depth);
-  for (std::uint32_t l = 0; l < depth; ++l) {  // children of a node are one run of the next level
+  eps_ = std::max(1e-7, std::ldexp(1.0, static_cast<int>(depth)) * 0x1p-36);
+}
+
+std::vector<std::vector<std::uint32_t>> ContourFitter::FitSubtree(
+    std::uint32_t first, std::span<const std::vector<std::uint64_t>> level_keys,
+    std::span<const std::uint32_t> triangles) const {
+  std::vector<std::vector<std::uint32_t>> out(level_keys.size());
+  for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
+  if (level_keys.empty() || level_keys[0].size() != 1 ||
+      first + level_keys.size() > std::size_t{depth_} + 1) {
+    return out;
+  }
+  Context ctx;
+  ctx.mesh = &mesh_;
+  ctx.vox = &vox_;
+  ctx.depth = depth_;
+  ctx.first = first;
+  ctx.last = first + static_cast<std::uint32_t>(level_keys.size()) - 1;
+  ctx.keys = level_keys;
+  ctx.options = options_;
+  ctx.eps = eps_;
+  ctx.out = &out;
+  ctx.first_child.resize(level_keys.size() - 1);
+  for (std::size_t l = 0; l + 1 < level_keys.size(); ++l) {
+    // Children of a node are one run of the next level.
     const auto& next = level_keys[l + 1];
-    auto& first = ctx.first_child[l];
-    first.resize(level_keys[l].size() + 1);
+    auto& first_child = ctx.first_child[l];
+    first_child.resize(level_keys[l].size() + 1);
     std::size_t f = 0;
     for (std::size_t i = 0; i < level_keys[l].size(); ++i) {
       while (f < next.size() && (next[f] >> 3) < level_keys[l][i]) ++f;
-      first[i] = f;
+      first_child[i] = f;
     }
-    first.back() = next.size();
-  }
-  ctx.vox.resize(mesh.positions.size());
-  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-    ctx.vox[i] = grid.WorldToVoxel(mesh.positions[i]);
+    first_child.back() = next.size();
   }
 
-  // The root's pieces: every triangle clipped to the (slightly enlarged) root cube.
-  Pieces root;
+  // The root's pieces: every triangle clipped to the (slightly enlarged) root cube, then split
+  // down the path to the subtree's root as the whole tree's walk splits them.
+  Pieces pieces, next;
   Scratch s;
-  const double rlo = -ctx.eps, rhi = extent + ctx.eps;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Triangle& tri = mesh.triangles[t];
-    s.a = {ctx.vox[tri[0]], ctx.vox[tri[1]], ctx.vox[tri[2]]};
+  const double extent = std::ldexp(1.0, static_cast<int>(depth_));
+  const double rlo = -eps_, rhi = extent + eps_;
+  for (const std::uint32_t t : triangles) {
+    const Triangle& tri = mesh_.triangles[t];
+    s.a = {vox_[tri[0]], vox_[tri[1]], vox_[tri[2]]};
     for (int a = 0; a < 3 && !s.a.empty(); ++a) {
       ClipAxis(s.a, a, rlo, false, s.b);
       ClipAxis(s.b, a, rhi, true, s.a);
     }
-    if (!s.a.empty()) root.Add(static_cast<std::uint32_t>(t), s.a.data(), s.a.size());
+    if (!s.a.empty()) pieces.Add(t, s.a.data(), s.a.size());
   }
-  if (root.pieces.empty()) return out;
-  Workspace ws(depth);
-  VisitNode(ctx, 0, 0, root, ws);
+  const std::uint64_t root = level_keys[0][0];
+  for (std::uint32_t l = 0; l < first && !pieces.pieces.empty(); ++l) {
+    const double size = std::ldexp(1.0, static_cast<int>(depth_ - l));
+    const MortonCoord mc = MortonDecode(root >> (3 * (first - l)));
+    const Vec3d center =
+        Vec3d{mc.x * size, mc.y * size, mc.z * size} + Vec3d{size, size, size} * 0.5;
+    std::array<Pieces*, 8> dst{};
+    next.clear();
+    dst[(root >> (3 * (first - l - 1))) & 7u] = &next;
+    SplitPieces(pieces, center, eps_, dst, s);
+    std::swap(pieces, next);
+  }
+  if (pieces.pieces.empty()) return out;
+  Workspace ws(depth_);
+  VisitNode(ctx, first, 0, pieces, ws);
   return out;
+}
+
+std::vector<std::vector<std::uint32_t>> FitContours(
+    const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
+    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options) {
+  if (level_keys.size() != std::size_t{depth} + 1 || level_keys[0].empty()) {
+    std::vector<std::vector<std::uint32_t>> out(level_keys.size());
+    for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
+    return out;
+  }
+  std::vector<std::uint32_t> all(mesh.triangles.size());
+  for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<std::uint32_t>(t);
+  return ContourFitter(mesh, grid, depth, options).FitSubtree(0, level_keys, all);
 }
 
 }  // namespace svokit

@@ -44,6 +44,29 @@ std::vector<std::vector<std::uint32_t>> FitContours(
     const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
     std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options = {});
 
+/// FitContours for any subtree of the octree of one mesh, e.g. one page at a time: the mesh is
+/// mapped to voxel space once.
+class ContourFitter {
+ public:
+  ContourFitter(const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
+                const ContourOptions& options = {});
+  /// The words of the subtree whose levels first .. first + level_keys.size() − 1 hold
+  /// `level_keys` (level `first`: its root alone; levels below the last are not fitted), from the
+  /// triangles `triangles` (ascending; every triangle that touches the root's closed cube among
+  /// them): exactly FitContours' words for those nodes, since each triangle's piece in a node is
+  /// a function of the triangle and the node's path alone.
+  std::vector<std::vector<std::uint32_t>> FitSubtree(
+      std::uint32_t first, std::span<const std::vector<std::uint64_t>> level_keys,
+      std::span<const std::uint32_t> triangles) const;
+
+ private:
+  const Mesh& mesh_;
+  std::uint32_t depth_;
+  ContourOptions options_;
+  std::vector<Vec3d> vox_;
+  double eps_ = 0;
+};
+
 /// Per level: the mean decoded slab thickness in units of the node size, over nodes with a
 /// contour, and the share of nodes that have one. Thicknesses are of the slab clipped to the
 /// cube along n (the part of the slab that can matter).

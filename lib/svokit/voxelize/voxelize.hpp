@@ -86,6 +86,7 @@ class RegionVoxelizer {
   /// with a voxel in the box must be among them). Thread-safe.
   StatusOr<VoxelSet> Voxelize(const IBox3& box, std::span<const std::uint32_t> triangles) const;
 
+  const Mesh& mesh() const { return mesh_; }
   const GridTransform& grid() const { return grid_; }
   const VoxelizeOptions& options() const { return options_; }
   /// The colour every voxel has, when colours are asked for and all triangles share one.

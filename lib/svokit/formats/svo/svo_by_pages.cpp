@@ -4,6 +4,8 @@
 // levels follow from the page keys. Only the pages in flight are held.
 
 #include <algorithm>
+#include <numeric>
+#include <optional>
 
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -11,6 +13,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/contour.hpp"
 #include "svokit/svo/svo_pages.hpp"
 
 namespace svokit {
@@ -25,9 +28,25 @@ IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
           {c.x * s + s + grow, c.y * s + s + grow, c.z * s + s + grow}};
 }
 
-// The top chunk of the pages with these root keys at `page_level`: masks only (builds by pages
-// have neither bricks nor contours).
-SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level) {
+// Each level's Morton keys of a chunk's tree, from its root's.
+std::vector<std::vector<std::uint64_t>> ChunkLevelKeys(const SvoChunk& chunk) {
+  std::vector<std::vector<std::uint64_t>> keys = {{chunk.root_key}};
+  for (const std::vector<std::uint8_t>& masks : chunk.tree.masks) {
+    std::vector<std::uint64_t>& next = keys.emplace_back();
+    const std::vector<std::uint64_t>& level = keys[keys.size() - 2];
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      for (unsigned c = 0; c < 8; ++c) {
+        if (masks[i] >> c & 1u) next.push_back(level[i] << 3 | c);
+      }
+    }
+  }
+  return keys;
+}
+
+// The top chunk of the pages with these root keys at `page_level`: masks, and contours fitted
+// to the whole mesh when `contours` is given (builds by pages have no bricks yet).
+SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
+                    const ContourFitter* contours, std::span<const std::uint32_t> triangles) {
   std::vector<std::vector<std::uint64_t>> level_keys(page_level + 1);
   level_keys[page_level].assign(keys.begin(), keys.end());
   for (std::uint32_t l = page_level; l > 0; --l) {
@@ -38,7 +57,12 @@ SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_leve
   }
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
-  top.contours.assign(page_level, {});
+  if (contours != nullptr) {
+    level_keys.pop_back();
+    top.contours = contours->FitSubtree(0, level_keys, triangles);
+  } else {
+    top.contours.assign(page_level, {});
+  }
   return top;
 }
 
@@ -49,10 +73,20 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                                        const std::filesystem::path& path,
                                        const SvoCompression& compression,
                                        std::uint64_t memory_limit, Progress& progress) {
-  if (options.brick_side != 0 || options.contours) {
+  if (options.brick_side != 0) {
     return Status::BadInput(
-        "a build by pages (--memory-limit) makes octrees without bricks and contours for now: "
-        "add --bricks none --no-contours");
+        "a build by pages (--memory-limit) makes octrees without bricks for now: add --bricks "
+        "none");
+  }
+  std::optional<ContourFitter> contours;
+  BuildOptions page_options = options;
+  page_options.contours = false;  // fitted below, from the page's triangles
+  std::vector<std::uint32_t> all_triangles;
+  if (options.contours) {
+    contours.emplace(voxelizer.mesh(), voxelizer.grid(), OctreeDepth(voxelizer.grid()),
+                     options.contour);
+    all_triangles.resize(voxelizer.mesh().triangles.size());
+    std::iota(all_triangles.begin(), all_triangles.end(), 0u);
   }
   SvoFrame frame;
   frame.grid = voxelizer.grid();
@@ -61,6 +95,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
   frame.shape.depth = frame.depth;
   frame.shape.has_color = voxelizer.options().colors;
   frame.shape.has_normal = voxelizer.options().normals;
+  frame.shape.has_contours = options.contours;
   if (const auto shared = voxelizer.shared_color()) frame.shape.shared_color = {HalfRgba(*shared)};
   frame.metadata = metadata;
   PagedSvoWriter writer(frame, compression);
@@ -122,7 +157,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                       std::lower_bound(voxels->keys.begin(), voxels->keys.end(), first);
                   if (begin == voxels->keys.end() || *begin >= last) return made;
                   StatusOr<CompactSvo> svo =
-                      BuildCompactSvo(std::move(*voxels), nullptr, options, metadata);
+                      BuildCompactSvo(std::move(*voxels), nullptr, page_options, metadata);
                   if (!svo.ok()) {
                     made.status = svo.status();
                     return made;
@@ -132,7 +167,12 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                   const std::size_t at = static_cast<std::size_t>(
                       std::lower_bound(keys.begin(), keys.end(), cell) - keys.begin());
                   const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->tree, page_level);
-                  made.page = writer.Encode(PageChunk(*svo, page_level, at, nbs[at], cell));
+                  SvoChunk chunk = PageChunk(*svo, page_level, at, nbs[at], cell);
+                  if (contours) {
+                    const auto keys_by_level = ChunkLevelKeys(chunk);
+                    chunk.contours = contours->FitSubtree(page_level, keys_by_level, bins.Of(i));
+                  }
+                  made.page = writer.Encode(chunk);
                   made.present = true;
                   return made;
                 }) &
@@ -148,7 +188,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
     return failed;
   };
   return writer.Write(path, pages, [&](std::span<const std::uint64_t> keys) {
-    return TopOfPages(keys, page_level);
+    return TopOfPages(keys, page_level, contours ? &*contours : nullptr, all_triangles);
   });
 }
 
