@@ -241,6 +241,23 @@ inline void PrintTimes(const Progress& progress) {
   fmt::print("time        {}total {:.2f} s\n", times, total);
 }
 
+/// "K/N": part K (0-based) of N.
+inline StatusOr<SvoPartOf> ParsePart(const std::string& option, const std::string& text) {
+  SvoPartOf part;
+  const std::size_t slash = text.find('/');
+  const char* end = text.data() + text.size();
+  const auto k =
+      std::from_chars(text.data(), text.data() + std::min(slash, text.size()), part.part);
+  const auto n = slash == std::string::npos
+                     ? std::from_chars_result{end, std::errc::invalid_argument}
+                     : std::from_chars(text.data() + slash + 1, end, part.parts);
+  if (k.ec != std::errc() || n.ec != std::errc() || n.ptr != end || k.ptr != text.data() + slash ||
+      part.parts == 0 || part.part >= part.parts) {
+    return Status::BadInput("{} '{}': expected K/N with 0 ≤ K < N, e.g. 0/4", option, text);
+  }
+  return part;
+}
+
 /// "4G", "512M", "64K" or a byte count: the bytes it names.
 inline StatusOr<std::uint64_t> ParseByteSize(const std::string& option, const std::string& text) {
   std::uint64_t value = 0;

@@ -5,6 +5,8 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
+#include "svokit/core/crc32c.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 
@@ -19,7 +21,7 @@ int main(int argc, char** argv) {
   app::VoxelizeCli voxelize;
   app::BuildCli build;
   app::CommonOptions common;
-  std::string memory_limit;
+  std::string memory_limit, pages;
   app::AddFile(cli, "input", input, "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
       ->required();
   app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
@@ -29,13 +31,23 @@ int main(int argc, char** argv) {
                  "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
                  "(K, M, G suffixes): any resolution, the same file; needs --bricks none")
       ->option_text("SIZE");
+  cli.add_option("--pages", pages,
+                 "Build part K of N (0-based) of a build by pages into OUT.svopart, as one job of "
+                 "many; svo-merge joins the parts into the .svo")
+      ->option_text("K/N");
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = voxelize.Check(); !s.ok()) return app::Fail(tool, s);
     const StatusOr<SvoCompression> compression = build.Compression();
     if (!compression.ok()) return app::Fail(tool, compression.status());
-    if (Status s = app::CheckOutputPath(output, {"svo"}, input); !s.ok()) return app::Fail(tool, s);
+    if (Status s = app::CheckOutputPath(output, {pages.empty() ? "svo" : "svopart"}, input);
+        !s.ok()) {
+      return app::Fail(tool, s);
+    }
+    StatusOr<SvoPartOf> part = SvoPartOf{};
+    if (!pages.empty()) part = app::ParsePart("--pages", pages);
+    if (!part.ok()) return app::Fail(tool, part.status());
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
@@ -45,13 +57,30 @@ int main(int argc, char** argv) {
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    if (!memory_limit.empty()) {
-      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+    if (!memory_limit.empty() || !pages.empty()) {
+      const StatusOr<std::uint64_t> limit =
+          memory_limit.empty() ? std::uint64_t{0}
+                               : app::ParseByteSize("--memory-limit", memory_limit);
       if (!limit.ok()) return app::Fail(tool, limit.status());
       StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
           RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
       if (!regions.ok()) return app::Fail(tool, regions.status().WithContext(input.string()));
       app::Warn(tool, (*regions)->warnings());
+      if (!pages.empty()) {
+        // The build's identity: the input's bytes and the options that shape the file.
+        StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(input);
+        if (!bytes.ok()) return app::Fail(tool, bytes.status());
+        part->identity = std::uint64_t{Crc32c(bytes->data(), bytes->size())} << 32 |
+                         Crc32c(meta.data(), meta.size());
+        StatusOr<SvoPartStats> made = BuildSvoPart(**regions, build.Options(), meta, *part, output,
+                                                   *compression, *limit, progress);
+        if (!made.ok()) return app::Fail(tool, made.status().WithContext(input.string()));
+        fmt::print("part        {} of {}: {} pages ({} cubes), {} voxels\n", part->part,
+                   part->parts, made->pages, made->cells, made->voxels);
+        app::PrintTimes(progress);
+        fmt::print("output      {}\n", output.string());
+        return 0;
+      }
       StatusOr<SvoFileStats> written =
           BuildSvoByPages(**regions, build.Options(), meta, output, *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));

@@ -3,6 +3,7 @@
 // textured multi-material meshes with contours and geometry only; impossible limits and options
 // are errors.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "svokit/core/file_io.hpp"
@@ -64,11 +65,27 @@ void ExpectSameFileAsWhole(const std::filesystem::path& mesh_path, std::uint32_t
   }
   auto reader = SvoReader::Open(dir / "paged.svo");
   ASSERT_TRUE(reader.ok()) << reader.status().message();
-  EXPECT_GT(reader->page_count(), 4u);
+  EXPECT_GE(reader->page_count(), 4u);
+
+  // As 3 and 5 jobs: the parts, merged in any order, are the same file.
+  for (const std::uint32_t n : {3u, 5u}) {
+    std::vector<std::filesystem::path> parts;
+    for (std::uint32_t k = n; k-- > 0;) {
+      parts.push_back(dir / fmt::format("p{}.svopart", k));
+      auto made =
+          BuildSvoPart(**regions, NoBricks(contours), meta, {k, n, 42}, parts.back(), {}, 0);
+      ASSERT_TRUE(made.ok()) << made.status().message();
+    }
+    auto merged = MergeSvoParts(parts, dir / "merged.svo");
+    ASSERT_TRUE(merged.ok()) << merged.status().message();
+    EXPECT_TRUE(Bytes(dir / "merged.svo") == want) << n << " parts, " << parts.size();
+  }
 }
 
 TEST(SvoByPages, TheFileIsTheWholeBuildsByteForByte) {
   ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 300, true, true);
+  // A side of exactly 2^depth: the pages' margins reach past the grid.
+  ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 256, true, true);
   ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 300, false, false);
   ExpectSameFileAsWhole(test::DataDir() / "box-room.obj", 260, true, true);
   ExpectSameFileAsWhole("/usr/share/assimp/models/OBJ/spider.obj", 400, true, true);
@@ -91,6 +108,37 @@ TEST(SvoByPages, ImpossibleLimitsAndOptionsAreErrors) {
   ASSERT_FALSE(bricks.ok());
   EXPECT_NE(bricks.status().message().find("--bricks none"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "t.svo"));
+}
+
+// Merging checks that the parts are those of one build, each once, all of them.
+TEST(SvoByPages, MergingAWrongSetOfPartsIsRefusedWithTheReason) {
+  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(mesh.ok());
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), 300);
+  auto regions = RegionVoxelizer::Create(*mesh, *grid, VoxelizeOptions{});
+  ASSERT_TRUE(regions.ok());
+  test::TempDir dir;
+  const auto part = [&](std::uint32_t k, std::uint32_t n, std::uint64_t identity,
+                        const std::string& name) {
+    EXPECT_TRUE(
+        BuildSvoPart(**regions, NoBricks(false), "{}", {k, n, identity}, dir / name, {}, 0).ok());
+    return dir / name;
+  };
+  const auto p0 = part(0, 3, 7, "p0"), p1 = part(1, 3, 7, "p1"), p2 = part(2, 3, 7, "p2");
+  const auto other = part(2, 3, 8, "other"), four = part(2, 4, 7, "four");
+  const auto merge = [&](std::vector<std::filesystem::path> parts) {
+    auto r = MergeSvoParts(parts, dir / "out.svo");
+    EXPECT_EQ(std::filesystem::exists(dir / "out.svo"), r.ok());
+    return r.ok() ? std::string("ok") : r.status().message();
+  };
+  EXPECT_NE(merge({p0, p2}).find("part 1 of 3 is missing"), std::string::npos);
+  EXPECT_NE(merge({p0, p1, p1, p2}).find("part 1 of 3 is given twice"), std::string::npos);
+  EXPECT_NE(merge({p0, p1, other}).find("another build"), std::string::npos);
+  EXPECT_NE(merge({p0, p1, four}).find("another build"), std::string::npos);
+  auto bad = BuildSvoPart(**regions, NoBricks(false), "{}", {3, 3, 7}, dir / "p3", {}, 0);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_EQ(merge({p2, p0, p1}), "ok");
+  EXPECT_FALSE(std::filesystem::exists(dir / "p3"));
 }
 
 }  // namespace

@@ -367,11 +367,22 @@ RegionVoxelizer::Bins RegionVoxelizer::BinTriangles(int cell_bits, std::int64_t 
                                   static_cast<std::uint32_t>(t), cell_bits, grow, pairs);
     }
   });
+  // Cells past the grid's last (reached by the margin) hold no voxels.
+  const IBox3 box = grid_.IndexBox();
+  const auto inside = [&](std::uint64_t cell) {
+    const MortonCoord c = MortonDecode(cell);
+    return (std::int64_t{c.x} << cell_bits) < box.hi.x &&
+           (std::int64_t{c.y} << cell_bits) < box.hi.y &&
+           (std::int64_t{c.z} << cell_bits) < box.hi.z;
+  };
   std::vector<voxelize_detail::CellTriangle> pairs;
   std::uint64_t last = 0;
   for (auto& part : parts) {
-    for (const auto& p : part) last = std::max(last, p.cell);
-    pairs.insert(pairs.end(), part.begin(), part.end());
+    for (const auto& p : part) {
+      if (!inside(p.cell)) continue;
+      last = std::max(last, p.cell);
+      pairs.push_back(p);
+    }
     std::vector<voxelize_detail::CellTriangle>().swap(part);
   }
   // Listed in triangle order: a stable sort by cell keeps each cell's triangles ascending.

@@ -1,16 +1,21 @@
-// The octree of a mesh built and written one page at a time (svo_file.hpp, BuildSvoByPages): each
-// page's cube, grown by the one voxel its halo needs, is voxelized from the triangles binned to
-// it, made into its page chunk and encoded, pages in parallel and handed on in key order; the top
-// levels follow from the page keys. Only the pages in flight are held.
+// Octrees built one page at a time (svo_file.hpp: BuildSvoByPages, BuildSvoPart, MergeSvoParts):
+// each page's cube, grown by the one voxel its halo needs, is voxelized from the triangles binned
+// to it, made into its page chunk (contours fitted from the same triangles) and encoded, pages in
+// parallel and handed on in key order; the top levels follow from the page keys. Only the pages
+// in flight are held. A part is a share of the pages in a file of its own; merging the parts
+// writes the file the whole build by pages writes.
 
 #include <algorithm>
+#include <map>
 #include <numeric>
 #include <optional>
 
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include "svokit/core/crc32c.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/contour.hpp"
@@ -43,10 +48,9 @@ std::vector<std::vector<std::uint64_t>> ChunkLevelKeys(const SvoChunk& chunk) {
   return keys;
 }
 
-// The top chunk of the pages with these root keys at `page_level`: masks, and contours fitted
-// to the whole mesh when `contours` is given (builds by pages have no bricks yet).
-SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
-                    const ContourFitter* contours, std::span<const std::uint32_t> triangles) {
+// The keys of levels 0 .. page_level of the tree whose level page_level holds `keys`.
+std::vector<std::vector<std::uint64_t>> TopLevelKeys(std::span<const std::uint64_t> keys,
+                                                     std::uint32_t page_level) {
   std::vector<std::vector<std::uint64_t>> level_keys(page_level + 1);
   level_keys[page_level].assign(keys.begin(), keys.end());
   for (std::uint32_t l = page_level; l > 0; --l) {
@@ -55,15 +59,196 @@ SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_leve
       if (up.empty() || up.back() != k >> 3) up.push_back(k >> 3);
     }
   }
+  return level_keys;
+}
+
+// Contour words of top-level nodes by key, per level 0 .. page_level − 1: fitted for every node
+// that may exist (the ancestors of every page that may hold voxels), since a node's word depends
+// on its own pieces alone.
+using TopContours = std::vector<std::map<std::uint64_t, std::uint32_t>>;
+
+// The top chunk of the pages with these root keys: masks, and the contours `words` gives.
+SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
+                    const TopContours* words) {
+  std::vector<std::vector<std::uint64_t>> level_keys = TopLevelKeys(keys, page_level);
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
-  if (contours != nullptr) {
-    level_keys.pop_back();
-    top.contours = contours->FitSubtree(0, level_keys, triangles);
-  } else {
-    top.contours.assign(page_level, {});
+  top.contours.assign(page_level, {});
+  if (words != nullptr) {
+    for (std::uint32_t l = 0; l < page_level; ++l) {
+      for (const std::uint64_t k : level_keys[l]) {
+        const auto it = (*words)[l].find(k);
+        top.contours[l].push_back(it == (*words)[l].end() ? 0 : it->second);
+      }
+    }
   }
   return top;
+}
+
+// What builds by pages and parts share: the frame, the bins, how many pages may be in flight,
+// and how a page is made.
+class PagePlan {
+ public:
+  static StatusOr<std::unique_ptr<PagePlan>> Make(const RegionVoxelizer& voxelizer,
+                                                  const BuildOptions& options,
+                                                  const std::string& metadata,
+                                                  std::uint64_t memory_limit, Progress& progress) {
+    if (options.brick_side != 0) {
+      return Status::BadInput(
+          "a build by pages (--memory-limit, --pages) makes octrees without bricks for now: add "
+          "--bricks none");
+    }
+    std::unique_ptr<PagePlan> plan(new PagePlan(voxelizer, options));
+    SvoFrame& frame = plan->frame_;
+    frame.grid = voxelizer.grid();
+    frame.mode = voxelizer.options().mode;
+    frame.depth = OctreeDepth(frame.grid);
+    frame.shape.depth = frame.depth;
+    frame.shape.has_color = voxelizer.options().colors;
+    frame.shape.has_normal = voxelizer.options().normals;
+    frame.shape.has_contours = options.contours;
+    if (const auto shared = voxelizer.shared_color()) {
+      frame.shape.shared_color = {HalfRgba(*shared)};
+    }
+    frame.metadata = metadata;
+    plan->page_level_ = PageLevel(frame.depth);
+    plan->bits_ = frame.depth - plan->page_level_;
+    plan->page_options_.contours = false;  // fitted from each page's triangles instead
+    if (options.contours) {
+      plan->contours_.emplace(voxelizer.mesh(), frame.grid, frame.depth, options.contour);
+    }
+    {
+      Progress::Stage stage(progress, "bin", 1);
+      plan->bins_ = voxelizer.BinTriangles(static_cast<int>(plan->bits_), 1);
+    }
+    // Held whatever the page: the snapped mesh and the bins; then each page in flight, at most a
+    // surface's voxels across its cube with their attributes and nodes (~40 B a voxel).
+    const std::size_t tokens =
+        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+    const std::uint64_t fixed = voxelizer.bytes() + plan->bins_.bytes();
+    const std::uint64_t page = std::uint64_t{40} * 4 << (2 * plan->bits_);
+    const std::uint64_t smallest = fixed + page;
+    if (memory_limit != 0 && memory_limit < smallest) {
+      const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
+      return Status::BadInput(
+          "a memory limit of {} MiB is too small for this mesh and grid: its bins and one page "
+          "need {} MiB (use --memory-limit {}M or more)",
+          memory_limit >> 20, mib, mib);
+    }
+    plan->in_flight_ = memory_limit == 0
+                           ? tokens
+                           : std::clamp<std::size_t>((memory_limit - fixed) / page, 1, tokens);
+    return plan;
+  }
+
+  const SvoFrame& frame() const { return frame_; }
+  std::uint32_t page_level() const { return page_level_; }
+  const RegionVoxelizer::Bins& bins() const { return bins_; }
+
+  // Encodes the pages of cells [first, end) that hold voxels and hands them to `take` in order.
+  Status Run(const PagedSvoWriter& writer, std::size_t first, std::size_t end,
+             const PagedSvoWriter::Take& take, Progress& progress) const {
+    Progress::Stage stage(progress, "pages", end - first);
+    Status failed;
+    std::size_t next = first;
+    struct Made {
+      std::optional<PagedSvoWriter::EncodedPage> page;
+      Status status;
+    };
+    tbb::parallel_pipeline(
+        in_flight_,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& fc) -> std::size_t {
+                                              if (next == end || !failed.ok()) fc.stop();
+                                              return next++;
+                                            }) &
+            tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel,
+                                                [&](std::size_t i) {
+                                                  Made made;
+                                                  made.status = MakePage(writer, i, made.page);
+                                                  return made;
+                                                }) &
+            tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
+              stage.Advance(1);
+              if (!failed.ok()) return;
+              if (!made.status.ok()) {
+                failed = made.status;
+              } else if (made.page) {
+                failed = take(std::move(*made.page));
+              }
+            }));
+    return failed;
+  }
+
+  // The words of every top-level node that may exist (empty without contours).
+  TopContours FitTopContours(Progress& progress) const {
+    TopContours words(page_level_);
+    if (!contours_ || page_level_ == 0) return words;
+    Progress::Stage stage(progress, "top contours", 1);
+    std::vector<std::vector<std::uint64_t>> level_keys = TopLevelKeys(bins_.cells, page_level_);
+    level_keys.pop_back();
+    std::vector<std::uint32_t> all(voxelizer_.mesh().triangles.size());
+    std::iota(all.begin(), all.end(), 0u);
+    const auto fitted = contours_->FitSubtree(0, level_keys, all);
+    for (std::uint32_t l = 0; l < page_level_; ++l) {
+      for (std::size_t i = 0; i < level_keys[l].size(); ++i) {
+        words[l].emplace(level_keys[l][i], fitted[l][i]);
+      }
+    }
+    return words;
+  }
+
+ private:
+  PagePlan(const RegionVoxelizer& voxelizer, const BuildOptions& options)
+      : voxelizer_(voxelizer), page_options_(options) {}
+
+  // Page `i` of the bins, if its cell holds voxels.
+  Status MakePage(const PagedSvoWriter& writer, std::size_t i,
+                  std::optional<PagedSvoWriter::EncodedPage>& out) const {
+    const std::uint64_t cell = bins_.cells[i];
+    StatusOr<VoxelSet> voxels = voxelizer_.Voxelize(CellBox(cell, bits_, 1), bins_.Of(i));
+    if (!voxels.ok()) return voxels.status();
+    // The page's own voxels are the keys of its cell's range; the rest are its halo.
+    const std::uint64_t first = cell << (3 * bits_), last = (cell + 1) << (3 * bits_);
+    const auto begin = std::lower_bound(voxels->keys.begin(), voxels->keys.end(), first);
+    if (begin == voxels->keys.end() || *begin >= last) return Status::Ok();
+    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), nullptr, page_options_);
+    if (!svo.ok()) return svo.status();
+    const std::vector<std::uint64_t> keys = svo_detail::KeysOfLevel(svo->tree, page_level_);
+    const std::size_t at =
+        static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), cell) - keys.begin());
+    const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->tree, page_level_);
+    SvoChunk chunk = PageChunk(*svo, page_level_, at, nbs[at], cell);
+    if (contours_) {
+      chunk.contours = contours_->FitSubtree(page_level_, ChunkLevelKeys(chunk), bins_.Of(i));
+    }
+    out = writer.Encode(chunk);
+    return Status::Ok();
+  }
+
+  const RegionVoxelizer& voxelizer_;
+  BuildOptions page_options_;
+  SvoFrame frame_;
+  std::uint32_t page_level_ = 0, bits_ = 0;
+  std::optional<ContourFitter> contours_;
+  RegionVoxelizer::Bins bins_;
+  std::size_t in_flight_ = 1;
+};
+
+// Part files: the pages of one share of the cells, with what merging needs.
+inline constexpr container::FormatId kPartFormat{
+    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 1, "svokit octree part (.svopart)"};
+constexpr container::Tag kPartHead = container::MakeTag("PART");
+constexpr container::Tag kPartTable = container::MakeTag("PTAB");
+constexpr container::Tag kPartTop = container::MakeTag("TOPC");
+constexpr container::Tag kPartPages = container::MakeTag("PAGE");
+
+// Where part `part` of `parts` begins among the cells: shares of equal triangle work.
+std::size_t PartStart(const RegionVoxelizer::Bins& bins, std::uint32_t part, std::uint32_t parts) {
+  const std::uint64_t total = bins.triangles.size();
+  const std::uint64_t target = total * part / parts;
+  return static_cast<std::size_t>(
+      std::lower_bound(bins.starts.begin(), bins.starts.end() - 1, target) - bins.starts.begin());
 }
 
 }  // namespace
@@ -73,123 +258,261 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                                        const std::filesystem::path& path,
                                        const SvoCompression& compression,
                                        std::uint64_t memory_limit, Progress& progress) {
-  if (options.brick_side != 0) {
-    return Status::BadInput(
-        "a build by pages (--memory-limit) makes octrees without bricks for now: add --bricks "
-        "none");
-  }
-  std::optional<ContourFitter> contours;
-  BuildOptions page_options = options;
-  page_options.contours = false;  // fitted below, from the page's triangles
-  std::vector<std::uint32_t> all_triangles;
-  if (options.contours) {
-    contours.emplace(voxelizer.mesh(), voxelizer.grid(), OctreeDepth(voxelizer.grid()),
-                     options.contour);
-    all_triangles.resize(voxelizer.mesh().triangles.size());
-    std::iota(all_triangles.begin(), all_triangles.end(), 0u);
-  }
-  SvoFrame frame;
-  frame.grid = voxelizer.grid();
-  frame.mode = voxelizer.options().mode;
-  frame.depth = OctreeDepth(frame.grid);
-  frame.shape.depth = frame.depth;
-  frame.shape.has_color = voxelizer.options().colors;
-  frame.shape.has_normal = voxelizer.options().normals;
-  frame.shape.has_contours = options.contours;
-  if (const auto shared = voxelizer.shared_color()) frame.shape.shared_color = {HalfRgba(*shared)};
-  frame.metadata = metadata;
-  PagedSvoWriter writer(frame, compression);
-  const std::uint32_t page_level = writer.page_level();
-  const std::uint32_t bits = frame.depth - page_level;
+  StatusOr<std::unique_ptr<PagePlan>> plan =
+      PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
+  if (!plan.ok()) return plan.status();
+  const PagePlan& p = **plan;
+  PagedSvoWriter writer(p.frame(), compression);
+  const TopContours words = p.FitTopContours(progress);
+  return writer.Write(
+      path,
+      [&](const PagedSvoWriter::Take& take) {
+        return p.Run(writer, 0, p.bins().cells.size(), take, progress);
+      },
+      [&](std::span<const std::uint64_t> keys) {
+        return TopOfPages(keys, p.page_level(), options.contours ? &words : nullptr);
+      });
+}
 
-  const RegionVoxelizer::Bins bins = [&] {
-    Progress::Stage stage(progress, "bin", 1);
-    return voxelizer.BinTriangles(static_cast<int>(bits), 1);
-  }();
-  // What the build holds whatever the page: the snapped mesh and the bins; then each page in
-  // flight, at most a full cube's voxels with their attributes and nodes (~40 B a voxel).
-  const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  const std::uint64_t fixed = voxelizer.bytes() + bins.bytes();
-  const std::uint64_t surface_page = std::uint64_t{40} * 4 << (2 * bits);
-  const std::uint64_t smallest = fixed + surface_page;
-  if (memory_limit != 0 && memory_limit < smallest) {
-    return Status::BadInput(
-        "a memory limit of {} MiB is too small for this mesh and grid: the mesh's bins and one "
-        "page "
-        "need {} MiB (use --memory-limit {}M or more)",
-        memory_limit >> 20, (smallest + (1 << 20) - 1) >> 20, (smallest + (1 << 20) - 1) >> 20);
+StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const BuildOptions& options,
+                                    const std::string& metadata, const SvoPartOf& part,
+                                    const std::filesystem::path& path,
+                                    const SvoCompression& compression, std::uint64_t memory_limit,
+                                    Progress& progress) {
+  if (part.parts == 0 || part.part >= part.parts) {
+    return Status::BadInput("part {} of {} does not exist (parts are 0 .. N − 1)", part.part,
+                            part.parts);
   }
-  const std::size_t in_flight =
-      memory_limit == 0 ? tokens
-                        : std::clamp<std::size_t>((memory_limit - fixed) / surface_page, 1, tokens);
+  StatusOr<std::unique_ptr<PagePlan>> plan =
+      PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
+  if (!plan.ok()) return plan.status();
+  const PagePlan& p = **plan;
+  const std::size_t first = PartStart(p.bins(), part.part, part.parts);
+  const std::size_t end = part.part + 1 == part.parts
+                              ? p.bins().cells.size()
+                              : PartStart(p.bins(), part.part + 1, part.parts);
+  const SvoFrame& frame = p.frame();
+  PagedSvoWriter encoder(frame, compression);
 
-  Progress::Stage stage(progress, "pages", bins.cells.size());
-  const PagedSvoWriter::PageSource pages = [&](const PagedSvoWriter::Take& take) -> Status {
-    Status failed;
-    std::size_t next = 0;
-    struct Made {
-      bool present = false;
-      PagedSvoWriter::EncodedPage page;
-      Status status;
-    };
-    tbb::parallel_pipeline(
-        in_flight,
-        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                            [&](tbb::flow_control& fc) -> std::size_t {
-                                              if (next == bins.cells.size() || !failed.ok())
-                                                fc.stop();
-                                              return next++;
-                                            }) &
-            tbb::make_filter<std::size_t, Made>(
-                tbb::filter_mode::parallel,
-                [&](std::size_t i) -> Made {
-                  Made made;
-                  const std::uint64_t cell = bins.cells[i];
-                  StatusOr<VoxelSet> voxels =
-                      voxelizer.Voxelize(CellBox(cell, bits, 1), bins.Of(i));
-                  if (!voxels.ok()) {
-                    made.status = voxels.status();
-                    return made;
-                  }
-                  // The page's own voxels are the keys of its cell's range.
-                  const std::uint64_t first = cell << (3 * bits), last = (cell + 1) << (3 * bits);
-                  const auto begin =
-                      std::lower_bound(voxels->keys.begin(), voxels->keys.end(), first);
-                  if (begin == voxels->keys.end() || *begin >= last) return made;
-                  StatusOr<CompactSvo> svo =
-                      BuildCompactSvo(std::move(*voxels), nullptr, page_options, metadata);
-                  if (!svo.ok()) {
-                    made.status = svo.status();
-                    return made;
-                  }
-                  const std::vector<std::uint64_t> keys =
-                      svo_detail::KeysOfLevel(svo->tree, page_level);
-                  const std::size_t at = static_cast<std::size_t>(
-                      std::lower_bound(keys.begin(), keys.end(), cell) - keys.begin());
-                  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->tree, page_level);
-                  SvoChunk chunk = PageChunk(*svo, page_level, at, nbs[at], cell);
-                  if (contours) {
-                    const auto keys_by_level = ChunkLevelKeys(chunk);
-                    chunk.contours = contours->FitSubtree(page_level, keys_by_level, bins.Of(i));
-                  }
-                  made.page = writer.Encode(chunk);
-                  made.present = true;
-                  return made;
-                }) &
-            tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
-              stage.Advance(1);
-              if (!failed.ok()) return;
-              if (!made.status.ok()) {
-                failed = made.status;
-              } else if (made.present) {
-                failed = take(std::move(made.page));
-              }
-            }));
-    return failed;
-  };
-  return writer.Write(path, pages, [&](std::span<const std::uint64_t> keys) {
-    return TopOfPages(keys, page_level, contours ? &*contours : nullptr, all_triangles);
+  ByteWriter head;
+  head.Put(part.part);
+  head.Put(part.parts);
+  head.Put(part.identity);
+  head.Put(static_cast<std::uint64_t>(p.bins().cells.size()));
+  head.Put(static_cast<std::uint64_t>(first));
+  head.Put(static_cast<std::uint64_t>(end));
+  head.Put(frame.depth);
+  head.Put(frame.shape.brick_side);
+  head.Put(std::uint32_t{(frame.shape.has_color ? 1u : 0u) | (frame.shape.has_normal ? 2u : 0u) |
+                         (frame.shape.has_contours ? 4u : 0u)});
+  head.Put(frame.shape.shared_color.empty() ? HalfRgba(0, 0, 0, 0) : frame.shape.shared_color[0]);
+  head.Put(std::uint32_t{frame.shape.shared_color.empty() ? 0u : 1u});
+  head.Put(std::uint32_t{compression.zstd ? 1u : 0u});
+  head.Put(static_cast<std::uint32_t>(compression.level));
+
+  ByteWriter table;
+  SvoPartStats stats;
+  stats.cells = end - first;
+  container::Writer file(kPartFormat, 0);
+  file.AddSection(svo_detail::kGrid, EncodeGridSection(frame.grid, frame.mode));
+  file.AddSection(kPartHead, std::move(head.bytes()));
+  file.AddSectionProduced(kPartPages, [&](const container::Writer::Emit& emit) {
+    return p.Run(
+        encoder, first, end,
+        [&](PagedSvoWriter::EncodedPage page) -> Status {
+          SVOKIT_RETURN_IF_ERROR(emit(page.bytes));
+          table.Put(page.key);
+          table.Put(static_cast<std::uint64_t>(page.bytes.size()));
+          for (const auto& level : page.levels) {
+            for (const std::uint64_t v : level) table.Put(v);
+          }
+          ++stats.pages;
+          stats.voxels += page.levels.back()[0];
+          return Status::Ok();
+        },
+        progress);
   });
+  file.AddSectionProduced(kPartTable,
+                          [&](const container::Writer::Emit& emit) { return emit(table.bytes()); });
+  // The top levels' contours travel with part 0: every part has the mesh, the merge need not.
+  ByteWriter top;
+  if (part.part == 0 && frame.shape.has_contours) {
+    const TopContours words = p.FitTopContours(progress);
+    for (const auto& level : words) {
+      top.Put(static_cast<std::uint64_t>(level.size()));
+      for (const auto& [key, word] : level) {
+        top.Put(key);
+        top.Put(word);
+      }
+    }
+  }
+  file.AddSection(kPartTop, std::move(top.bytes()));
+  file.AddSection(svo_detail::kMetadata,
+                  std::vector<std::uint8_t>(metadata.begin(), metadata.end()));
+  SVOKIT_RETURN_IF_ERROR(file.WriteFile(path));
+  return stats;
+}
+
+namespace {
+
+// A part file, read and checked on its own.
+struct Part {
+  std::string name;
+  container::Reader file;
+  std::uint32_t part = 0, parts = 0;
+  std::uint64_t identity = 0, cells = 0, first = 0, end = 0;
+  SvoFrame frame;
+  SvoCompression compression;
+  struct Page {
+    std::uint64_t key = 0, offset = 0, size = 0;
+    std::vector<std::array<std::uint64_t, 3>> levels;
+  };
+  std::vector<Page> pages;
+  std::span<const std::uint8_t> page_bytes;
+  TopContours top;
+};
+
+StatusOr<Part> ReadPart(const std::filesystem::path& path) {
+  StatusOr<container::Reader> file = container::Reader::Open(path, kPartFormat);
+  if (!file.ok()) return file.status();
+  Part part{path.string(), std::move(*file)};
+  const std::string& name = part.name;
+  StatusOr<std::span<const std::uint8_t>> grid = part.file.Require(svo_detail::kGrid);
+  StatusOr<std::span<const std::uint8_t>> head = part.file.Require(kPartHead);
+  StatusOr<std::span<const std::uint8_t>> table = part.file.Require(kPartTable);
+  StatusOr<std::span<const std::uint8_t>> pages = part.file.Require(kPartPages);
+  StatusOr<std::span<const std::uint8_t>> top = part.file.Require(kPartTop);
+  StatusOr<std::span<const std::uint8_t>> meta = part.file.Require(svo_detail::kMetadata);
+  for (const auto* s : {&grid, &head, &table, &pages, &top, &meta}) {
+    if (!s->ok()) return s->status();
+  }
+  SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, name, part.frame.grid, part.frame.mode));
+  ByteReader h(*head, name + ": PART");
+  std::uint32_t flags = 0, shared = 0, zstd = 0, level = 0;
+  HalfRgba color(0, 0, 0, 0);
+  SvoShape& shape = part.frame.shape;
+  for (Status s :
+       {h.Get(part.part), h.Get(part.parts), h.Get(part.identity), h.Get(part.cells),
+        h.Get(part.first), h.Get(part.end), h.Get(part.frame.depth), h.Get(shape.brick_side),
+        h.Get(flags), h.Get(color), h.Get(shared), h.Get(zstd), h.Get(level)}) {
+    SVOKIT_RETURN_IF_ERROR(s);
+  }
+  shape.depth = part.frame.depth;
+  shape.has_color = flags & 1u, shape.has_normal = flags & 2u, shape.has_contours = flags & 4u;
+  if (shared) shape.shared_color = {color};
+  part.compression.zstd = zstd != 0;
+  part.compression.level = static_cast<int>(level);
+  part.frame.metadata.assign(meta->begin(), meta->end());
+  if (part.parts == 0 || part.part >= part.parts || part.first > part.end ||
+      part.end > part.cells || part.frame.depth != OctreeDepth(part.frame.grid) ||
+      shape.brick_side != 0 || flags > 7) {
+    return Status::BadInput("{}: the part's header is inconsistent", name);
+  }
+  const std::uint32_t page_level = PageLevel(part.frame.depth);
+  const std::size_t held = part.frame.depth - page_level + 1;
+  ByteReader t(*table, name + ": PTAB");
+  std::uint64_t offset = 0;
+  while (t.remaining() > 0) {
+    Part::Page& page = part.pages.emplace_back();
+    SVOKIT_RETURN_IF_ERROR(t.Get(page.key));
+    SVOKIT_RETURN_IF_ERROR(t.Get(page.size));
+    page.levels.resize(held);
+    for (auto& l : page.levels) {
+      for (auto& v : l) SVOKIT_RETURN_IF_ERROR(t.Get(v));
+    }
+    page.offset = offset;
+    offset += page.size;
+    if (part.pages.size() > 1 && page.key <= part.pages[part.pages.size() - 2].key) {
+      return Status::BadInput("{}: page keys are not ascending", name);
+    }
+  }
+  if (offset != pages->size()) {
+    return Status::BadInput("{}: the page table does not fill the pages", name);
+  }
+  part.page_bytes = *pages;
+  ByteReader c(*top, name + ": TOPC");
+  if (part.part == 0 && shape.has_contours) {
+    part.top.resize(page_level);
+    for (auto& words : part.top) {
+      std::uint64_t n = 0;
+      SVOKIT_RETURN_IF_ERROR(c.Get(n));
+      for (std::uint64_t i = 0; i < n; ++i) {
+        std::uint64_t key = 0;
+        std::uint32_t word = 0;
+        SVOKIT_RETURN_IF_ERROR(c.Get(key));
+        SVOKIT_RETURN_IF_ERROR(c.Get(word));
+        words.emplace(key, word);
+      }
+    }
+  }
+  if (c.remaining() != 0) return Status::BadInput("{}: the top contours are inconsistent", name);
+  return part;
+}
+
+}  // namespace
+
+StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> paths,
+                                     const std::filesystem::path& path, Progress& progress) {
+  if (paths.empty()) return Status::BadInput("no parts to merge");
+  std::vector<Part> parts;
+  for (const std::filesystem::path& p : paths) {
+    StatusOr<Part> part = ReadPart(p);
+    if (!part.ok()) return part.status();
+    parts.push_back(std::move(*part));
+  }
+  std::sort(parts.begin(), parts.end(),
+            [](const Part& a, const Part& b) { return a.part < b.part; });
+  const Part& head = parts[0];
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Part& p = parts[i];
+    if (p.identity != head.identity || p.parts != head.parts || p.cells != head.cells ||
+        p.frame.metadata != head.frame.metadata) {
+      return Status::BadInput("{} belongs to another build than {} (another mesh or options)",
+                              p.name, head.name);
+    }
+    if (i > 0 && p.part == parts[i - 1].part) {
+      return Status::BadInput("part {} of {} is given twice: {} and {}", p.part, p.parts,
+                              parts[i - 1].name, p.name);
+    }
+  }
+  for (std::uint32_t k = 0; k < head.parts; ++k) {
+    if (k >= parts.size() || parts[k].part != k) {
+      return Status::BadInput("part {} of {} is missing", k, head.parts);
+    }
+  }
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::uint64_t want = i == 0 ? 0 : parts[i - 1].end;
+    if (parts[i].first != want || (i + 1 == parts.size() && parts[i].end != head.cells)) {
+      return Status::BadInput("{}: its pages do not follow part {}'s", parts[i].name,
+                              i == 0 ? 0 : parts[i - 1].part);
+    }
+  }
+  PagedSvoWriter writer(head.frame, head.compression);
+  Progress::Stage stage(progress, "merge", parts.size());
+  return writer.Write(
+      path,
+      [&](const PagedSvoWriter::Take& take) -> Status {
+        for (const Part& part : parts) {
+          for (const Part::Page& page : part.pages) {
+            PagedSvoWriter::EncodedPage encoded;
+            encoded.key = page.key;
+            const auto bytes = part.page_bytes.subspan(page.offset, page.size);
+            encoded.bytes.assign(bytes.begin(), bytes.end());
+            StatusOr<ChunkBytes> sizes =
+                ChunkStreamBytes(bytes, fmt::format("{}: page {:#x}", part.name, page.key));
+            if (!sizes.ok()) return sizes.status();
+            encoded.stats = std::move(*sizes);
+            encoded.levels = page.levels;
+            SVOKIT_RETURN_IF_ERROR(take(std::move(encoded)));
+          }
+          stage.Advance(1);
+        }
+        return Status::Ok();
+      },
+      [&](std::span<const std::uint64_t> keys) {
+        return TopOfPages(keys, PageLevel(head.frame.depth),
+                          head.frame.shape.has_contours ? &head.top : nullptr);
+      });
 }
 
 }  // namespace svokit

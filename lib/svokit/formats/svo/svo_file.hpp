@@ -133,6 +133,32 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                                        std::uint64_t memory_limit,
                                        Progress& progress = Progress::Silent());
 
+/// One share of a build by pages run as separate jobs (on one machine or many): part `part` of
+/// `parts` (0-based), of the build `identity` names (e.g. checksums of the input and options;
+/// merging refuses parts whose identities differ).
+struct SvoPartOf {
+  std::uint32_t part = 0, parts = 1;
+  std::uint64_t identity = 0;
+};
+struct SvoPartStats {
+  std::uint64_t cells = 0;  ///< the page cubes of its share that may hold voxels
+  std::uint64_t pages = 0, voxels = 0;
+};
+/// The pages of one share of BuildSvoByPages' cells (shares of equal triangle work) into a part
+/// file (.svopart: the container with the pages, their counts and, in part 0, the top levels'
+/// contours), so that MergeSvoParts of all parts writes BuildSvoByPages' file.
+StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const BuildOptions& options,
+                                    const std::string& metadata, const SvoPartOf& part,
+                                    const std::filesystem::path& path,
+                                    const SvoCompression& compression, std::uint64_t memory_limit,
+                                    Progress& progress = Progress::Silent());
+/// Joins the parts of one build, given in any order, into its .svo, after checking that they
+/// belong to the same build and cover its pages exactly once (an error names the missing,
+/// repeated or foreign part). The pages' bytes are copied, not recompressed.
+StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> parts,
+                                     const std::filesystem::path& path,
+                                     Progress& progress = Progress::Silent());
+
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);

@@ -1,0 +1,43 @@
+// svo-merge: joins the parts of a build by pages (mesh2svo --pages K/N) into its .svo.
+
+#include <filesystem>
+#include <vector>
+
+#include "apps/app.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+
+int main(int argc, char** argv) {
+  using namespace svokit;
+  const std::string tool = "svo-merge";
+  CLI::App cli{
+      "Joins the parts of a build by pages (mesh2svo --pages K/N, one job each) into the .svo "
+      "the whole build writes, after checking that they are the parts of one build and cover it "
+      "exactly once.",
+      tool};
+  std::vector<std::filesystem::path> parts;
+  std::filesystem::path output;
+  app::CommonOptions common;
+  cli.add_option("parts", parts, "The part files (.svopart), in any order")
+      ->required()
+      ->check(CLI::ExistingFile.description(""))
+      ->option_text("PART...");
+  app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
+  app::AddCommonOptions(cli, common, "svo-merge out/*.svopart -o scene.svo");
+
+  return app::Run(tool, cli, argc, argv, parts.empty() ? std::filesystem::path{} : parts[0], [&] {
+    if (Status s = app::CheckOutputPath(output, {"svo"}, parts.front()); !s.ok()) {
+      return app::Fail(tool, s);
+    }
+    ThreadLimit threads(common.threads);
+    Progress progress = common.MakeProgress();
+    StatusOr<SvoFileStats> written = MergeSvoParts(parts, output, progress);
+    if (!written.ok()) return app::Fail(tool, written.status());
+    fmt::print("parts       {}\n", parts.size());
+    fmt::print("voxels      {}\n", written->voxels);
+    app::PrintFileSummary(*written);
+    app::PrintTimes(progress);
+    fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
+    return 0;
+  });
+}
