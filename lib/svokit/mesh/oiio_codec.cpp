@@ -9,6 +9,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -104,6 +105,28 @@ std::string CheckDeclaredSizes(std::string_view format, const std::uint8_t* byte
   return {};
 }
 
+// OpenImageIO 2.4's IOMemReader bounds its copies by offset + size in wrapping arithmetic, so a
+// damaged file whose offsets point far past its end makes it copy from outside the buffer
+// (OpenImageIO #5262). The same reader with the bounds checked without overflow.
+class BoundedMemReader final : public OIIO::Filesystem::IOMemReader {
+ public:
+  using IOMemReader::IOMemReader;
+  std::size_t read(void* buf, std::size_t size) override {
+    const std::size_t n = pread(buf, size, m_pos);
+    m_pos += static_cast<std::int64_t>(n);
+    return n;
+  }
+  std::size_t pread(void* buf, std::size_t size, std::int64_t offset) override {
+    const auto all = buffer();
+    const auto length = static_cast<std::uint64_t>(all.size());
+    if (offset < 0 || static_cast<std::uint64_t>(offset) >= length) return 0;
+    const auto n = static_cast<std::size_t>(
+        std::min<std::uint64_t>(size, length - static_cast<std::uint64_t>(offset)));
+    std::memcpy(buf, all.data() + offset, n);
+    return n;
+  }
+};
+
 // The reader the name's extension picks decodes the bytes from memory, through an IOProxy, or,
 // for a format whose reader cannot, from an unnamed in-memory file (memfd): the bytes never go
 // through a file name, so no file of the same name is read instead and no temporary is left.
@@ -155,7 +178,7 @@ class EncodedImageReader {
     input_.reset();
   }
 
-  OIIO::Filesystem::IOMemReader reader_;
+  BoundedMemReader reader_;
   int memfd_ = -1;
   std::unique_ptr<OIIO::ImageInput> input_;
   std::string error_;
