@@ -8,8 +8,8 @@
 namespace svokit::test {
 namespace {
 
-const char* const kTools[] = {"svo-import", "mesh2svo",     "svo-voxelize", "svo-build",
-                              "svo-export", "svo-validate", "svo-inspect"};
+const char* const kTools[] = {"svo-import", "mesh2svo",   "svo-voxelize", "svo-build",
+                              "svo-merge",  "svo-export", "svo-validate", "svo-inspect"};
 
 std::string Help(const std::string& tool) {
   const ToolResult r = RunTool(tool, {"--help"});
@@ -28,10 +28,10 @@ void ExpectShows(const std::string& help, const std::vector<std::string>& parts,
 TEST(HelpCli, EveryToolShowsWordsDefaultsAndAnExample) {
   for (const std::string tool : kTools) {
     const std::string help = Help(tool);
-    ExpectShows(
-        help,
-        {"input FILE REQUIRED", "-j,--threads N", "(default: 0)", "Example:\n  " + tool + " "},
-        tool);
+    ExpectShows(help,
+                {tool == "svo-merge" ? "parts PART... REQUIRED" : "input FILE REQUIRED",
+                 "-j,--threads N", "(default: 0)", "Example:\n  " + tool + " "},
+                tool);
     // CLI11's type names and enum maps are not for people.
     for (const char* noise : {"ENUM", "->", "TEXT", "UINT", "FLOAT", "{false}", "OR {"}) {
       EXPECT_EQ(help.find(noise), std::string::npos) << tool << " --help shows " << noise << ":\n"

@@ -165,6 +165,48 @@ TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
   }
 }
 
+// mesh2svo --pages K/N as separate jobs, then svo-merge: the whole build's file. A wrong set of
+// parts, a part number that does not exist or a part file for an .svo are one-line errors.
+TEST(SvoBuildCli, PartsMergeIntoTheSameFile) {
+  TempDir dir;
+  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "-q"};
+  auto mesh2svo = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {Torus(), "-o", (dir / name).string()};
+    args.insert(args.end(), options.begin(), options.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunTool("mesh2svo", args);
+  };
+  ASSERT_EQ(mesh2svo("whole.svo", {}).exit_code, 0);
+  std::vector<std::string> parts;
+  for (int k = 3; k-- > 0;) {
+    parts.push_back((dir / fmt::format("t{}.svopart", k)).string());
+    const ToolResult r =
+        mesh2svo(fmt::format("t{}.svopart", k), {"--pages", fmt::format("{}/3", k)});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::vector<std::string> merge = parts;
+  merge.insert(merge.end(), {"-o", (dir / "merged.svo").string(), "-q"});
+  const ToolResult merged = RunTool("svo-merge", merge);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_NE(merged.out.find("voxels"), std::string::npos) << merged.out;
+  EXPECT_TRUE(ReadText(dir / "merged.svo") == ReadText(dir / "whole.svo"));
+
+  const ToolResult missing =
+      RunTool("svo-merge", {parts[0], parts[2], "-o", (dir / "bad.svo").string(), "-q"});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_EQ(missing.ErrLines().size(), 1u) << missing.err;
+  EXPECT_NE(missing.err.find("part 1 of 3 is missing"), std::string::npos) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.svo"));
+  for (const char* bad : {"3/3", "1", "a/2", "1/0"}) {
+    const ToolResult r = mesh2svo("bad.svopart", {"--pages", bad});
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_NE(r.err.find("expected K/N"), std::string::npos) << r.err;
+  }
+  const ToolResult wrong_name = mesh2svo("bad.svo", {"--pages", "0/2"});
+  EXPECT_NE(wrong_name.exit_code, 0);
+  EXPECT_NE(wrong_name.err.find(".svopart"), std::string::npos) << wrong_name.err;
+}
+
 TEST(SvoBuildCli, Mesh2svoPrintsOneLinePerStageAndASummary) {
   TempDir dir;
   const std::string out = (dir / "t.svo").string();
