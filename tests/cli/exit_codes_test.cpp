@@ -32,6 +32,13 @@ class ExitCodes : public ::testing::Test {
     ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", "64", "-o", Input("t.vfrag"), "-q"}).exit_code,
               0);
     ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "64", "-o", Input("t.svo"), "-q"}).exit_code, 0);
+    for (const char* k : {"0", "1"}) {
+      ASSERT_EQ(RunTool("mesh2svo",
+                        {mesh, "-r", "300", "--bricks", "none", "--pages", std::string(k) + "/2",
+                         "-o", Input(k + std::string(".svopart")), "-q"})
+                    .exit_code,
+                0);
+    }
   }
   static void TearDownTestSuite() {
     delete inputs_;
@@ -60,6 +67,17 @@ class ExitCodes : public ::testing::Test {
          {vfrag, "--mesh", svm, "-o", (out / "o.svo").string()},
          (out / "o.svo").string()},
         {"mesh2svo", {svm, "-r", "64", "-o", (out / "m.svo").string()}, (out / "m.svo").string()},
+        {"mesh2svo",
+         {svm, "-r", "300", "--bricks", "none", "--memory-limit", "1G", "-o",
+          (out / "p.svo").string()},
+         (out / "p.svo").string()},
+        {"mesh2svo",
+         {svm, "-r", "300", "--bricks", "none", "--pages", "1/2", "-o",
+          (out / "p.svopart").string()},
+         (out / "p.svopart").string()},
+        {"svo-merge",
+         {Input("0.svopart"), Input("1.svopart"), "-o", (out / "merged.svo").string()},
+         (out / "merged.svo").string()},
         {"svo-inspect",
          {svo, "--render", (out / "r.png").string(), "--size", "1024x1024"},
          (out / "r.png").string()},

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 namespace svokit {
 namespace {
@@ -41,6 +43,29 @@ TEST(Progress, BarRedrawsInPlaceAndEndsWithNewline) {
   EXPECT_NE(s.find('\r'), std::string::npos);
   EXPECT_NE(s.find("100%"), std::string::npos);
   EXPECT_EQ(s.back(), '\n');
+}
+
+// While a stage runs, the bar shows the units done of all, the bytes written and what is left.
+TEST(Progress, ARunningBarShowsCountsBytesAndEta) {
+  char* buf = nullptr;
+  std::size_t size = 0;
+  std::FILE* out = open_memstream(&buf, &size);
+  {
+    Progress progress(Progress::Style::kBar, out);
+    Progress::Stage stage(progress, "pages", 4);
+    stage.Advance();
+    stage.AddBytes(2500000);
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    stage.Advance();  // redraws: 100 ms have passed
+  }
+  std::fclose(out);
+  const std::string s(buf, size);
+  std::free(buf);
+  EXPECT_NE(s.find("50% "), std::string::npos) << s;
+  EXPECT_NE(s.find("2/4"), std::string::npos) << s;
+  EXPECT_NE(s.find("2.5 MB written"), std::string::npos) << s;
+  EXPECT_NE(s.find("ETA "), std::string::npos) << s;
+  EXPECT_NE(s.find("100%"), std::string::npos) << s;
 }
 
 TEST(Progress, AutoOnAPipeIsLines) {

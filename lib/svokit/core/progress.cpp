@@ -52,14 +52,31 @@ double Progress::Stage::seconds() const {
 
 void Progress::Stage::Advance(std::uint64_t units) {
   done_.fetch_add(units, std::memory_order_relaxed);
-  if (progress_.style_ != Style::kBar) return;
-  // Redraw at most every 100 ms, and never block a worker on another one's drawing.
+  if (progress_.style_ != Style::kBar && progress_.style_ != Style::kLines) return;
+  // Redraw a bar at most every 100 ms; in a log (lines), a line every 10 s of a long stage. Never
+  // block a worker on another one's drawing.
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_draw_ < std::chrono::milliseconds(100)) return;
+  const auto every = progress_.style_ == Style::kBar ? std::chrono::milliseconds(100)
+                                                     : std::chrono::milliseconds(10000);
+  if (now - last_draw_ < every) return;
   std::unique_lock lock(draw_mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
   last_draw_ = now;
   Draw(false);
+}
+
+// "45% 12.3 s, 1234/5000, 12.5 MB written, ETA 15 s": what a long stage has done and has left.
+std::string Progress::Stage::Status() const {
+  const std::uint64_t done = std::min(done_.load(), total_);
+  const double t = seconds();
+  const double frac = total_ == 0 ? 1.0 : static_cast<double>(done) / static_cast<double>(total_);
+  std::string s = fmt::format("{:3.0f}% {:.1f} s", frac * 100.0, t);
+  if (total_ > 1) s += fmt::format(", {}/{}", done, total_);
+  if (const std::uint64_t b = bytes_.load(); b > 0) {
+    s += fmt::format(", {:.1f} MB written", static_cast<double>(b) / 1e6);
+  }
+  if (done > 0 && done < total_) s += fmt::format(", ETA {:.0f} s", t * (1.0 - frac) / frac);
+  return s;
 }
 
 void Progress::Stage::Draw(bool final) {
@@ -70,7 +87,11 @@ void Progress::Stage::Draw(bool final) {
     case Style::kAuto:
       return;
     case Style::kLines:
-      if (final) fmt::print(out, "{:<12} done in {:.3f} s{}\n", name_, seconds(), tail);
+      if (final) {
+        fmt::print(out, "{:<12} done in {:.3f} s{}\n", name_, seconds(), tail);
+      } else {
+        fmt::print(out, "{:<12} {}\n", name_, Status());
+      }
       break;
     case Style::kBar: {
       constexpr int kWidth = 30;
@@ -79,9 +100,10 @@ void Progress::Stage::Draw(bool final) {
               ? 1.0
               : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
       const int filled = static_cast<int>(frac * kWidth);
-      fmt::print(out, "\r{:<12} [{}{}] {:3.0f}% {:.1f} s{}\x1b[K{}", name_,
-                 std::string(filled, '#'), std::string(kWidth - filled, '.'), frac * 100.0,
-                 seconds(), final ? tail : "", final ? "\n" : "");
+      fmt::print(out, "\r{:<12} [{}{}] {}{}\x1b[K{}", name_, std::string(filled, '#'),
+                 std::string(kWidth - filled, '.'),
+                 final ? fmt::format("{:3.0f}% {:.1f} s", frac * 100.0, seconds()) : Status(),
+                 final ? tail : "", final ? "\n" : "");
       break;
     }
   }

@@ -44,10 +44,13 @@ class Progress {
     void Cancel() { cancelled_ = true; }
     /// Text appended to the stage's final line (e.g. "1.2 M triangles").
     void SetSummary(std::string summary) { summary_ = std::move(summary); }
+    /// Bytes the stage has written so far, shown while it runs (thread-safe).
+    void AddBytes(std::uint64_t bytes) { bytes_.fetch_add(bytes, std::memory_order_relaxed); }
     double seconds() const;
 
    private:
     void Draw(bool final);
+    std::string Status() const;
 
     Progress& progress_;
     std::string name_;
@@ -55,6 +58,7 @@ class Progress {
     std::uint64_t total_;
     bool cancelled_ = false;
     std::atomic<std::uint64_t> done_{0};
+    std::atomic<std::uint64_t> bytes_{0};
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_draw_;
     std::mutex draw_mutex_;

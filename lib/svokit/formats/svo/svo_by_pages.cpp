@@ -174,6 +174,7 @@ class PagePlan {
               if (!made.status.ok()) {
                 failed = made.status;
               } else if (made.page) {
+                stage.AddBytes(made.page->bytes.size());
                 failed = take(std::move(*made.page));
               }
             }));
