@@ -241,6 +241,14 @@ inline void PrintTimes(const Progress& progress) {
   fmt::print("time        {}total {:.2f} s\n", times, total);
 }
 
+/// The machine's physical memory in bytes (0 if unknown).
+inline std::uint64_t MachineMemory() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && size > 0
+             ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size)
+             : 0;
+}
+
 /// "K/N": part K (0-based) of N.
 inline StatusOr<SvoPartOf> ParsePart(const std::string& option, const std::string& text) {
   SvoPartOf part;

@@ -29,7 +29,9 @@ int main(int argc, char** argv) {
   build.Add(cli);
   cli.add_option("--memory-limit", memory_limit,
                  "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
-                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none")
+                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none. "
+                 "Default: by pages within half the machine's memory when the whole grid would "
+                 "not fit there (with --bricks none), else whole")
       ->option_text("SIZE");
   cli.add_option("--pages", pages,
                  "Build part K of N (0-based) of a build by pages into OUT.svopart, as one job of "
@@ -57,10 +59,18 @@ int main(int argc, char** argv) {
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    if (!memory_limit.empty() || !pages.empty()) {
+    // Without a limit, a build that fits no bricks goes by pages when the whole grid would not
+    // fit in half the machine's memory (~48 B a voxel held whole): the same file either way.
+    const double whole_bytes = 48.0 * EstimateVoxelCount(*mesh, *grid);
+    const std::uint64_t half_machine = app::MachineMemory() / 2;
+    const bool by_pages_by_default = memory_limit.empty() && build.Options().brick_side == 0 &&
+                                     half_machine > 0 &&
+                                     whole_bytes > static_cast<double>(half_machine);
+    if (!memory_limit.empty() || !pages.empty() || by_pages_by_default) {
       const StatusOr<std::uint64_t> limit =
-          memory_limit.empty() ? std::uint64_t{0}
-                               : app::ParseByteSize("--memory-limit", memory_limit);
+          by_pages_by_default    ? half_machine
+          : memory_limit.empty() ? std::uint64_t{0}
+                                 : app::ParseByteSize("--memory-limit", memory_limit);
       if (!limit.ok()) return app::Fail(tool, limit.status());
       StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
           RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
@@ -88,6 +98,14 @@ int main(int argc, char** argv) {
       fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
       fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
                  grid->voxel_size(), OctreeDepth(*grid));
+      if (*limit > 0) {
+        fmt::print("build       by pages within {:.1f} GiB{}\n",
+                   static_cast<double>(*limit) / 1073741824.0,
+                   by_pages_by_default
+                       ? fmt::format(" (half the machine: whole, it would need ~{:.0f} GiB)",
+                                     whole_bytes / 1073741824.0)
+                       : "");
+      }
       fmt::print("voxels      {} ({})\n", written->voxels, voxelize.ModeName());
       app::PrintFileSummary(*written);
       app::PrintTimes(progress);

@@ -114,6 +114,23 @@ TEST(RegionVoxelizer, BoxesHoldExactlyTheWholeVoxelizationsVoxels) {
   ExpectRegionsMatch(*spider, 160, attributes, "spider, 19 materials over photo textures");
 }
 
+// The estimate that decides how to build is within a factor of two of the voxels made.
+TEST(RegionVoxelizer, TheVoxelEstimateIsWithinAFactorOfTwo) {
+  for (const char* name : {"uv-torus.obj", "box-room.obj", "tetra.off"}) {
+    auto mesh = ImportMesh(test::DataDir() / name);
+    ASSERT_TRUE(mesh.ok());
+    for (const std::uint32_t n : {64u, 512u}) {
+      auto grid = GridTransform::FitResolution(mesh->Bounds(), n);
+      auto voxels = Voxelize(*mesh, *grid, VoxelizeOptions{});
+      ASSERT_TRUE(voxels.ok());
+      const double estimate = EstimateVoxelCount(*mesh, *grid);
+      const double actual = static_cast<double>(voxels->size());
+      EXPECT_GT(estimate, 0.5 * actual) << name << " at " << n;
+      EXPECT_LT(estimate, 2.0 * actual) << name << " at " << n;
+    }
+  }
+}
+
 // A large triangle crossing many cells is binned to the cells its plane passes, not to its
 // whole bounding box.
 TEST(RegionVoxelizer, BinsFollowTheTrianglesPlane) {

@@ -328,6 +328,24 @@ StatusOr<PackedVoxelSet> VoxelizePacked(const Mesh& mesh, const GridTransform& g
   return set;
 }
 
+double EstimateVoxelCount(const Mesh& mesh, const GridTransform& grid) {
+  return OrderedReduce(
+      mesh.triangles.size(), 1 << 14, 0.0,
+      [&](std::size_t begin, std::size_t end) {
+        double voxels = 0;
+        for (std::size_t t = begin; t < end; ++t) {
+          const Triangle& tri = mesh.triangles[t];
+          const Vec3d a = grid.WorldToVoxel(mesh.positions[tri[0]]);
+          const Vec3d n = Cross(grid.WorldToVoxel(mesh.positions[tri[1]]) - a,
+                                grid.WorldToVoxel(mesh.positions[tri[2]]) - a);
+          // Curved surfaces fill ~1.75 voxels per voxel² of projected area; a triangle at least 1.
+          voxels += 1.0 + 0.875 * std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
+        }
+        return voxels;
+      },
+      [](double& acc, double part) { acc += part; });
+}
+
 RegionVoxelizer::RegionVoxelizer(const Mesh& mesh, const GridTransform& grid,
                                  const VoxelizeOptions& options)
     : mesh_(mesh), grid_(grid), options_(options) {}

@@ -53,6 +53,11 @@ StatusOr<PackedVoxelization> VoxelizePacked(const Mesh& mesh, const GridTransfor
                                             PackedVoxelStorage& storage,
                                             Progress& progress = Progress::Silent());
 
+/// About how many voxels Voxelize() makes of `mesh` in `grid`, from the triangles' projected areas
+/// alone (a surface fills ~1–2 voxels per voxel² of its dominant-axis projection): for choosing
+/// how to build before building.
+double EstimateVoxelCount(const Mesh& mesh, const GridTransform& grid);
+
 class AttributeSampler;
 
 /// A mesh voxelized one box at a time, for builds that never hold the whole grid: the triangles
