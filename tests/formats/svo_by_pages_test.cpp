@@ -32,7 +32,8 @@ std::vector<std::uint8_t> Bytes(const std::filesystem::path& path) {
 }
 
 void ExpectSameFileAsWhole(const std::filesystem::path& mesh_path, std::uint32_t resolution,
-                           bool attributes, bool contours) {
+                           bool attributes, bool contours,
+                           VoxelMode mode = VoxelMode::kConservative) {
   SCOPED_TRACE(mesh_path.filename().string() + " at " + std::to_string(resolution) +
                (attributes ? ", colour and normal" : ", geometry only") +
                (contours ? ", contours" : ""));
@@ -42,6 +43,7 @@ void ExpectSameFileAsWhole(const std::filesystem::path& mesh_path, std::uint32_t
   ASSERT_TRUE(grid.ok());
   VoxelizeOptions vo;
   vo.colors = vo.normals = attributes;
+  vo.mode = mode;
   const std::string meta = R"({"source":"test"})";
   test::TempDir dir;
   auto voxels = Voxelize(*mesh, *grid, vo);
@@ -87,6 +89,7 @@ TEST(SvoByPages, TheFileIsTheWholeBuildsByteForByte) {
   // A side of exactly 2^depth: the pages' margins reach past the grid.
   ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 256, true, true);
   ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 300, false, false);
+  ExpectSameFileAsWhole(test::DataDir() / "uv-torus.obj", 300, true, true, VoxelMode::kThin);
   ExpectSameFileAsWhole(test::DataDir() / "box-room.obj", 260, true, true);
   ExpectSameFileAsWhole("/usr/share/assimp/models/OBJ/spider.obj", 400, true, true);
 }
@@ -135,6 +138,19 @@ TEST(SvoByPages, MergingAWrongSetOfPartsIsRefusedWithTheReason) {
   EXPECT_NE(merge({p0, p1, p1, p2}).find("part 1 of 3 is given twice"), std::string::npos);
   EXPECT_NE(merge({p0, p1, other}).find("another build"), std::string::npos);
   EXPECT_NE(merge({p0, p1, four}).find("another build"), std::string::npos);
+  // A part damaged on its way (one flipped byte in its pages) is refused, naming it.
+  {
+    const auto damaged = dir / "damaged";
+    std::filesystem::copy_file(p1, damaged);
+    std::vector<std::uint8_t> bytes = Bytes(damaged);
+    bytes[bytes.size() / 2] ^= 0x40;
+    std::FILE* f = std::fopen(damaged.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(bytes.data(), 1, bytes.size(), f);
+    std::fclose(f);
+    const std::string why = merge({p0, damaged, p2});
+    EXPECT_NE(why.find("damaged"), std::string::npos) << why;
+  }
   auto bad = BuildSvoPart(**regions, NoBricks(false), "{}", {3, 3, 7}, dir / "p3", {}, 0);
   EXPECT_FALSE(bad.ok());
   EXPECT_EQ(merge({p2, p0, p1}), "ok");
