@@ -59,13 +59,20 @@ int main(int argc, char** argv) {
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    // Without a limit, a build that fits no bricks goes by pages when the whole grid would not
-    // fit in half the machine's memory (~48 B a voxel held whole): the same file either way.
-    const double whole_bytes = 48.0 * EstimateVoxelCount(*mesh, *grid);
+    // Without a limit, a build without bricks goes by pages when the whole grid would not fit
+    // in half the machine's memory (~48 B a voxel held whole): the same file either way.
+    const bool may_go_by_pages =
+        memory_limit.empty() && pages.empty() && build.Options().brick_side == 0;
+    const double whole_bytes = may_go_by_pages ? 48.0 * EstimateVoxelCount(*mesh, *grid) : 0.0;
     const std::uint64_t half_machine = app::MachineMemory() / 2;
-    const bool by_pages_by_default = memory_limit.empty() && build.Options().brick_side == 0 &&
-                                     half_machine > 0 &&
-                                     whole_bytes > static_cast<double>(half_machine);
+    const bool by_pages_by_default =
+        may_go_by_pages && half_machine > 0 && whole_bytes > static_cast<double>(half_machine);
+    const auto print_mesh_and_grid = [&] {
+      const auto& d = grid->dims();
+      fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
+      fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
+                 grid->voxel_size(), OctreeDepth(*grid));
+    };
     if (!memory_limit.empty() || !pages.empty() || by_pages_by_default) {
       const StatusOr<std::uint64_t> limit =
           by_pages_by_default    ? half_machine
@@ -94,10 +101,7 @@ int main(int argc, char** argv) {
       StatusOr<SvoFileStats> written =
           BuildSvoByPages(**regions, build.Options(), meta, output, *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
-      const auto& d = grid->dims();
-      fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
-      fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
-                 grid->voxel_size(), OctreeDepth(*grid));
+      print_mesh_and_grid();
       if (*limit > 0) {
         fmt::print("build       by pages within {:.1f} GiB{}\n",
                    static_cast<double>(*limit) / 1073741824.0,
@@ -123,10 +127,7 @@ int main(int argc, char** argv) {
         app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
     if (!written.ok()) return app::Fail(tool, written.status());
 
-    const auto& d = grid->dims();
-    fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
-    fmt::print("grid        {} x {} x {} voxels of {:.9g}, octree depth {}\n", d[0], d[1], d[2],
-               grid->voxel_size(), svo->depth);
+    print_mesh_and_grid();
     fmt::print("voxels      {} ({})\n", svo->voxel_count(), voxelize.ModeName());
     app::PrintOctreeSummary(*svo, *written);
     app::PrintTimes(progress);

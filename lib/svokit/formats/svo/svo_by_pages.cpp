@@ -33,35 +33,6 @@ IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
           {c.x * s + s + grow, c.y * s + s + grow, c.z * s + s + grow}};
 }
 
-// Each level's Morton keys of a chunk's tree, from its root's.
-std::vector<std::vector<std::uint64_t>> ChunkLevelKeys(const SvoChunk& chunk) {
-  std::vector<std::vector<std::uint64_t>> keys = {{chunk.root_key}};
-  for (const std::vector<std::uint8_t>& masks : chunk.tree.masks) {
-    std::vector<std::uint64_t>& next = keys.emplace_back();
-    const std::vector<std::uint64_t>& level = keys[keys.size() - 2];
-    for (std::size_t i = 0; i < level.size(); ++i) {
-      for (unsigned c = 0; c < 8; ++c) {
-        if (masks[i] >> c & 1u) next.push_back(level[i] << 3 | c);
-      }
-    }
-  }
-  return keys;
-}
-
-// The keys of levels 0 .. page_level of the tree whose level page_level holds `keys`.
-std::vector<std::vector<std::uint64_t>> TopLevelKeys(std::span<const std::uint64_t> keys,
-                                                     std::uint32_t page_level) {
-  std::vector<std::vector<std::uint64_t>> level_keys(page_level + 1);
-  level_keys[page_level].assign(keys.begin(), keys.end());
-  for (std::uint32_t l = page_level; l > 0; --l) {
-    std::vector<std::uint64_t>& up = level_keys[l - 1];
-    for (const std::uint64_t k : level_keys[l]) {
-      if (up.empty() || up.back() != k >> 3) up.push_back(k >> 3);
-    }
-  }
-  return level_keys;
-}
-
 // Contour words of top-level nodes by key, per level 0 .. page_level − 1: fitted for every node
 // that may exist (the ancestors of every page that may hold voxels), since a node's word depends
 // on its own pieces alone.
@@ -70,7 +41,7 @@ using TopContours = std::vector<std::map<std::uint64_t, std::uint32_t>>;
 // The top chunk of the pages with these root keys: masks, and the contours `words` gives.
 SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
                     const TopContours* words) {
-  std::vector<std::vector<std::uint64_t>> level_keys = TopLevelKeys(keys, page_level);
+  const std::vector<std::vector<std::uint64_t>> level_keys = LevelKeysFromVoxels(keys, page_level);
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
   top.contours.assign(page_level, {});
@@ -186,7 +157,8 @@ class PagePlan {
     TopContours words(page_level_);
     if (!contours_ || page_level_ == 0) return words;
     Progress::Stage stage(progress, "top contours", 1);
-    std::vector<std::vector<std::uint64_t>> level_keys = TopLevelKeys(bins_.cells, page_level_);
+    std::vector<std::vector<std::uint64_t>> level_keys =
+        LevelKeysFromVoxels(bins_.cells, page_level_);
     level_keys.pop_back();
     std::vector<std::uint32_t> all(voxelizer_.mesh().triangles.size());
     std::iota(all.begin(), all.end(), 0u);
@@ -221,7 +193,8 @@ class PagePlan {
     const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->tree, page_level_);
     SvoChunk chunk = PageChunk(*svo, page_level_, at, nbs[at], cell);
     if (contours_) {
-      chunk.contours = contours_->FitSubtree(page_level_, ChunkLevelKeys(chunk), bins_.Of(i));
+      chunk.contours = contours_->FitSubtree(
+          page_level_, svo_detail::TreeLevelKeys(chunk.tree, cell, frame_.depth), bins_.Of(i));
     }
     out = writer.Encode(chunk);
     return Status::Ok();
@@ -304,8 +277,9 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   head.Put(static_cast<std::uint64_t>(end));
   head.Put(frame.depth);
   head.Put(frame.shape.brick_side);
-  head.Put(std::uint32_t{(frame.shape.has_color ? 1u : 0u) | (frame.shape.has_normal ? 2u : 0u) |
-                         (frame.shape.has_contours ? 4u : 0u)});
+  head.Put(std::uint32_t{(frame.shape.has_color ? svo_detail::kHasColor : 0u) |
+                         (frame.shape.has_normal ? svo_detail::kHasNormal : 0u) |
+                         (frame.shape.has_contours ? svo_detail::kHasContours : 0u)});
   head.Put(frame.shape.shared_color.empty() ? HalfRgba(0, 0, 0, 0) : frame.shape.shared_color[0]);
   head.Put(std::uint32_t{frame.shape.shared_color.empty() ? 0u : 1u});
   head.Put(std::uint32_t{compression.zstd ? 1u : 0u});
@@ -399,14 +373,17 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
     SVOKIT_RETURN_IF_ERROR(s);
   }
   shape.depth = part.frame.depth;
-  shape.has_color = flags & 1u, shape.has_normal = flags & 2u, shape.has_contours = flags & 4u;
+  shape.has_color = flags & svo_detail::kHasColor;
+  shape.has_normal = flags & svo_detail::kHasNormal;
+  shape.has_contours = flags & svo_detail::kHasContours;
   if (shared) shape.shared_color = {color};
   part.compression.zstd = zstd != 0;
   part.compression.level = static_cast<int>(level);
   part.frame.metadata.assign(meta->begin(), meta->end());
   if (part.parts == 0 || part.part >= part.parts || part.first > part.end ||
       part.end > part.cells || part.frame.depth != OctreeDepth(part.frame.grid) ||
-      shape.brick_side != 0 || flags > 7) {
+      shape.brick_side != 0 ||
+      (flags & ~(svo_detail::kHasColor | svo_detail::kHasNormal | svo_detail::kHasContours)) != 0) {
     return Status::BadInput("{}: the part's header is inconsistent", name);
   }
   const std::uint32_t page_level = PageLevel(part.frame.depth);

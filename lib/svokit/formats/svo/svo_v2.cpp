@@ -22,20 +22,26 @@ namespace svokit {
 
 namespace svo_detail {
 
-std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
-  std::vector<std::uint64_t> keys = {0};
-  for (std::uint32_t l = tree.first_level; l < level; ++l) {
+std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std::uint64_t root_key,
+                                                      std::uint32_t last_level) {
+  std::vector<std::vector<std::uint64_t>> keys = {{root_key}};
+  for (std::uint32_t l = tree.first_level; l < last_level; ++l) {
+    const std::vector<std::uint64_t>& level = keys.back();
     std::vector<std::uint64_t> next;
     next.reserve(tree.NodeCount(l + 1));
     const std::vector<std::uint8_t>& masks = tree.masks[l - tree.first_level];
-    for (std::size_t i = 0; i < keys.size(); ++i) {
+    for (std::size_t i = 0; i < level.size(); ++i) {
       for (unsigned c = 0; c < 8; ++c) {
-        if (masks[i] >> c & 1u) next.push_back(keys[i] << 3 | c);
+        if (masks[i] >> c & 1u) next.push_back(level[i] << 3 | c);
       }
     }
-    keys = std::move(next);
+    keys.push_back(std::move(next));
   }
   return keys;
+}
+
+std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
+  return std::move(TreeLevelKeys(tree, 0, level).back());
 }
 
 namespace {
@@ -59,6 +65,22 @@ using svo_detail::kPages;
 using svo_detail::kPageTable;
 using svo_detail::kSharedColor;
 using svo_detail::kTop;
+
+namespace {
+
+// What HEAD counts of level `level` of `chunk`: its nodes, contours and distinct samples.
+std::array<std::uint64_t, 3> ChunkLevelCounts(const SvoChunk& chunk, std::uint32_t level) {
+  const std::size_t k = level - chunk.tree.first_level;
+  const std::uint64_t contours = k < chunk.contours.size()
+                                     ? static_cast<std::uint64_t>(std::count_if(
+                                           chunk.contours[k].begin(), chunk.contours[k].end(),
+                                           [](std::uint32_t w) { return w != 0; }))
+                                     : 0;
+  const std::uint64_t samples = k < chunk.layouts.size() ? chunk.layouts[k].size() : 0;
+  return {chunk.tree.NodeCount(level), contours, samples};
+}
+
+}  // namespace
 
 PagedSvoWriter::PagedSvoWriter(const SvoFrame& frame, const SvoCompression& compression)
     : frame_(frame), compression_(compression) {
@@ -87,14 +109,7 @@ PagedSvoWriter::EncodedPage PagedSvoWriter::Encode(const SvoChunk& page) const {
   out.key = page.root_key;
   out.bytes = EncodeChunk(page, frame_.shape, compression_, &out.stats);
   for (std::uint32_t l = page_level_; l <= frame_.depth; ++l) {
-    const std::uint64_t k = l - page_level_;
-    const std::uint64_t contours = k < page.contours.size()
-                                       ? static_cast<std::uint64_t>(std::count_if(
-                                             page.contours[k].begin(), page.contours[k].end(),
-                                             [](std::uint32_t w) { return w != 0; }))
-                                       : 0;
-    const std::uint64_t samples = k < page.layouts.size() ? page.layouts[k].size() : 0;
-    out.levels.push_back({page.tree.NodeCount(l), contours, samples});
+    out.levels.push_back(ChunkLevelCounts(page, l));
   }
   return out;
 }
@@ -123,12 +138,7 @@ Status PagedSvoWriter::Finish() {
   if (page_level_ > 0) {
     const SvoChunk top = top_maker_(keys_);
     top_ = EncodeChunk(top, frame_.shape, compression_, &top_stats_);
-    for (std::uint32_t l = 0; l < page_level_; ++l) {
-      levels_[l][0] = top.tree.NodeCount(l);
-      levels_[l][1] = static_cast<std::uint64_t>(std::count_if(
-          top.contours[l].begin(), top.contours[l].end(), [](std::uint32_t w) { return w != 0; }));
-      levels_[l][2] = l < top.layouts.size() ? top.layouts[l].size() : 0;
-    }
+    for (std::uint32_t l = 0; l < page_level_; ++l) levels_[l] = ChunkLevelCounts(top, l);
   }
   ByteWriter head;
   const SvoShape& shape = frame_.shape;
