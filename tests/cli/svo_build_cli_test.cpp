@@ -130,17 +130,22 @@ TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
   ExpectValidSvo((dir / "m1.svo").string(), Torus());
 }
 
+// mesh2svo on the torus at 300 without bricks (what builds by pages make) into `out`, with
+// `extra` options.
+ToolResult Mesh2svoWithoutBricks(const std::filesystem::path& out, std::vector<std::string> extra) {
+  std::vector<std::string> args = {Torus(), "-o",       out.string(), "-r",
+                                   "300",   "--bricks", "none",       "-q"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return RunTool("mesh2svo", args);
+}
+
 // mesh2svo --memory-limit builds page by page into the same file; sizes it cannot parse, limits
 // too small for one page and bricks (not yet built by pages) are one-line errors that leave no
 // file.
 TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
   TempDir dir;
-  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "-q"};
   auto run = [&](const std::string& name, std::vector<std::string> extra) {
-    std::vector<std::string> args = {Torus(), "-o", (dir / name).string()};
-    args.insert(args.end(), options.begin(), options.end());
-    args.insert(args.end(), extra.begin(), extra.end());
-    return RunTool("mesh2svo", args);
+    return Mesh2svoWithoutBricks(dir / name, std::move(extra));
   };
   ASSERT_EQ(run("whole.svo", {}).exit_code, 0);
   for (const char* limit : {"64M", "1G", "100000000"}) {
@@ -169,12 +174,8 @@ TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
 // parts, a part number that does not exist or a part file for an .svo are one-line errors.
 TEST(SvoBuildCli, PartsMergeIntoTheSameFile) {
   TempDir dir;
-  const std::vector<std::string> options = {"-r", "300", "--bricks", "none", "-q"};
   auto mesh2svo = [&](const std::string& name, std::vector<std::string> extra) {
-    std::vector<std::string> args = {Torus(), "-o", (dir / name).string()};
-    args.insert(args.end(), options.begin(), options.end());
-    args.insert(args.end(), extra.begin(), extra.end());
-    return RunTool("mesh2svo", args);
+    return Mesh2svoWithoutBricks(dir / name, std::move(extra));
   };
   ASSERT_EQ(mesh2svo("whole.svo", {}).exit_code, 0);
   std::vector<std::string> parts;

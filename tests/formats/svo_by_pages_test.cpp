@@ -94,20 +94,33 @@ TEST(SvoByPages, TheFileIsTheWholeBuildsByteForByte) {
   ExpectSameFileAsWhole("/usr/share/assimp/models/OBJ/spider.obj", 400, true, true);
 }
 
+// The torus at 300, geometry only, ready to build by pages (null if it cannot be).
+const RegionVoxelizer* TorusGeometry() {
+  static const std::unique_ptr<RegionVoxelizer> regions = [] {
+    static Mesh mesh;  // made first, so it outlives the voxelizer that refers to it
+    StatusOr<Mesh> imported = ImportMesh(test::DataDir() / "uv-torus.obj");
+    if (!imported.ok()) return std::unique_ptr<RegionVoxelizer>();
+    mesh = std::move(*imported);
+    auto grid = GridTransform::FitResolution(mesh.Bounds(), 300);
+    if (!grid.ok()) return std::unique_ptr<RegionVoxelizer>();
+    auto made = RegionVoxelizer::Create(mesh, *grid, VoxelizeOptions{});
+    return made.ok() ? std::move(*made) : std::unique_ptr<RegionVoxelizer>();
+  }();
+  return regions.get();
+}
+
 TEST(SvoByPages, ImpossibleLimitsAndOptionsAreErrors) {
-  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
-  ASSERT_TRUE(mesh.ok());
-  auto grid = GridTransform::FitResolution(mesh->Bounds(), 300);
-  auto regions = RegionVoxelizer::Create(*mesh, *grid, VoxelizeOptions{});
-  ASSERT_TRUE(regions.ok());
+  const RegionVoxelizer* torus = TorusGeometry();
+  ASSERT_NE(torus, nullptr);
+  const RegionVoxelizer& regions = *torus;
   test::TempDir dir;
-  auto tiny = BuildSvoByPages(**regions, NoBricks(false), "{}", dir / "t.svo", {}, 1 << 20);
+  auto tiny = BuildSvoByPages(regions, NoBricks(false), "{}", dir / "t.svo", {}, 1 << 20);
   ASSERT_FALSE(tiny.ok());
   EXPECT_NE(tiny.status().message().find("too small"), std::string::npos)
       << tiny.status().message();
   EXPECT_NE(tiny.status().message().find("--memory-limit "), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "t.svo"));
-  auto bricks = BuildSvoByPages(**regions, BuildOptions{}, "{}", dir / "t.svo", {}, 0);
+  auto bricks = BuildSvoByPages(regions, BuildOptions{}, "{}", dir / "t.svo", {}, 0);
   ASSERT_FALSE(bricks.ok());
   EXPECT_NE(bricks.status().message().find("--bricks none"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "t.svo"));
@@ -115,16 +128,14 @@ TEST(SvoByPages, ImpossibleLimitsAndOptionsAreErrors) {
 
 // Merging checks that the parts are those of one build, each once, all of them.
 TEST(SvoByPages, MergingAWrongSetOfPartsIsRefusedWithTheReason) {
-  auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
-  ASSERT_TRUE(mesh.ok());
-  auto grid = GridTransform::FitResolution(mesh->Bounds(), 300);
-  auto regions = RegionVoxelizer::Create(*mesh, *grid, VoxelizeOptions{});
-  ASSERT_TRUE(regions.ok());
+  const RegionVoxelizer* torus = TorusGeometry();
+  ASSERT_NE(torus, nullptr);
+  const RegionVoxelizer& regions = *torus;
   test::TempDir dir;
   const auto part = [&](std::uint32_t k, std::uint32_t n, std::uint64_t identity,
                         const std::string& name) {
     EXPECT_TRUE(
-        BuildSvoPart(**regions, NoBricks(false), "{}", {k, n, identity}, dir / name, {}, 0).ok());
+        BuildSvoPart(regions, NoBricks(false), "{}", {k, n, identity}, dir / name, {}, 0).ok());
     return dir / name;
   };
   const auto p0 = part(0, 3, 7, "p0"), p1 = part(1, 3, 7, "p1"), p2 = part(2, 3, 7, "p2");
@@ -151,7 +162,7 @@ TEST(SvoByPages, MergingAWrongSetOfPartsIsRefusedWithTheReason) {
     const std::string why = merge({p0, damaged, p2});
     EXPECT_NE(why.find("damaged"), std::string::npos) << why;
   }
-  auto bad = BuildSvoPart(**regions, NoBricks(false), "{}", {3, 3, 7}, dir / "p3", {}, 0);
+  auto bad = BuildSvoPart(regions, NoBricks(false), "{}", {3, 3, 7}, dir / "p3", {}, 0);
   EXPECT_FALSE(bad.ok());
   EXPECT_EQ(merge({p2, p0, p1}), "ok");
   EXPECT_FALSE(std::filesystem::exists(dir / "p3"));
