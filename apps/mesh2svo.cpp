@@ -29,9 +29,8 @@ int main(int argc, char** argv) {
   build.Add(cli);
   cli.add_option("--memory-limit", memory_limit,
                  "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
-                 "(K, M, G suffixes): any resolution, the same file; needs --bricks none. "
-                 "Default: by pages within half the machine's memory when the whole grid would "
-                 "not fit there (with --bricks none), else whole")
+                 "(K, M, G suffixes): any resolution, the same file. Default: by pages within "
+                 "half the machine's memory when the whole grid would not fit there, else whole")
       ->option_text("SIZE");
   cli.add_option("--pages", pages,
                  "Build part K of N (0-based) of a build by pages into OUT.svopart, as one job of "

@@ -359,4 +359,58 @@ Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::u
   return writer.Commit();
 }
 
+StatusOr<std::unique_ptr<ScratchFile>> ScratchFile::Create(const std::filesystem::path& of) {
+  const std::filesystem::path dir = of.parent_path().empty() ? "." : of.parent_path();
+  int fd = ::open(dir.c_str(), O_RDWR | O_TMPFILE | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    // No unnamed files here: a named one, unlinked at once.
+    std::string name = (dir / ".svokit-scratch-XXXXXX").string();
+    fd = ::mkostemp(name.data(), O_CLOEXEC);
+    if (fd >= 0) ::unlink(name.c_str());
+  }
+  if (fd < 0) {
+    return Status::CannotWrite("{}: cannot make the build's scratch file ({})", of.string(),
+                               std::strerror(errno));
+  }
+  return std::unique_ptr<ScratchFile>(new ScratchFile(of, fd));
+}
+
+ScratchFile::~ScratchFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+StatusOr<std::uint64_t> ScratchFile::Append(std::span<const std::uint8_t> bytes) {
+  const std::uint64_t at = size_;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done,
+                               static_cast<off_t>(size_ + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Status::CannotWrite("{}: cannot write the build's scratch data ({})", of_.string(),
+                                 std::strerror(n < 0 ? errno : ENOSPC));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  size_ += bytes.size();
+  return at;
+}
+
+StatusOr<std::vector<std::uint8_t>> ScratchFile::Read(std::uint64_t offset,
+                                                      std::uint64_t size) const {
+  std::vector<std::uint8_t> bytes(size);
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n =
+        ::pread(fd_, bytes.data() + done, size - done, static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Status::CannotWrite("{}: cannot read the build's scratch data back ({})", of_.string(),
+                                 n < 0 ? std::strerror(errno) : "it is shorter than written");
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return bytes;
+}
+
 }  // namespace svokit

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -107,6 +108,30 @@ std::string TemporaryName(const std::string& name, long pid, std::string_view un
 /// Removes the hidden temporaries `.NAME.tmp-HOST-PID-XXXXXX` of `name` in `dir_fd` left by
 /// processes of this host that no longer run; other hosts' and live processes' are kept.
 void RemoveStaleTemporaries(int dir_fd, const std::string& name);
+
+/// A file a process writes and reads back (one pass of a build for the next), beside output `of`:
+/// unnamed from the start (O_TMPFILE, or unlinked at once), so nothing is left whatever happens
+/// to the process. Errors name the output: a full disk is "OUT: cannot write the build's scratch
+/// data (No space left on device)". Reads may run in parallel with each other.
+class ScratchFile {
+ public:
+  static StatusOr<std::unique_ptr<ScratchFile>> Create(const std::filesystem::path& of);
+  ~ScratchFile();
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+
+  /// Appends `bytes` and says where they begin.
+  StatusOr<std::uint64_t> Append(std::span<const std::uint8_t> bytes);
+  /// The `size` bytes at `offset`.
+  StatusOr<std::vector<std::uint8_t>> Read(std::uint64_t offset, std::uint64_t size) const;
+  std::uint64_t size() const { return size_; }
+
+ private:
+  ScratchFile(std::filesystem::path of, int fd) : of_(std::move(of)), fd_(fd) {}
+  std::filesystem::path of_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
 
 /// Writes `bytes` to `path` atomically.
 Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);

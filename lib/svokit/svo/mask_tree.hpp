@@ -55,6 +55,11 @@ struct MaskTree {
 MaskTree MaskTreeFromKeys(std::span<const std::vector<std::uint64_t>> level_keys,
                           std::uint32_t first = 0);
 
+/// The Morton keys of levels tree.first_level .. last_level of a tree whose root has `root_key`,
+/// walked down from the root.
+std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std::uint64_t root_key,
+                                                      std::uint32_t last_level);
+
 /// The neighbourhood of child `c` of a node of `level` whose neighbourhood is `parent`.
 Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
                                  const Neighbourhood& parent, unsigned c);

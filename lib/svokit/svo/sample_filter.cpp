@@ -466,6 +466,18 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
   });
 }
 
+// Levels from − 1 .. first_level of `out` (indexed from first_level), each filtered from the one
+// below it; level `from`'s samples are in.
+void FilterLevelsAbove(const MaskTree& tree, std::span<const SampleLayout> layouts,
+                       std::uint32_t side, Flags f, std::uint32_t from,
+                       std::vector<LevelSamples>& out) {
+  for (std::uint32_t level = from; level-- > tree.first_level;) {
+    const std::size_t k = level - tree.first_level;
+    out[k] = Allocate(layouts[k].size(), f);
+    FilterInner(tree, level, layouts[k], layouts[k + 1], out[k + 1], side, f, out[k]);
+  }
+}
+
 }  // namespace
 
 std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
@@ -473,15 +485,21 @@ std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const Sa
   const Flags f{!source.colors.empty(), !source.normals.empty()};
   const std::uint32_t voxels = tree.last_level();
   std::vector<LevelSamples> out(voxels - tree.first_level);
-  for (std::uint32_t level = voxels; level-- > tree.first_level;) {
-    const std::size_t k = level - tree.first_level;
-    out[k] = Allocate(layouts[k].size(), f);
-    if (level + 1 == voxels) {
-      FilterAboveVoxels(tree, layouts[k], side, source, f, out[k]);
-    } else {
-      FilterInner(tree, level, layouts[k], layouts[k + 1], out[k + 1], side, f, out[k]);
-    }
-  }
+  if (out.empty()) return out;
+  out.back() = Allocate(layouts.back().size(), f);
+  FilterAboveVoxels(tree, layouts.back(), side, source, f, out.back());
+  FilterLevelsAbove(tree, layouts, side, f, voxels - 1, out);
+  return out;
+}
+
+std::vector<LevelSamples> FilterSamplesAbove(const MaskTree& tree,
+                                             std::span<const SampleLayout> layouts,
+                                             std::uint32_t side, LevelSamples last) {
+  const Flags f{!last.color.empty(), !last.normal.empty()};
+  std::vector<LevelSamples> out(tree.last_level() - tree.first_level + 1);
+  out.back() = std::move(last);
+  FilterLevelsAbove(tree, layouts, side, f, tree.last_level(), out);
+  out.pop_back();
   return out;
 }
 

@@ -41,6 +41,13 @@ struct VoxelSamplesSource {
 std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
                                         std::uint32_t side, const VoxelSamplesSource& source);
 
+/// Samples of the levels first_level .. last_level() − 1 of `tree` from those of its last level,
+/// `last` (laid out by layouts.back()), as FilterSamples filters each level from the one below:
+/// the top levels of an octree built one page at a time, from its pages' roots.
+std::vector<LevelSamples> FilterSamplesAbove(const MaskTree& tree,
+                                             std::span<const SampleLayout> layouts,
+                                             std::uint32_t side, LevelSamples last);
+
 /// The bricks of level `level` (< tree.last_level()) assembled from its distinct samples: side³
 /// samples per node, SvoLevel's layout.
 void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,

@@ -44,17 +44,7 @@ void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
 }  // namespace
 
 std::vector<std::uint64_t> ChunkVoxelKeys(const SvoChunk& chunk) {
-  std::vector<std::uint64_t> keys = {chunk.root_key};
-  for (const std::vector<std::uint8_t>& masks : chunk.tree.masks) {
-    std::vector<std::uint64_t> next;
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      for (unsigned c = 0; c < 8; ++c) {
-        if (masks[i] >> c & 1u) next.push_back(keys[i] << 3 | c);
-      }
-    }
-    keys = std::move(next);
-  }
-  return keys;
+  return std::move(TreeLevelKeys(chunk.tree, chunk.root_key, chunk.tree.last_level()).back());
 }
 
 SvoChunk TopChunk(const CompactSvo& svo, std::uint32_t page_level) {

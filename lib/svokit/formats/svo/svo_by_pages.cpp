@@ -6,6 +6,7 @@
 // writes the file the whole build by pages writes.
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -14,11 +15,13 @@
 #include <tbb/task_arena.h>
 
 #include "svokit/core/crc32c.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/contour.hpp"
+#include "svokit/svo/page_borders.hpp"
 #include "svokit/svo/svo_pages.hpp"
 
 namespace svokit {
@@ -38,9 +41,10 @@ IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
 // on its own pieces alone.
 using TopContours = std::vector<std::map<std::uint64_t, std::uint32_t>>;
 
-// The top chunk of the pages with these root keys: masks, and the contours `words` gives.
+// The top chunk of the pages with these root keys: masks, the contours `words` gives, and with
+// bricks (side ≠ 0) the samples filtered from the bricks of the pages' roots.
 SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
-                    const TopContours* words) {
+                    const TopContours* words, std::uint32_t side, const LevelSamples& roots) {
   const std::vector<std::vector<std::uint64_t>> level_keys = LevelKeysFromVoxels(keys, page_level);
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
@@ -53,7 +57,106 @@ SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_leve
       }
     }
   }
+  if (side != 0 && page_level != 0) FilterTopSamples(top, side, roots);
   return top;
+}
+
+// How pages built alone are kept for the second pass of a build with bricks: fast to write and
+// read back, they are decoded once more.
+const SvoCompression kAloneCompression{true, 1};
+
+// Items [first, end) made in parallel, at most `in_flight` at a time, and handed to `take` in
+// order; stops at take's first error.
+template <class Made, class MakeFn, class TakeFn>
+Status PagesInOrder(std::size_t first, std::size_t end, std::size_t in_flight, const MakeFn& make,
+                    const TakeFn& take) {
+  Status failed;
+  std::size_t next = first;
+  tbb::parallel_pipeline(
+      in_flight,
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& fc) -> std::size_t {
+                                            if (next == end || !failed.ok()) fc.stop();
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel, make) &
+          tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
+            if (failed.ok()) failed = take(std::move(made));
+          }));
+  return failed;
+}
+
+// The pages of a build with bricks as its first pass left them, built alone, with their shells:
+// ascending keys, and each one's bytes.
+struct BuiltPages {
+  std::vector<std::uint64_t> keys;
+  std::function<StatusOr<std::vector<std::uint8_t>>(std::size_t)> page, shell;
+  std::string name;  // for messages
+};
+
+// The second pass: each page with the samples of its faces set from the shells of the pages
+// around it, encoded and handed to `take` in order; the bricks of their roots are appended to
+// `roots` in the same order.
+Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const BuiltPages& built,
+                   std::size_t in_flight, const PagedSvoWriter::Take& take, LevelSamples& roots,
+                   Progress& progress) {
+  const std::uint32_t page_level = PageLevel(frame.depth);
+  const std::int64_t cells = std::int64_t{1} << page_level;
+  Progress::Stage stage(progress, "page faces", built.keys.size());
+  struct Made {
+    std::optional<PagedSvoWriter::EncodedPage> page;
+    LevelSamples root;
+    Status status;
+  };
+  const auto finish = [&](std::size_t i, Made& made) -> Status {
+    const std::uint64_t key = built.keys[i];
+    const std::string name = fmt::format("{}: page {:#x}", built.name, key);
+    StatusOr<std::vector<std::uint8_t>> bytes = built.page(i);
+    if (!bytes.ok()) return bytes.status();
+    StatusOr<SvoChunk> page =
+        DecodeChunk(*bytes, frame.shape, {page_level, key, frame.depth - page_level + 1, true},
+                    name);
+    if (!page.ok()) return page.status();
+    // The shells of the pages around, by their keys.
+    const MortonCoord c = MortonDecode(key);
+    std::array<std::vector<std::uint8_t>, 27> shells;
+    for (int o = 0; o < 27; ++o) {
+      const std::int64_t at[3] = {c.x + o % 3 - 1, c.y + o / 3 % 3 - 1, c.z + o / 9 - 1};
+      if (std::any_of(at, at + 3, [&](std::int64_t v) { return v < 0 || v >= cells; })) continue;
+      const std::uint64_t k =
+          MortonEncode(static_cast<std::uint32_t>(at[0]), static_cast<std::uint32_t>(at[1]),
+                       static_cast<std::uint32_t>(at[2]));
+      const auto it = std::lower_bound(built.keys.begin(), built.keys.end(), k);
+      if (it == built.keys.end() || *it != k) continue;
+      StatusOr<std::vector<std::uint8_t>> shell =
+          built.shell(static_cast<std::size_t>(it - built.keys.begin()));
+      if (!shell.ok()) return shell.status();
+      shells[o] = std::move(*shell);
+    }
+    const std::vector<std::span<const std::uint8_t>> views(shells.begin(), shells.end());
+    SVOKIT_RETURN_IF_ERROR(PatchPageFaces(*page, frame.shape, views, name));
+    made.root = RootBrick(*page, frame.shape.brick_side);
+    made.page = writer.Encode(*page);
+    return Status::Ok();
+  };
+  return PagesInOrder<Made>(
+      0, built.keys.size(), in_flight,
+      [&](std::size_t i) {
+        Made made;
+        made.status = finish(i, made);
+        return made;
+      },
+      [&](Made made) -> Status {
+        stage.Advance(1);
+        SVOKIT_RETURN_IF_ERROR(made.status);
+        stage.AddBytes(made.page->bytes.size());
+        for (std::size_t s = 0; s < made.root.opacity.size(); ++s) {
+          roots.opacity.push_back(made.root.opacity[s]);
+          if (!made.root.color.empty()) roots.color.push_back(made.root.color[s]);
+          if (!made.root.normal.empty()) roots.normal.push_back(made.root.normal[s]);
+        }
+        return take(std::move(*made.page));
+      });
 }
 
 // What builds by pages and parts share: the frame, the bins, how many pages may be in flight,
@@ -64,17 +167,13 @@ class PagePlan {
                                                   const BuildOptions& options,
                                                   const std::string& metadata,
                                                   std::uint64_t memory_limit, Progress& progress) {
-    if (options.brick_side != 0) {
-      return Status::BadInput(
-          "a build by pages (--memory-limit, --pages) makes octrees without bricks for now: add "
-          "--bricks none");
-    }
     std::unique_ptr<PagePlan> plan(new PagePlan(voxelizer, options));
     SvoFrame& frame = plan->frame_;
     frame.grid = voxelizer.grid();
     frame.mode = voxelizer.options().mode;
     frame.depth = OctreeDepth(frame.grid);
     frame.shape.depth = frame.depth;
+    frame.shape.brick_side = options.brick_side;
     frame.shape.has_color = voxelizer.options().colors;
     frame.shape.has_normal = voxelizer.options().normals;
     frame.shape.has_contours = options.contours;
@@ -83,6 +182,9 @@ class PagePlan {
     }
     frame.metadata = metadata;
     plan->page_level_ = PageLevel(frame.depth);
+    // The halo: the voxels a page's voxel bricks read, one around it; with bricks of side 2 the
+    // samples of its faces above the voxels read one more.
+    plan->grow_ = options.brick_side == 2 ? 2 : 1;
     plan->bits_ = frame.depth - plan->page_level_;
     plan->page_options_.contours = false;  // fitted from each page's triangles instead
     if (options.contours) {
@@ -90,14 +192,16 @@ class PagePlan {
     }
     {
       Progress::Stage stage(progress, "bin", 1);
-      plan->bins_ = voxelizer.BinTriangles(static_cast<int>(plan->bits_), 1);
+      plan->bins_ = voxelizer.BinTriangles(static_cast<int>(plan->bits_), plan->grow_);
     }
     // Held whatever the page: the snapped mesh and the bins; then each page in flight, at most a
-    // surface's voxels across its cube with their attributes and nodes (~40 B a voxel).
+    // surface's voxels across its cube with their attributes and nodes (~40 B a voxel; with
+    // bricks, their samples too).
     const std::size_t tokens =
         2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     const std::uint64_t fixed = voxelizer.bytes() + plan->bins_.bytes();
-    const std::uint64_t page = std::uint64_t{40} * 4 << (2 * plan->bits_);
+    const std::uint64_t per_voxel = options.brick_side == 0 ? 40 : 160;
+    const std::uint64_t page = per_voxel * 4 << (2 * plan->bits_);
     const std::uint64_t smallest = fixed + page;
     if (memory_limit != 0 && memory_limit < smallest) {
       const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
@@ -116,40 +220,41 @@ class PagePlan {
   std::uint32_t page_level() const { return page_level_; }
   const RegionVoxelizer::Bins& bins() const { return bins_; }
 
-  // Encodes the pages of cells [first, end) that hold voxels and hands them to `take` in order.
+  // A page built alone, and its shell (empty without bricks): what a build without bricks
+  // writes, and what the second pass of one with bricks completes.
+  using TakeBuilt = std::function<Status(PagedSvoWriter::EncodedPage, std::vector<std::uint8_t>)>;
+
+  // Builds the pages of cells [first, end) that hold voxels and hands them to `take` in order.
   Status Run(const PagedSvoWriter& writer, std::size_t first, std::size_t end,
-             const PagedSvoWriter::Take& take, Progress& progress) const {
+             const TakeBuilt& take, Progress& progress) const {
     Progress::Stage stage(progress, "pages", end - first);
-    Status failed;
-    std::size_t next = first;
     struct Made {
       std::optional<PagedSvoWriter::EncodedPage> page;
+      std::vector<std::uint8_t> shell;
       Status status;
     };
-    tbb::parallel_pipeline(
-        in_flight_,
-        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                            [&](tbb::flow_control& fc) -> std::size_t {
-                                              if (next == end || !failed.ok()) fc.stop();
-                                              return next++;
-                                            }) &
-            tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel,
-                                                [&](std::size_t i) {
-                                                  Made made;
-                                                  made.status = MakePage(writer, i, made.page);
-                                                  return made;
-                                                }) &
-            tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
-              stage.Advance(1);
-              if (!failed.ok()) return;
-              if (!made.status.ok()) {
-                failed = made.status;
-              } else if (made.page) {
-                stage.AddBytes(made.page->bytes.size());
-                failed = take(std::move(*made.page));
-              }
-            }));
-    return failed;
+    return InOrder<Made>(
+        first, end,
+        [&](std::size_t i) {
+          Made made;
+          made.status = MakePage(writer, i, made.page, made.shell);
+          return made;
+        },
+        [&](Made made) -> Status {
+          stage.Advance(1);
+          SVOKIT_RETURN_IF_ERROR(made.status);
+          if (!made.page) return Status::Ok();
+          stage.AddBytes(made.page->bytes.size());
+          return take(std::move(*made.page), std::move(made.shell));
+        });
+  }
+
+  // The second pass of a build with bricks: each page of `built` with the samples of its faces
+  // set from its neighbours' shells, encoded and handed to `take` in order; the bricks of their
+  // roots go to `roots`, in the same order.
+  Status Finish(const PagedSvoWriter& writer, const BuiltPages& built,
+                const PagedSvoWriter::Take& take, LevelSamples& roots, Progress& progress) const {
+    return FinishPages(frame_, writer, built, in_flight_, take, roots, progress);
   }
 
   // The words of every top-level node that may exist (empty without contours).
@@ -177,9 +282,10 @@ class PagePlan {
 
   // Page `i` of the bins, if its cell holds voxels.
   Status MakePage(const PagedSvoWriter& writer, std::size_t i,
-                  std::optional<PagedSvoWriter::EncodedPage>& out) const {
+                  std::optional<PagedSvoWriter::EncodedPage>& out,
+                  std::vector<std::uint8_t>& shell) const {
     const std::uint64_t cell = bins_.cells[i];
-    StatusOr<VoxelSet> voxels = voxelizer_.Voxelize(CellBox(cell, bits_, 1), bins_.Of(i));
+    StatusOr<VoxelSet> voxels = voxelizer_.Voxelize(CellBox(cell, bits_, grow_), bins_.Of(i));
     if (!voxels.ok()) return voxels.status();
     // The page's own voxels are the keys of its cell's range; the rest are its halo.
     const std::uint64_t first = cell << (3 * bits_), last = (cell + 1) << (3 * bits_);
@@ -194,16 +300,25 @@ class PagePlan {
     SvoChunk chunk = PageChunk(*svo, page_level_, at, nbs[at], cell);
     if (contours_) {
       chunk.contours = contours_->FitSubtree(
-          page_level_, svo_detail::TreeLevelKeys(chunk.tree, cell, frame_.depth), bins_.Of(i));
+          page_level_, TreeLevelKeys(chunk.tree, cell, frame_.depth), bins_.Of(i));
     }
+    shell = EncodePageShell(chunk, frame_.shape);
     out = writer.Encode(chunk);
     return Status::Ok();
+  }
+
+  // Work items [first, end) made in parallel (as many in flight as the limit allows) and handed
+  // to `take` in order; stops at take's first error.
+  template <class Made, class MakeFn, class TakeFn>
+  Status InOrder(std::size_t first, std::size_t end, const MakeFn& make, const TakeFn& take) const {
+    return PagesInOrder<Made>(first, end, in_flight_, make, take);
   }
 
   const RegionVoxelizer& voxelizer_;
   BuildOptions page_options_;
   SvoFrame frame_;
   std::uint32_t page_level_ = 0, bits_ = 0;
+  std::int64_t grow_ = 1;
   std::optional<ContourFitter> contours_;
   RegionVoxelizer::Bins bins_;
   std::size_t in_flight_ = 1;
@@ -211,11 +326,12 @@ class PagePlan {
 
 // Part files: the pages of one share of the cells, with what merging needs.
 inline constexpr container::FormatId kPartFormat{
-    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 1, "svokit octree part (.svopart)"};
+    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 2, "svokit octree part (.svopart)"};
 constexpr container::Tag kPartHead = container::MakeTag("PART");
 constexpr container::Tag kPartTable = container::MakeTag("PTAB");
 constexpr container::Tag kPartTop = container::MakeTag("TOPC");
 constexpr container::Tag kPartPages = container::MakeTag("PAGE");
+constexpr container::Tag kPartShells = container::MakeTag("SHEL");
 
 // Where part `part` of `parts` begins among the cells: shares of equal triangle work.
 std::size_t PartStart(const RegionVoxelizer::Bins& bins, std::uint32_t part, std::uint32_t parts) {
@@ -238,13 +354,56 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
   const PagePlan& p = **plan;
   PagedSvoWriter writer(p.frame(), compression);
   const TopContours words = p.FitTopContours(progress);
+  const TopContours* top_words = options.contours ? &words : nullptr;
+  if (options.brick_side == 0) {
+    return writer.Write(
+        path,
+        [&](const PagedSvoWriter::Take& take) {
+          return p.Run(
+              writer, 0, p.bins().cells.size(),
+              [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t>) {
+                return take(std::move(page));
+              },
+              progress);
+        },
+        [&](std::span<const std::uint64_t> keys) {
+          return TopOfPages(keys, p.page_level(), top_words, 0, {});
+        });
+  }
+  // With bricks, two passes: the pages built alone and their shells go to a scratch file; then
+  // each page's faces are set from its neighbours' shells and the page is written.
+  StatusOr<std::unique_ptr<ScratchFile>> scratch = ScratchFile::Create(path);
+  if (!scratch.ok()) return scratch.status();
+  ScratchFile& file = **scratch;
+  struct Stored {
+    std::uint64_t page, page_size, shell, shell_size;
+  };
+  std::vector<Stored> stored;
+  BuiltPages built;
+  const PagedSvoWriter alone(p.frame(), kAloneCompression);
+  SVOKIT_RETURN_IF_ERROR(p.Run(
+      alone, 0, p.bins().cells.size(),
+      [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t> shell) -> Status {
+        StatusOr<std::uint64_t> at_page = file.Append(page.bytes);
+        if (!at_page.ok()) return at_page.status();
+        StatusOr<std::uint64_t> at_shell = file.Append(shell);
+        if (!at_shell.ok()) return at_shell.status();
+        stored.push_back({*at_page, page.bytes.size(), *at_shell, shell.size()});
+        built.keys.push_back(page.key);
+        return Status::Ok();
+      },
+      progress));
+  built.name = path.string();
+  built.page = [&](std::size_t i) { return file.Read(stored[i].page, stored[i].page_size); };
+  built.shell = [&](std::size_t i) { return file.Read(stored[i].shell, stored[i].shell_size); };
+  LevelSamples roots;
   return writer.Write(
       path,
       [&](const PagedSvoWriter::Take& take) {
-        return p.Run(writer, 0, p.bins().cells.size(), take, progress);
+        return p.Finish(writer, built, take, roots, progress);
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, p.page_level(), options.contours ? &words : nullptr);
+        return TopOfPages(keys, p.page_level(), top_words, options.brick_side, roots);
       });
 }
 
@@ -266,7 +425,15 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
                               ? p.bins().cells.size()
                               : PartStart(p.bins(), part.part + 1, part.parts);
   const SvoFrame& frame = p.frame();
-  PagedSvoWriter encoder(frame, compression);
+  // With bricks a part holds its pages as built alone, with their shells: merging completes them.
+  const bool bricks = frame.shape.brick_side != 0;
+  PagedSvoWriter encoder(frame, bricks ? kAloneCompression : compression);
+  std::unique_ptr<ScratchFile> shells;
+  if (bricks) {
+    StatusOr<std::unique_ptr<ScratchFile>> scratch = ScratchFile::Create(path);
+    if (!scratch.ok()) return scratch.status();
+    shells = std::move(*scratch);
+  }
 
   ByteWriter head;
   head.Put(part.part);
@@ -294,10 +461,15 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   file.AddSectionProduced(kPartPages, [&](const container::Writer::Emit& emit) {
     return p.Run(
         encoder, first, end,
-        [&](PagedSvoWriter::EncodedPage page) -> Status {
+        [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t> shell) -> Status {
           SVOKIT_RETURN_IF_ERROR(emit(page.bytes));
+          if (shells) {
+            StatusOr<std::uint64_t> at = shells->Append(shell);
+            if (!at.ok()) return at.status();
+          }
           table.Put(page.key);
           table.Put(static_cast<std::uint64_t>(page.bytes.size()));
+          table.Put(static_cast<std::uint64_t>(shell.size()));
           for (const auto& level : page.levels) {
             for (const std::uint64_t v : level) table.Put(v);
           }
@@ -309,6 +481,16 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   });
   file.AddSectionProduced(kPartTable,
                           [&](const container::Writer::Emit& emit) { return emit(table.bytes()); });
+  file.AddSectionProduced(kPartShells, [&](const container::Writer::Emit& emit) -> Status {
+    constexpr std::uint64_t kBlock = std::uint64_t{16} << 20;
+    for (std::uint64_t at = 0; shells && at < shells->size(); at += kBlock) {
+      StatusOr<std::vector<std::uint8_t>> bytes =
+          shells->Read(at, std::min(kBlock, shells->size() - at));
+      if (!bytes.ok()) return bytes.status();
+      SVOKIT_RETURN_IF_ERROR(emit(*bytes));
+    }
+    return Status::Ok();
+  });
   // The top levels' contours travel with part 0: every part has the mesh, the merge need not.
   ByteWriter top;
   if (part.part == 0 && frame.shape.has_contours) {
@@ -339,11 +521,11 @@ struct Part {
   SvoFrame frame;
   SvoCompression compression;
   struct Page {
-    std::uint64_t key = 0, offset = 0, size = 0;
+    std::uint64_t key = 0, offset = 0, size = 0, shell_offset = 0, shell_size = 0;
     std::vector<std::array<std::uint64_t, 3>> levels;
   };
   std::vector<Page> pages;
-  std::span<const std::uint8_t> page_bytes;
+  std::span<const std::uint8_t> page_bytes, shell_bytes;
   TopContours top;
 };
 
@@ -356,9 +538,10 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
   StatusOr<std::span<const std::uint8_t>> head = part.file.Require(kPartHead);
   StatusOr<std::span<const std::uint8_t>> table = part.file.Require(kPartTable);
   StatusOr<std::span<const std::uint8_t>> pages = part.file.Require(kPartPages);
+  StatusOr<std::span<const std::uint8_t>> shells = part.file.Require(kPartShells);
   StatusOr<std::span<const std::uint8_t>> top = part.file.Require(kPartTop);
   StatusOr<std::span<const std::uint8_t>> meta = part.file.Require(svo_detail::kMetadata);
-  for (const auto* s : {&grid, &head, &table, &pages, &top, &meta}) {
+  for (const auto* s : {&grid, &head, &table, &pages, &shells, &top, &meta}) {
     if (!s->ok()) return s->status();
   }
   SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, name, part.frame.grid, part.frame.mode));
@@ -382,18 +565,21 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
   part.frame.metadata.assign(meta->begin(), meta->end());
   if (part.parts == 0 || part.part >= part.parts || part.first > part.end ||
       part.end > part.cells || part.frame.depth != OctreeDepth(part.frame.grid) ||
-      shape.brick_side != 0 ||
+      (shape.brick_side != 0 && shape.brick_side != 2 && shape.brick_side != 3) ||
       (flags & ~(svo_detail::kHasColor | svo_detail::kHasNormal | svo_detail::kHasContours)) != 0) {
     return Status::BadInput("{}: the part's header is inconsistent", name);
   }
   const std::uint32_t page_level = PageLevel(part.frame.depth);
   const std::size_t held = part.frame.depth - page_level + 1;
   ByteReader t(*table, name + ": PTAB");
-  std::uint64_t offset = 0;
+  std::uint64_t offset = 0, shell_offset = 0;
   while (t.remaining() > 0) {
     Part::Page& page = part.pages.emplace_back();
     SVOKIT_RETURN_IF_ERROR(t.Get(page.key));
     SVOKIT_RETURN_IF_ERROR(t.Get(page.size));
+    SVOKIT_RETURN_IF_ERROR(t.Get(page.shell_size));
+    page.shell_offset = shell_offset;
+    shell_offset += page.shell_size;
     page.levels.resize(held);
     for (auto& l : page.levels) {
       for (auto& v : l) SVOKIT_RETURN_IF_ERROR(t.Get(v));
@@ -404,10 +590,11 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
       return Status::BadInput("{}: page keys are not ascending", name);
     }
   }
-  if (offset != pages->size()) {
+  if (offset != pages->size() || shell_offset != shells->size()) {
     return Status::BadInput("{}: the page table does not fill the pages", name);
   }
   part.page_bytes = *pages;
+  part.shell_bytes = *shells;
   ByteReader c(*top, name + ": TOPC");
   if (part.part == 0 && shape.has_contours) {
     part.top.resize(page_level);
@@ -466,6 +653,48 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
     }
   }
   PagedSvoWriter writer(head.frame, head.compression);
+  const std::uint32_t side = head.frame.shape.brick_side;
+  const TopContours* top_words = head.frame.shape.has_contours ? &head.top : nullptr;
+  LevelSamples roots;
+  if (side != 0) {
+    // The parts hold their pages as built alone: each is completed from its neighbours' shells.
+    struct Where {
+      const Part* part;
+      const Part::Page* page;
+    };
+    std::vector<Where> where;
+    BuiltPages built;
+    for (const Part& part : parts) {
+      for (const Part::Page& page : part.pages) {
+        where.push_back({&part, &page});
+        built.keys.push_back(page.key);
+      }
+    }
+    if (!std::is_sorted(built.keys.begin(), built.keys.end())) {
+      return Status::BadInput("{}: the parts' pages are not in key order", head.name);
+    }
+    const auto copy = [](std::span<const std::uint8_t> bytes) {
+      return StatusOr<std::vector<std::uint8_t>>(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
+    };
+    built.name = path.string();
+    built.page = [&](std::size_t i) {
+      return copy(where[i].part->page_bytes.subspan(where[i].page->offset, where[i].page->size));
+    };
+    built.shell = [&](std::size_t i) {
+      return copy(where[i].part->shell_bytes.subspan(where[i].page->shell_offset,
+                                                       where[i].page->shell_size));
+    };
+    const std::size_t in_flight =
+        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+    return writer.Write(
+        path,
+        [&](const PagedSvoWriter::Take& take) {
+          return FinishPages(head.frame, writer, built, in_flight, take, roots, progress);
+        },
+        [&](std::span<const std::uint64_t> keys) {
+          return TopOfPages(keys, PageLevel(head.frame.depth), top_words, side, roots);
+        });
+  }
   Progress::Stage stage(progress, "merge", parts.size());
   return writer.Write(
       path,
@@ -488,8 +717,7 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
         return Status::Ok();
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, PageLevel(head.frame.depth),
-                          head.frame.shape.has_contours ? &head.top : nullptr);
+        return TopOfPages(keys, PageLevel(head.frame.depth), top_words, 0, roots);
       });
 }
 

@@ -91,10 +91,6 @@ void SetPageSizes(std::vector<std::uint64_t> sizes, SvoFileStats& stats);
 /// Completes `stats` of a file of `file_bytes`: its size, and the frame's share ("frame").
 void CompleteStats(std::uint64_t file_bytes, SvoFileStats& stats);
 
-/// The Morton keys of levels tree.first_level .. last_level of a tree whose root has `root_key`,
-/// walked down from the root.
-std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std::uint64_t root_key,
-                                                      std::uint32_t last_level);
 /// The Morton keys of a level of a tree whose root has key 0.
 std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level);
 

@@ -22,24 +22,6 @@ namespace svokit {
 
 namespace svo_detail {
 
-std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std::uint64_t root_key,
-                                                      std::uint32_t last_level) {
-  std::vector<std::vector<std::uint64_t>> keys = {{root_key}};
-  for (std::uint32_t l = tree.first_level; l < last_level; ++l) {
-    const std::vector<std::uint64_t>& level = keys.back();
-    std::vector<std::uint64_t> next;
-    next.reserve(tree.NodeCount(l + 1));
-    const std::vector<std::uint8_t>& masks = tree.masks[l - tree.first_level];
-    for (std::size_t i = 0; i < level.size(); ++i) {
-      for (unsigned c = 0; c < 8; ++c) {
-        if (masks[i] >> c & 1u) next.push_back(level[i] << 3 | c);
-      }
-    }
-    keys.push_back(std::move(next));
-  }
-  return keys;
-}
-
 std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
   return std::move(TreeLevelKeys(tree, 0, level).back());
 }

@@ -1,0 +1,297 @@
+#include "svokit/svo/page_borders.hpp"
+
+#include <array>
+#include <unordered_map>
+
+#include "svokit/core/bytes.hpp"
+#include "svokit/core/morton.hpp"
+#include "svokit/svo/brick_math.hpp"
+
+namespace svokit {
+
+namespace {
+
+using brick_math::DecodePremultiplied;
+using brick_math::Encode;
+using brick_math::EncodedSample;
+
+// A lattice point of one level (sample k of node n is (side − 1)·n + k), packed 21 bits an axis.
+struct Point {
+  std::int64_t x = 0, y = 0, z = 0;
+};
+std::uint64_t Pack(const Point& p) {
+  return static_cast<std::uint64_t>(p.x) | static_cast<std::uint64_t>(p.y) << 21 |
+         static_cast<std::uint64_t>(p.z) << 42;
+}
+Point Unpack(std::uint64_t v) {
+  constexpr std::uint64_t kAxis = (std::uint64_t{1} << 21) - 1;
+  return {static_cast<std::int64_t>(v & kAxis), static_cast<std::int64_t>(v >> 21 & kAxis),
+          static_cast<std::int64_t>(v >> 42 & kAxis)};
+}
+
+// Where a page's points are, per level: its cube spans lattice points cell·edge .. (cell + 1)·edge.
+struct PageFrame {
+  std::uint32_t side = 0, page_level = 0, depth = 0;
+  std::int64_t cell[3] = {};
+
+  PageFrame(const SvoChunk& page, const SvoShape& shape)
+      : side(shape.brick_side), page_level(page.root_level), depth(shape.depth) {
+    const MortonCoord c = MortonDecode(page.root_key);
+    cell[0] = c.x;
+    cell[1] = c.y;
+    cell[2] = c.z;
+  }
+  std::int64_t Edge(std::uint32_t level) const {
+    return static_cast<std::int64_t>(side - 1) << (level - page_level);
+  }
+  // On one of the page's faces, or one lattice step inside them (and on none).
+  bool OnFace(std::uint32_t level, const Point& p) const {
+    const std::int64_t e = Edge(level), q[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t r = q[a] - cell[a] * e;
+      if (r == 0 || r == e) return true;
+    }
+    return false;
+  }
+  bool InLayer(std::uint32_t level, const Point& p) const {
+    if (OnFace(level, p)) return false;
+    const std::int64_t e = Edge(level), q[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t r = q[a] - cell[a] * e;
+      if (r == 1 || r == e - 1) return true;
+    }
+    return false;
+  }
+  // Whether the samples of the page's face points at the page level may read point p of `level`
+  // (through the levels between): within the page's cube grown by what the tents between reach,
+  // half the page level's lattice step less one step of `level` (side 3; a whole one for side 2).
+  bool Reaches(std::uint32_t level, const Point& p) const {
+    const std::int64_t e = Edge(level), grow = (side == 3 ? e / 2 : e) - 1, q[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) {
+      if (q[a] < cell[a] * e - grow || q[a] > (cell[a] + 1) * e + grow) return false;
+    }
+    return true;
+  }
+};
+
+// Calls fn(point, stored index) for every sample the nodes of `level` of the page store.
+template <class Fn>
+void ForEachStoredPoint(const SvoChunk& page, std::uint32_t side, std::uint32_t level,
+                        std::span<const std::uint64_t> keys, const Fn& fn) {
+  const SampleLayout& layout = page.layouts[level - page.root_level];
+  const layout_detail::SideTable& t = layout_detail::TableFor(side);
+  const std::int64_t step = side - 1;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const MortonCoord c = MortonDecode(keys[i]);
+    std::uint64_t next = layout.first[i] + t.home_count;
+    for (unsigned s = 0; s < side * side * side; ++s) {
+      std::uint64_t at;
+      if (t.is_home[s]) {
+        at = layout.first[i] + t.index[s];
+      } else if (layout.orphans[i] >> t.index[s] & 1u) {
+        at = next++;
+      } else {
+        continue;
+      }
+      fn(Point{step * c.x + s % side, step * c.y + s / side % side, step * c.z + s / (side * side)},
+         at);
+    }
+  }
+}
+
+void PutValues(ByteWriter& out, const LevelSamples& v) {
+  out.PutArray(std::span<const std::uint8_t>(v.opacity));
+  out.PutArray(std::span<const std::uint32_t>(v.color));
+  out.PutArray(std::span<const std::uint16_t>(v.normal));
+}
+
+void Append(LevelSamples& to, const LevelSamples& from, std::uint64_t at) {
+  to.opacity.push_back(from.opacity[at]);
+  if (!from.color.empty()) to.color.push_back(from.color[at]);
+  if (!from.normal.empty()) to.normal.push_back(from.normal[at]);
+}
+
+EncodedSample Load(const LevelSamples& in, std::uint64_t at) {
+  return {in.opacity[at], in.color.empty() ? 0u : in.color[at],
+          in.normal.empty() ? std::uint16_t{0} : in.normal[at]};
+}
+
+void Store(const EncodedSample& e, std::uint64_t at, LevelSamples& out) {
+  out.opacity[at] = e.opacity;
+  if (!out.color.empty()) out.color[at] = e.color;
+  if (!out.normal.empty()) out.normal[at] = e.normal;
+}
+
+// One level of a shell: the face points its nodes hold (with their samples at the level above the
+// voxels, which the page has right) and its samples one step inside its faces.
+struct ShellLevel {
+  std::vector<std::uint64_t> face, layer;
+  LevelSamples face_values, layer_values;
+};
+
+Status GetValues(ByteReader& in, std::size_t n, const SvoShape& shape, LevelSamples& v) {
+  SVOKIT_RETURN_IF_ERROR(in.GetArray(v.opacity, n));
+  SVOKIT_RETURN_IF_ERROR(in.GetArray(v.color, shape.has_color ? n : 0));
+  return in.GetArray(v.normal, shape.has_normal ? n : 0);
+}
+
+StatusOr<std::vector<ShellLevel>> DecodeShell(std::span<const std::uint8_t> bytes,
+                                              const SvoShape& shape, std::uint32_t page_level,
+                                              const std::string& name) {
+  std::vector<ShellLevel> levels(shape.depth - page_level);
+  if (bytes.empty()) return levels;
+  ByteReader in(bytes, name);
+  for (std::uint32_t l = page_level; l < shape.depth; ++l) {
+    ShellLevel& level = levels[l - page_level];
+    std::uint64_t faces = 0, layers = 0;
+    SVOKIT_RETURN_IF_ERROR(in.Get(faces));
+    SVOKIT_RETURN_IF_ERROR(in.GetArray(level.face, faces));
+    if (l + 1 == shape.depth) {
+      SVOKIT_RETURN_IF_ERROR(GetValues(in, level.face.size(), shape, level.face_values));
+    }
+    SVOKIT_RETURN_IF_ERROR(in.Get(layers));
+    SVOKIT_RETURN_IF_ERROR(in.GetArray(level.layer, layers));
+    SVOKIT_RETURN_IF_ERROR(GetValues(in, level.layer.size(), shape, level.layer_values));
+  }
+  if (!in.at_end()) return Status::BadInput("{} has bytes after its last level", name);
+  return levels;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> EncodePageShell(const SvoChunk& page, const SvoShape& shape) {
+  const PageFrame frame(page, shape);
+  ByteWriter out;
+  if (shape.brick_side == 0 || page.layouts.empty()) return {};
+  const auto keys = TreeLevelKeys(page.tree, page.root_key, shape.depth - 1);
+  for (std::uint32_t l = page.root_level; l < shape.depth; ++l) {
+    const std::size_t k = l - page.root_level;
+    ShellLevel level;
+    const LevelSamples& samples = page.samples[k];
+    const bool values = l + 1 == shape.depth;
+    ForEachStoredPoint(page, shape.brick_side, l, keys[k], [&](const Point& p, std::uint64_t at) {
+      if (frame.OnFace(l, p)) {
+        level.face.push_back(Pack(p));
+        if (values) Append(level.face_values, samples, at);
+      } else if (l > page.root_level && frame.InLayer(l, p)) {
+        level.layer.push_back(Pack(p));
+        Append(level.layer_values, samples, at);
+      }
+    });
+    out.Put(static_cast<std::uint64_t>(level.face.size()));
+    out.PutArray(std::span<const std::uint64_t>(level.face));
+    if (values) PutValues(out, level.face_values);
+    out.Put(static_cast<std::uint64_t>(level.layer.size()));
+    out.PutArray(std::span<const std::uint64_t>(level.layer));
+    PutValues(out, level.layer_values);
+  }
+  return std::move(out.bytes());
+}
+
+Status PatchPageFaces(SvoChunk& page, const SvoShape& shape,
+                      std::span<const std::span<const std::uint8_t>> shells,
+                      const std::string& name) {
+  const std::uint32_t side = shape.brick_side, depth = shape.depth, top = page.root_level;
+  if (side == 0 || depth < top + 2) return Status::Ok();
+  const PageFrame frame(page, shape);
+  std::vector<std::vector<ShellLevel>> around;
+  for (const std::span<const std::uint8_t> bytes : shells) {
+    if (bytes.empty()) continue;
+    StatusOr<std::vector<ShellLevel>> shell =
+        DecodeShell(bytes, shape, top, name + ": a neighbour's shell");
+    if (!shell.ok()) return shell.status();
+    around.push_back(std::move(*shell));
+  }
+  const bool color = shape.has_color, normal = shape.has_normal;
+  // The samples of one level the next level up reads: on faces (computed, or given at the level
+  // above the voxels) and one step inside them (given).
+  std::unordered_map<std::uint64_t, EncodedSample> known;
+  const auto add_given = [&](std::uint32_t l, bool faces) {
+    for (const auto& shell : around) {
+      const ShellLevel& level = shell[l - top];
+      if (faces) {
+        for (std::size_t i = 0; i < level.face.size(); ++i) {
+          known.emplace(level.face[i], Load(level.face_values, i));
+        }
+      }
+      for (std::size_t i = 0; i < level.layer.size(); ++i) {
+        known.emplace(level.layer[i], Load(level.layer_values, i));
+      }
+    }
+  };
+  add_given(depth - 1, true);
+  const auto keys = TreeLevelKeys(page.tree, page.root_key, depth - 2);
+  for (std::uint32_t l = depth - 1; l-- > top;) {
+    std::unordered_map<std::uint64_t, EncodedSample> computed;
+    for (const auto& shell : around) {
+      for (const std::uint64_t packed : shell[l - top].face) {
+        const Point q = Unpack(packed);
+        if (!frame.Reaches(l, q) || computed.contains(packed)) continue;
+        // The tent over the finer points 2q + d − 1, as the filter reads them: decoded, and zero
+        // where no node holds the point.
+        std::array<PremultipliedSample, 27> taps;
+        for (int d = 0; d < 27; ++d) {
+          const Point t{2 * q.x + d % 3 - 1, 2 * q.y + d / 3 % 3 - 1, 2 * q.z + d / 9 - 1};
+          const auto it = known.find(Pack(t));
+          taps[d] = it == known.end() || it->second.opacity == 0
+                        ? PremultipliedSample{}
+                        : DecodePremultiplied(it->second, color, normal);
+        }
+        computed.emplace(packed, Encode(color, normal, brick_math::Tent([&](int x, int y, int z) -> const PremultipliedSample& {
+                                          return taps[x + 3 * y + 9 * z];
+                                        })));
+      }
+    }
+    Status missing;
+    LevelSamples& samples = page.samples[l - top];
+    ForEachStoredPoint(page, side, l, keys[l - top], [&](const Point& p, std::uint64_t at) {
+      if (!frame.OnFace(l, p)) return;
+      const auto it = computed.find(Pack(p));
+      if (it == computed.end()) {
+        missing = Status::BadInput("{}: its shell does not hold a point of its faces", name);
+        return;
+      }
+      Store(it->second, at, samples);
+    });
+    SVOKIT_RETURN_IF_ERROR(missing);
+    known = std::move(computed);
+    if (l > top) add_given(l, false);
+  }
+  return Status::Ok();
+}
+
+LevelSamples RootBrick(const SvoChunk& page, std::uint32_t side) {
+  Neighbourhood alone;
+  alone.fill(-1);
+  alone[NeighbourSlot(0, 0, 0)] = 0;
+  const LevelSamples& samples = page.samples.front();
+  LevelSamples brick;
+  for (unsigned s = 0; s < side * side * side; ++s) {
+    Append(brick, samples, SampleIndex(page.layouts.front(), alone, s));
+  }
+  return brick;
+}
+
+void FilterTopSamples(SvoChunk& top, std::uint32_t side, const LevelSamples& root_bricks) {
+  const std::uint32_t pages = top.tree.last_level(), n = side * side * side;
+  std::vector<SampleLayout> layouts;
+  for (std::uint32_t l = 0; l <= pages; ++l) layouts.push_back(LayOutSamples(top.tree, l, side));
+  LevelSamples last;
+  const std::uint64_t size = layouts.back().size();
+  last.opacity.resize(size);
+  last.color.resize(root_bricks.color.empty() ? 0 : size);
+  last.normal.resize(root_bricks.normal.empty() ? 0 : size);
+  const layout_detail::SideTable& t = layout_detail::TableFor(side);
+  ForEachNeighbourhood(top.tree, pages, [&](std::uint64_t i, const Neighbourhood& nb) {
+    for (unsigned s = 0; s < n; ++s) {
+      // Only the samples the page's root stores: a point shared with another page is written once.
+      if (!t.is_home[s] && !(layouts.back().orphans[i] >> t.index[s] & 1u)) continue;
+      Store(Load(root_bricks, i * n + s), SampleIndex(layouts.back(), nb, s), last);
+    }
+  });
+  top.samples = FilterSamplesAbove(top.tree, layouts, side, std::move(last));
+  layouts.pop_back();
+  top.layouts = std::move(layouts);
+}
+
+}  // namespace svokit
