@@ -58,11 +58,12 @@ int main(int argc, char** argv) {
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
     const std::string meta =
         SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
-    // Without a limit, a build without bricks goes by pages when the whole grid would not fit
-    // in half the machine's memory (~48 B a voxel held whole): the same file either way.
-    const bool may_go_by_pages =
-        memory_limit.empty() && pages.empty() && build.Options().brick_side == 0;
-    const double whole_bytes = may_go_by_pages ? 48.0 * EstimateVoxelCount(*mesh, *grid) : 0.0;
+    // Without a limit, a build goes by pages when the whole grid would not fit in half the
+    // machine's memory (held whole, ~48 B a voxel, ~100 with bricks): the same file either way.
+    const bool may_go_by_pages = memory_limit.empty() && pages.empty();
+    const double per_voxel = build.Options().brick_side == 0 ? 48.0 : 100.0;
+    const double whole_bytes =
+        may_go_by_pages ? per_voxel * EstimateVoxelCount(*mesh, *grid) : 0.0;
     const std::uint64_t half_machine = app::MachineMemory() / 2;
     const bool by_pages_by_default =
         may_go_by_pages && half_machine > 0 && whole_bytes > static_cast<double>(half_machine);

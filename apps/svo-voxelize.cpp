@@ -22,9 +22,14 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output;
   app::VoxelizeCli voxelize;
   app::CommonOptions common;
+  std::string memory_limit;
   app::AddFile(cli, "input", input, "Mesh (.svm from svo-import, or any mesh file)")->required();
   app::AddFile(cli, "-o,--output", output, "Output: .vfrag, .xyz or .ply")->required();
   voxelize.Add(cli);
+  cli.add_option("--memory-limit", memory_limit,
+                 "Voxelize one 128³-voxel cube at a time within SIZE bytes besides the mesh (K, M, "
+                 "G suffixes), streaming the .vfrag: any resolution, the same file")
+      ->option_text("SIZE");
   app::AddCommonOptions(cli, common, "svo-voxelize bunny.svm -r 1024 -o bunny.vfrag");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -46,7 +51,21 @@ int main(int argc, char** argv) {
     std::size_t voxel_count = 0;
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
-    if (ext == "vfrag") {
+    if (!memory_limit.empty()) {
+      if (ext != "vfrag") {
+        return app::Fail(tool, Status::BadInput("--memory-limit writes .vfrag files only, not {}",
+                                                output.string()));
+      }
+      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+      if (!limit.ok()) return app::Fail(tool, limit.status());
+      StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
+          RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
+      if (!regions.ok()) return app::Fail(tool, regions.status().WithContext(input.string()));
+      app::Warn(tool, (*regions)->warnings());
+      StatusOr<std::uint64_t> count = WriteVfragByCubes(**regions, meta, output, *limit, progress);
+      if (!count.ok()) return app::Fail(tool, count.status().WithContext(input.string()));
+      voxel_count = *count;
+    } else if (ext == "vfrag") {
       // Keys packed as they are found, everything written in place into the file's mapped
       // sections. Methods and thread counts give the same file, byte for byte: they are not
       // recorded.

@@ -4,7 +4,7 @@
 # a Slurm job array (scripts/pipeline/slurm-parts.sh) on a cluster with a shared file system.
 #
 #   make -f scripts/pipeline/parts.mk MESH=scan.ply OUT=out/scan PARTS=16 \
-#        OPTIONS="-r 16384 --bricks none" LIMIT=4G -j2
+#        OPTIONS="-r 16384" LIMIT=4G -j2
 #
 # Files: $(OUT)/part-K-of-N.svopart per job, then $(OUT)/$(NAME).svo (the same bytes as one
 # mesh2svo run with the same options, whatever PARTS).
@@ -13,7 +13,7 @@ MESH    ?= data/uv-torus.obj
 OUT     ?= out/parts
 BIN     ?= build/apps
 PARTS   ?= 4
-OPTIONS ?= -r 512 --bricks none
+OPTIONS ?= -r 512
 # Memory each job may use besides the mesh (mesh2svo --memory-limit); empty: no limit.
 LIMIT   ?=
 # Threads per job: make -j spreads the jobs over the cores instead.

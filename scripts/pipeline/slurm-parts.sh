@@ -4,7 +4,7 @@
 # (a shared file system) and have svokit's tools in BIN.
 #
 #   scripts/pipeline/slurm-parts.sh MESH OUT N "OPTIONS" [LIMIT]
-#   e.g. scripts/pipeline/slurm-parts.sh scan.ply /shared/scan 64 "-r 65536 --bricks none" 4G
+#   e.g. scripts/pipeline/slurm-parts.sh scan.ply /shared/scan 64 "-r 65536 --bricks none --attributes none" 4G
 #
 # A rerun submits only the tasks whose part is missing (a task that died left no part file).
 set -euo pipefail

@@ -38,6 +38,14 @@ class ExitCodes : public ::testing::Test {
                          "-o", Input(k + std::string(".svopart")), "-q"})
                     .exit_code,
                 0);
+      // With bricks: pages as built alone and their shells, which the merge completes.
+      std::string bricked = "b";
+      bricked += k;
+      bricked += ".svopart";
+      ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "300", "--pages", std::string(k) + "/2", "-o",
+                                     Input(bricked), "-q"})
+                    .exit_code,
+                0);
     }
   }
   static void TearDownTestSuite() {
@@ -63,6 +71,9 @@ class ExitCodes : public ::testing::Test {
         {"svo-voxelize",
          {svm, "-r", "128", "-o", (out / "o.ply").string()},
          (out / "o.ply").string()},
+        {"svo-voxelize",
+         {svm, "-r", "300", "--memory-limit", "1G", "-o", (out / "c.vfrag").string()},
+         (out / "c.vfrag").string()},
         {"svo-build",
          {vfrag, "--mesh", svm, "-o", (out / "o.svo").string()},
          (out / "o.svo").string()},
@@ -78,6 +89,15 @@ class ExitCodes : public ::testing::Test {
         {"svo-merge",
          {Input("0.svopart"), Input("1.svopart"), "-o", (out / "merged.svo").string()},
          (out / "merged.svo").string()},
+        {"mesh2svo",
+         {svm, "-r", "300", "--memory-limit", "1G", "-o", (out / "pb.svo").string()},
+         (out / "pb.svo").string()},
+        {"mesh2svo",
+         {svm, "-r", "300", "--pages", "1/2", "-o", (out / "pb.svopart").string()},
+         (out / "pb.svopart").string()},
+        {"svo-merge",
+         {Input("b0.svopart"), Input("b1.svopart"), "-o", (out / "merged-b.svo").string()},
+         (out / "merged-b.svo").string()},
         {"svo-inspect",
          {svo, "--render", (out / "r.png").string(), "--size", "1024x1024"},
          (out / "r.png").string()},

@@ -130,22 +130,20 @@ TEST(SvoBuildCli, ThreadCountDoesNotChangeTheFile) {
   ExpectValidSvo((dir / "m1.svo").string(), Torus());
 }
 
-// mesh2svo on the torus at 300 without bricks (what builds by pages make) into `out`, with
-// `extra` options.
-ToolResult Mesh2svoWithoutBricks(const std::filesystem::path& out, std::vector<std::string> extra) {
-  std::vector<std::string> args = {Torus(), "-o",       out.string(), "-r",
-                                   "300",   "--bricks", "none",       "-q"};
+// mesh2svo on the torus at 300 (4³ page cubes; bricks, colour, normal and contours) into `out`,
+// with `extra` options.
+ToolResult Mesh2svoTorus300(const std::filesystem::path& out, std::vector<std::string> extra) {
+  std::vector<std::string> args = {Torus(), "-o", out.string(), "-r", "300", "-q"};
   args.insert(args.end(), extra.begin(), extra.end());
   return RunTool("mesh2svo", args);
 }
 
-// mesh2svo --memory-limit builds page by page into the same file; sizes it cannot parse, limits
-// too small for one page and bricks (not yet built by pages) are one-line errors that leave no
-// file.
+// mesh2svo --memory-limit builds page by page into the same file; sizes it cannot parse and
+// limits too small for one page are one-line errors that leave no file.
 TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
   TempDir dir;
   auto run = [&](const std::string& name, std::vector<std::string> extra) {
-    return Mesh2svoWithoutBricks(dir / name, std::move(extra));
+    return Mesh2svoTorus300(dir / name, std::move(extra));
   };
   ASSERT_EQ(run("whole.svo", {}).exit_code, 0);
   for (const char* limit : {"64M", "1G", "100000000"}) {
@@ -157,12 +155,8 @@ TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
   for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--memory-limit", "4Q"}, "expected a size"},
            {{"--memory-limit", "0"}, "expected a size"},
-           {{"--memory-limit", "1M"}, "too small"},
-           {{"--memory-limit", "1G"}, "--bricks none"}}) {
-    const ToolResult r = message.starts_with("--bricks")
-                             ? RunTool("mesh2svo", {Torus(), "-o", (dir / "bad.svo").string(), "-r",
-                                                    "300", "-q", args[0], args[1]})
-                             : run("bad.svo", args);
+           {{"--memory-limit", "1M"}, "too small"}}) {
+    const ToolResult r = run("bad.svo", args);
     EXPECT_NE(r.exit_code, 0) << args[1];
     ASSERT_EQ(r.ErrLines().size(), 1u) << r.err;
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
@@ -175,7 +169,7 @@ TEST(SvoBuildCli, MemoryLimitWritesTheSameFile) {
 TEST(SvoBuildCli, PartsMergeIntoTheSameFile) {
   TempDir dir;
   auto mesh2svo = [&](const std::string& name, std::vector<std::string> extra) {
-    return Mesh2svoWithoutBricks(dir / name, std::move(extra));
+    return Mesh2svoTorus300(dir / name, std::move(extra));
   };
   ASSERT_EQ(mesh2svo("whole.svo", {}).exit_code, 0);
   std::vector<std::string> parts;

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <fmt/ranges.h>
+
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
@@ -38,6 +40,33 @@ TEST(SvoVoxelizeCli, SvmInputAndEveryMethodAndThreadCountGiveTheSameFile) {
                 .exit_code,
             0);
   EXPECT_EQ(ReadVfrag(direct)->keys, set->keys);
+}
+
+// --memory-limit voxelizes one 128³ cube at a time and streams the file: the same bytes, for
+// textured, multi-material and geometry-only voxels, in both modes, with 1 and 2 threads.
+TEST(SvoVoxelizeCli, MemoryLimitWritesTheSameFile) {
+  TempDir dir;
+  const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
+      {(DataDir() / "uv-torus.obj").string(), {"-r", "300"}},
+      {(DataDir() / "uv-torus.obj").string(), {"-r", "300", "--mode", "thin"}},
+      {(DataDir() / "uv-torus.obj").string(), {"-r", "300", "--attributes", "none"}},
+      {(DataDir() / "box-room.obj").string(), {"-r", "260"}},
+      {std::string(SVOKIT_ASSIMP_MODELS "/OBJ/spider.obj"), {"-r", "400"}}};
+  for (const auto& [mesh, options] : runs) {
+    std::vector<std::string> whole = {mesh, "-o", (dir / "whole.vfrag").string(), "-q"};
+    whole.insert(whole.end(), options.begin(), options.end());
+    ASSERT_EQ(RunTool("svo-voxelize", whole).exit_code, 0) << mesh;
+    for (const char* threads : {"1", "2"}) {
+      std::vector<std::string> cubes = {mesh, "-o", (dir / "cubes.vfrag").string(), "-q",
+                                        "--memory-limit", "64M", "-j", threads};
+      cubes.insert(cubes.end(), options.begin(), options.end());
+      const ToolResult r = RunTool("svo-voxelize", cubes);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_TRUE(ReadText(dir / "cubes.vfrag") == ReadText(dir / "whole.vfrag"))
+          << mesh << " " << fmt::format("{}", fmt::join(options, " ")) << ", -j " << threads;
+    }
+  }
+  EXPECT_GT(ReadVfrag(dir / "cubes.vfrag")->size(), 10000u);
 }
 
 TEST(SvoVoxelizeCli, ThinIsASubsetAndXyzListsTheSameVoxels) {
@@ -75,6 +104,9 @@ TEST(SvoVoxelizeCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--method", "magic"}, "--method"},
       {{mesh, "-o", "{dir}/v.obj", "-r", "8"}, "output must be a .vfrag, .xyz, .ply file"},
       {{"{dir}/missing.svm", "-o", "{dir}/v.vfrag", "-r", "8"}, "missing.svm: no such file"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--memory-limit", "4Q"}, "expected a size"},
+      {{mesh, "-o", "{dir}/v.vfrag", "-r", "8", "--memory-limit", "1K"}, "too small"},
+      {{mesh, "-o", "{dir}/v.xyz", "-r", "8", "--memory-limit", "1G"}, ".vfrag files only"},
   };
   for (const auto& [args_template, expect] : cases) {
     TempDir dir;

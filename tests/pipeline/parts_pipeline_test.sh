@@ -4,7 +4,7 @@
 set -euo pipefail
 root="$1" bin="$2"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
-options="-r 300 --bricks none"
+options="-r 300"
 run() { make -s -f "$root/scripts/pipeline/parts.mk" MESH="$root/data/uv-torus.obj" OUT="$tmp/out" \
           BIN="$bin" PARTS=4 OPTIONS="$options" LIMIT=256M -j2 "$@"; }
 run

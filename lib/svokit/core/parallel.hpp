@@ -9,6 +9,9 @@
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+
+#include "svokit/core/status.hpp"
 
 namespace svokit {
 
@@ -47,6 +50,28 @@ T OrderedReduce(std::size_t n, std::size_t chunk, T init, const Map& map, const 
   });
   for (auto& p : parts) combine(init, p);
   return init;
+}
+
+/// Items [first, end) made by make(i) → Made in parallel, at most `in_flight` at a time, and handed
+/// to take(Made) → Status in order; stops at take's first error and returns it. What streams a
+/// file out of parts made in parallel within a memory bound.
+template <class Made, class MakeFn, class TakeFn>
+Status ParallelInOrder(std::size_t first, std::size_t end, std::size_t in_flight,
+                       const MakeFn& make, const TakeFn& take) {
+  Status failed;
+  std::size_t next = first;
+  tbb::parallel_pipeline(
+      std::max<std::size_t>(in_flight, 1),
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& fc) -> std::size_t {
+                                            if (next == end || !failed.ok()) fc.stop();
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel, make) &
+          tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
+            if (failed.ok()) failed = take(std::move(made));
+          }));
+  return failed;
 }
 
 }  // namespace svokit

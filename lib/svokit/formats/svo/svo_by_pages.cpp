@@ -11,12 +11,12 @@
 #include <numeric>
 #include <optional>
 
-#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/core/parallel.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
@@ -64,27 +64,6 @@ SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_leve
 // How pages built alone are kept for the second pass of a build with bricks: fast to write and
 // read back, they are decoded once more.
 const SvoCompression kAloneCompression{true, 1};
-
-// Items [first, end) made in parallel, at most `in_flight` at a time, and handed to `take` in
-// order; stops at take's first error.
-template <class Made, class MakeFn, class TakeFn>
-Status PagesInOrder(std::size_t first, std::size_t end, std::size_t in_flight, const MakeFn& make,
-                    const TakeFn& take) {
-  Status failed;
-  std::size_t next = first;
-  tbb::parallel_pipeline(
-      in_flight,
-      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                          [&](tbb::flow_control& fc) -> std::size_t {
-                                            if (next == end || !failed.ok()) fc.stop();
-                                            return next++;
-                                          }) &
-          tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel, make) &
-          tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
-            if (failed.ok()) failed = take(std::move(made));
-          }));
-  return failed;
-}
 
 // The pages of a build with bricks as its first pass left them, built alone, with their shells:
 // ascending keys, and each one's bytes.
@@ -139,7 +118,7 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
     made.page = writer.Encode(*page);
     return Status::Ok();
   };
-  return PagesInOrder<Made>(
+  return ParallelInOrder<Made>(
       0, built.keys.size(), in_flight,
       [&](std::size_t i) {
         Made made;
@@ -311,7 +290,7 @@ class PagePlan {
   // to `take` in order; stops at take's first error.
   template <class Made, class MakeFn, class TakeFn>
   Status InOrder(std::size_t first, std::size_t end, const MakeFn& make, const TakeFn& take) const {
-    return PagesInOrder<Made>(first, end, in_flight_, make, take);
+    return ParallelInOrder<Made>(first, end, in_flight_, make, take);
   }
 
   const RegionVoxelizer& voxelizer_;

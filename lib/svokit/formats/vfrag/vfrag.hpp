@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
@@ -56,6 +57,18 @@ class VfragFileWriter final : public PackedVoxelStorage {
   bool open_ = false;
   PackedVoxelContents contents_;
 };
+
+class RegionVoxelizer;
+/// The .vfrag of the mesh `voxelizer` holds, voxelized one cube of 128³ voxels at a time (cubes in
+/// parallel, in key order, as many at once as `memory_limit` bytes besides the mesh allow; 0: no
+/// limit) and streamed through unnamed scratch files: WriteVfrag()'s bytes for Voxelize()'s
+/// voxels, at any resolution. Returns the voxel count. A limit too small for the triangle bins
+/// and one cube is an error naming the smallest limit that works.
+StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
+                                          const VfragMetadata& meta,
+                                          const std::filesystem::path& path,
+                                          std::uint64_t memory_limit,
+                                          Progress& progress = Progress::Silent());
 
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
