@@ -8,6 +8,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
+#include "svokit/svo/svo_pages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -20,11 +21,16 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output, mesh_path;
   app::BuildCli build;
   app::CommonOptions common;
+  std::string memory_limit;
   app::AddFile(cli, "input", input, "Voxel fragment list (.vfrag from svo-voxelize)")->required();
   app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
   app::AddFile(cli, "--mesh", mesh_path,
                "The mesh that was voxelized (.svm or any mesh file), for the contours");
   build.Add(cli);
+  cli.add_option("--memory-limit", memory_limit,
+                 "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh (K, "
+                 "M, G suffixes), reading the .vfrag a page at a time: any size, the same file")
+      ->option_text("SIZE");
   app::AddCommonOptions(cli, common, "svo-build bunny.vfrag --mesh bunny.svm -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -38,6 +44,43 @@ int main(int argc, char** argv) {
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
+    if (!memory_limit.empty()) {
+      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+      if (!limit.ok()) return app::Fail(tool, limit.status());
+      VfragMetadata source;
+      StatusOr<std::unique_ptr<VfragCubes>> cubes = app::RunStage(
+          progress, "index", [&] { return VfragCubes::Open(input, kPageSideBits, &source); });
+      if (!cubes.ok()) return app::Fail(tool, cubes.status());
+      const VfragCubes& vfrag = **cubes;
+      std::optional<Mesh> mesh;
+      if (!mesh_path.empty()) {
+        StatusOr<Mesh> m =
+            app::ImportSourceMesh(progress, mesh_path, vfrag.grid(), input, "that was voxelized");
+        if (!m.ok()) return app::Fail(tool, m.status());
+        mesh = std::move(*m);
+      }
+      const BoxVoxels voxels{vfrag.grid(),
+                             vfrag.mode(),
+                             vfrag.has_colors(),
+                             vfrag.has_normals(),
+                             vfrag.shared_color(),
+                             vfrag.cubes(),
+                             [&vfrag](const IBox3& box) { return vfrag.Read(box); },
+                             vfrag.bytes()};
+      const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
+      StatusOr<SvoFileStats> written =
+          BuildSvoByPages(voxels, mesh ? &*mesh : nullptr, build.Options(), meta, output,
+                          *compression, *limit, progress);
+      if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
+      fmt::print("input       {} ({} voxels)\n", input.string(), vfrag.voxel_count());
+      fmt::print("octree      depth {}, bricks {}, contours {}, by pages within {:.1f} GiB\n",
+                 OctreeDepth(vfrag.grid()), build.bricks, build.contours ? "on" : "off",
+                 static_cast<double>(*limit) / 1073741824.0);
+      app::PrintFileSummary(*written);
+      app::PrintTimes(progress);
+      fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
+      return 0;
+    }
     VfragMetadata source;
     StatusOr<VoxelSet> voxels =
         app::RunStage(progress, "read", [&] { return ReadVfrag(input, &source); });

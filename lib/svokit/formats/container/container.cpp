@@ -437,6 +437,7 @@ StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std:
     SVOKIT_RETURN_IF_ERROR(table.Get(s.size));
     SVOKIT_RETURN_IF_ERROR(table.Get(section_crc));
     SVOKIT_RETURN_IF_ERROR(table.Get(reserved1));
+    s.crc = section_crc;
     s.in_file = s.offset >= table_end && s.offset % kAlignment == 0 && s.offset <= bytes.size() &&
                 s.size <= bytes.size() - s.offset;
     if (!s.in_file) {

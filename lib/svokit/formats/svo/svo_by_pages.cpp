@@ -138,66 +138,81 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
       });
 }
 
-// What builds by pages and parts share: the frame, the bins, how many pages may be in flight,
-// and how a page is made.
+// What builds by pages and parts share: the frame, the page cubes and where their voxels come
+// from, how many pages may be in flight, and how a page is made.
 class PagePlan {
  public:
+  // Each page voxelized from the mesh's triangles binned to it.
   static StatusOr<std::unique_ptr<PagePlan>> Make(const RegionVoxelizer& voxelizer,
                                                   const BuildOptions& options,
                                                   const std::string& metadata,
                                                   std::uint64_t memory_limit, Progress& progress) {
-    std::unique_ptr<PagePlan> plan(new PagePlan(voxelizer, options));
-    SvoFrame& frame = plan->frame_;
-    frame.grid = voxelizer.grid();
-    frame.mode = voxelizer.options().mode;
-    frame.depth = OctreeDepth(frame.grid);
-    frame.shape.depth = frame.depth;
-    frame.shape.brick_side = options.brick_side;
-    frame.shape.has_color = voxelizer.options().colors;
-    frame.shape.has_normal = voxelizer.options().normals;
-    frame.shape.has_contours = options.contours;
-    if (const auto shared = voxelizer.shared_color()) {
-      frame.shape.shared_color = {HalfRgba(*shared)};
-    }
-    frame.metadata = metadata;
-    plan->page_level_ = PageLevel(frame.depth);
-    // The halo: the voxels a page's voxel bricks read, one around it; with bricks of side 2 the
-    // samples of its faces above the voxels read one more.
-    plan->grow_ = options.brick_side == 2 ? 2 : 1;
-    plan->bits_ = frame.depth - plan->page_level_;
-    plan->page_options_.contours = false;  // fitted from each page's triangles instead
+    std::unique_ptr<PagePlan> plan(new PagePlan(
+        options, metadata, voxelizer.grid(), voxelizer.options().mode, voxelizer.options().colors,
+        voxelizer.options().normals,
+        voxelizer.shared_color() ? std::optional<HalfRgba>(HalfRgba(*voxelizer.shared_color()))
+                                 : std::nullopt));
+    plan->mesh_ = &voxelizer.mesh();
     if (options.contours) {
-      plan->contours_.emplace(voxelizer.mesh(), frame.grid, frame.depth, options.contour);
+      plan->contours_.emplace(voxelizer.mesh(), plan->frame_.grid, plan->frame_.depth,
+                              options.contour);
     }
     {
       Progress::Stage stage(progress, "bin", 1);
       plan->bins_ = voxelizer.BinTriangles(static_cast<int>(plan->bits_), plan->grow_);
     }
-    // Held whatever the page: the snapped mesh and the bins; then each page in flight, at most a
-    // surface's voxels across its cube with their attributes and nodes (~40 B a voxel; with
-    // bricks, their samples too).
-    const std::size_t tokens =
-        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-    const std::uint64_t fixed = voxelizer.bytes() + plan->bins_.bytes();
-    const std::uint64_t per_voxel = options.brick_side == 0 ? 40 : 160;
-    const std::uint64_t page = per_voxel * 4 << (2 * plan->bits_);
-    const std::uint64_t smallest = fixed + page;
-    if (memory_limit != 0 && memory_limit < smallest) {
-      const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
-      return Status::BadInput(
-          "a memory limit of {} MiB is too small for this mesh and grid: its bins and one page "
-          "need {} MiB (use --memory-limit {}M or more)",
-          memory_limit >> 20, mib, mib);
+    plan->cells_ = plan->bins_.cells;
+    const RegionVoxelizer::Bins& bins = plan->bins_;
+    plan->read_ = [&voxelizer, &bins](std::size_t i, const IBox3& box) {
+      return voxelizer.Voxelize(box, bins.Of(i));
+    };
+    plan->triangles_ = [&bins](std::size_t i) { return bins.Of(i); };
+    SVOKIT_RETURN_IF_ERROR(
+        plan->SetLimit(voxelizer.bytes() + plan->bins_.bytes(), memory_limit, "its bins"));
+    return plan;
+  }
+
+  // Each page read from voxels made before (a .vfrag); contours fitted to `mesh`, binned here.
+  static StatusOr<std::unique_ptr<PagePlan>> Make(const BoxVoxels& voxels, const Mesh* mesh,
+                                                  const BuildOptions& options,
+                                                  const std::string& metadata,
+                                                  std::uint64_t memory_limit, Progress& progress) {
+    std::unique_ptr<PagePlan> plan(new PagePlan(options, metadata, voxels.grid, voxels.mode,
+                                                voxels.colors, voxels.normals,
+                                                voxels.shared_color));
+    plan->mesh_ = mesh;
+    std::uint64_t fixed = voxels.bytes;
+    if (options.contours) {
+      if (mesh == nullptr) return Status::BadInput("contours need the mesh");
+      plan->contours_.emplace(*mesh, plan->frame_.grid, plan->frame_.depth, options.contour);
+      VoxelizeOptions binning;
+      binning.mode = voxels.mode;
+      StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
+          RegionVoxelizer::Create(*mesh, voxels.grid, binning);
+      if (!regions.ok()) return regions.status();
+      Progress::Stage stage(progress, "bin", 1);
+      plan->bins_ = (*regions)->BinTriangles(static_cast<int>(plan->bits_), plan->grow_);
+      fixed += (*regions)->bytes() + plan->bins_.bytes();
     }
-    plan->in_flight_ = memory_limit == 0
-                           ? tokens
-                           : std::clamp<std::size_t>((memory_limit - fixed) / page, 1, tokens);
+    plan->cells_ = voxels.cubes;
+    const RegionVoxelizer::Bins& bins = plan->bins_;
+    const std::span<const std::uint64_t> cells = plan->cells_;
+    plan->read_ = [&voxels](std::size_t, const IBox3& box) { return voxels.read(box); };
+    // A cube the mesh's bins do not hold has no triangles to fit.
+    plan->triangles_ = [&bins, cells](std::size_t i) {
+      const auto it = std::lower_bound(bins.cells.begin(), bins.cells.end(), cells[i]);
+      return it == bins.cells.end() || *it != cells[i]
+                 ? std::span<const std::uint32_t>()
+                 : bins.Of(static_cast<std::size_t>(it - bins.cells.begin()));
+    };
+    SVOKIT_RETURN_IF_ERROR(plan->SetLimit(fixed, memory_limit, "its index"));
     return plan;
   }
 
   const SvoFrame& frame() const { return frame_; }
   std::uint32_t page_level() const { return page_level_; }
   const RegionVoxelizer::Bins& bins() const { return bins_; }
+  std::span<const std::uint64_t> cells() const { return cells_; }
 
   // A page built alone, and its shell (empty without bricks): what a build without bricks
   // writes, and what the second pass of one with bricks completes.
@@ -241,10 +256,9 @@ class PagePlan {
     TopContours words(page_level_);
     if (!contours_ || page_level_ == 0) return words;
     Progress::Stage stage(progress, "top contours", 1);
-    std::vector<std::vector<std::uint64_t>> level_keys =
-        LevelKeysFromVoxels(bins_.cells, page_level_);
+    std::vector<std::vector<std::uint64_t>> level_keys = LevelKeysFromVoxels(cells_, page_level_);
     level_keys.pop_back();
-    std::vector<std::uint32_t> all(voxelizer_.mesh().triangles.size());
+    std::vector<std::uint32_t> all(mesh_->triangles.size());
     std::iota(all.begin(), all.end(), 0u);
     const auto fitted = contours_->FitSubtree(0, level_keys, all);
     for (std::uint32_t l = 0; l < page_level_; ++l) {
@@ -256,15 +270,55 @@ class PagePlan {
   }
 
  private:
-  PagePlan(const RegionVoxelizer& voxelizer, const BuildOptions& options)
-      : voxelizer_(voxelizer), page_options_(options) {}
+  PagePlan(const BuildOptions& options, const std::string& metadata, const GridTransform& grid,
+           VoxelMode mode, bool colors, bool normals, std::optional<HalfRgba> shared_color)
+      : page_options_(options) {
+    frame_.grid = grid;
+    frame_.mode = mode;
+    frame_.depth = OctreeDepth(grid);
+    frame_.shape.depth = frame_.depth;
+    frame_.shape.brick_side = options.brick_side;
+    frame_.shape.has_color = colors;
+    frame_.shape.has_normal = normals;
+    frame_.shape.has_contours = options.contours;
+    if (shared_color) frame_.shape.shared_color = {*shared_color};
+    frame_.metadata = metadata;
+    page_level_ = PageLevel(frame_.depth);
+    bits_ = frame_.depth - page_level_;
+    // The halo: the voxels a page's voxel bricks read, one around it; with bricks of side 2 the
+    // samples of its faces above the voxels read one more.
+    grow_ = options.brick_side == 2 ? 2 : 1;
+    page_options_.contours = false;  // fitted from each page's triangles instead
+  }
 
-  // Page `i` of the bins, if its cell holds voxels.
+  // How many pages may be in flight: held whatever the page, `fixed` bytes (the snapped mesh
+  // and `what`); then each page in flight, at most a surface's voxels across its cube with their
+  // attributes and nodes (~40 B a voxel; with bricks, their samples too).
+  Status SetLimit(std::uint64_t fixed, std::uint64_t memory_limit, const char* what) {
+    const std::size_t tokens =
+        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+    const std::uint64_t per_voxel = frame_.shape.brick_side == 0 ? 40 : 160;
+    const std::uint64_t page = per_voxel * 4 << (2 * bits_);
+    const std::uint64_t smallest = fixed + page;
+    if (memory_limit != 0 && memory_limit < smallest) {
+      const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
+      return Status::BadInput(
+          "a memory limit of {} MiB is too small for this mesh and grid: {} and one page need "
+          "{} MiB (use --memory-limit {}M or more)",
+          memory_limit >> 20, what, mib, mib);
+    }
+    in_flight_ = memory_limit == 0
+                     ? tokens
+                     : std::clamp<std::size_t>((memory_limit - fixed) / page, 1, tokens);
+    return Status::Ok();
+  }
+
+  // Page `i` of the cells, if its cell holds voxels.
   Status MakePage(const PagedSvoWriter& writer, std::size_t i,
                   std::optional<PagedSvoWriter::EncodedPage>& out,
                   std::vector<std::uint8_t>& shell) const {
-    const std::uint64_t cell = bins_.cells[i];
-    StatusOr<VoxelSet> voxels = voxelizer_.Voxelize(CellBox(cell, bits_, grow_), bins_.Of(i));
+    const std::uint64_t cell = cells_[i];
+    StatusOr<VoxelSet> voxels = read_(i, CellBox(cell, bits_, grow_));
     if (!voxels.ok()) return voxels.status();
     // The page's own voxels are the keys of its cell's range; the rest are its halo.
     const std::uint64_t first = cell << (3 * bits_), last = (cell + 1) << (3 * bits_);
@@ -279,7 +333,7 @@ class PagePlan {
     SvoChunk chunk = PageChunk(*svo, page_level_, at, nbs[at], cell);
     if (contours_) {
       chunk.contours = contours_->FitSubtree(
-          page_level_, TreeLevelKeys(chunk.tree, cell, frame_.depth), bins_.Of(i));
+          page_level_, TreeLevelKeys(chunk.tree, cell, frame_.depth), triangles_(i));
     }
     shell = EncodePageShell(chunk, frame_.shape);
     out = writer.Encode(chunk);
@@ -293,13 +347,16 @@ class PagePlan {
     return ParallelInOrder<Made>(first, end, in_flight_, make, take);
   }
 
-  const RegionVoxelizer& voxelizer_;
   BuildOptions page_options_;
   SvoFrame frame_;
   std::uint32_t page_level_ = 0, bits_ = 0;
   std::int64_t grow_ = 1;
+  const Mesh* mesh_ = nullptr;
   std::optional<ContourFitter> contours_;
-  RegionVoxelizer::Bins bins_;
+  RegionVoxelizer::Bins bins_;  // the triangles binned to the page cubes (grown by the halo)
+  std::span<const std::uint64_t> cells_;
+  std::function<StatusOr<VoxelSet>(std::size_t cell, const IBox3& box)> read_;
+  std::function<std::span<const std::uint32_t>(std::size_t cell)> triangles_;
   std::size_t in_flight_ = 1;
 };
 
@@ -322,15 +379,13 @@ std::size_t PartStart(const RegionVoxelizer::Bins& bins, std::uint32_t part, std
 
 }  // namespace
 
-StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
-                                       const BuildOptions& options, const std::string& metadata,
-                                       const std::filesystem::path& path,
-                                       const SvoCompression& compression,
-                                       std::uint64_t memory_limit, Progress& progress) {
-  StatusOr<std::unique_ptr<PagePlan>> plan =
-      PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
-  if (!plan.ok()) return plan.status();
-  const PagePlan& p = **plan;
+namespace {
+
+// The file of a build by pages: pages in order as `p` makes them, then the top levels; with
+// bricks, in two passes through a scratch file.
+StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options,
+                                  const std::filesystem::path& path,
+                                  const SvoCompression& compression, Progress& progress) {
   PagedSvoWriter writer(p.frame(), compression);
   const TopContours words = p.FitTopContours(progress);
   const TopContours* top_words = options.contours ? &words : nullptr;
@@ -339,7 +394,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
         path,
         [&](const PagedSvoWriter::Take& take) {
           return p.Run(
-              writer, 0, p.bins().cells.size(),
+              writer, 0, p.cells().size(),
               [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t>) {
                 return take(std::move(page));
               },
@@ -361,7 +416,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
   BuiltPages built;
   const PagedSvoWriter alone(p.frame(), kAloneCompression);
   SVOKIT_RETURN_IF_ERROR(p.Run(
-      alone, 0, p.bins().cells.size(),
+      alone, 0, p.cells().size(),
       [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t> shell) -> Status {
         StatusOr<std::uint64_t> at_page = file.Append(page.bytes);
         if (!at_page.ok()) return at_page.status();
@@ -386,6 +441,31 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
       });
 }
 
+}  // namespace
+
+StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
+                                       const BuildOptions& options, const std::string& metadata,
+                                       const std::filesystem::path& path,
+                                       const SvoCompression& compression,
+                                       std::uint64_t memory_limit, Progress& progress) {
+  StatusOr<std::unique_ptr<PagePlan>> plan =
+      PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
+  if (!plan.ok()) return plan.status();
+  return WritePages(**plan, options, path, compression, progress);
+}
+
+StatusOr<SvoFileStats> BuildSvoByPages(const BoxVoxels& voxels, const Mesh* mesh,
+                                       const BuildOptions& options, const std::string& metadata,
+                                       const std::filesystem::path& path,
+                                       const SvoCompression& compression,
+                                       std::uint64_t memory_limit, Progress& progress) {
+  if (voxels.cubes.empty()) return Status::BadInput("there are no voxels to build an octree of");
+  StatusOr<std::unique_ptr<PagePlan>> plan =
+      PagePlan::Make(voxels, mesh, options, metadata, memory_limit, progress);
+  if (!plan.ok()) return plan.status();
+  return WritePages(**plan, options, path, compression, progress);
+}
+
 StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const BuildOptions& options,
                                     const std::string& metadata, const SvoPartOf& part,
                                     const std::filesystem::path& path,
@@ -401,7 +481,7 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   const PagePlan& p = **plan;
   const std::size_t first = PartStart(p.bins(), part.part, part.parts);
   const std::size_t end = part.part + 1 == part.parts
-                              ? p.bins().cells.size()
+                              ? p.cells().size()
                               : PartStart(p.bins(), part.part + 1, part.parts);
   const SvoFrame& frame = p.frame();
   // With bricks a part holds its pages as built alone, with their shells: merging completes them.
@@ -418,7 +498,7 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   head.Put(part.part);
   head.Put(part.parts);
   head.Put(part.identity);
-  head.Put(static_cast<std::uint64_t>(p.bins().cells.size()));
+  head.Put(static_cast<std::uint64_t>(p.cells().size()));
   head.Put(static_cast<std::uint64_t>(first));
   head.Put(static_cast<std::uint64_t>(end));
   head.Put(frame.depth);

@@ -6,30 +6,49 @@
 #include <cstring>
 
 #include <nlohmann/json.hpp>
-#include <tbb/task_arena.h>
 
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/key_gaps.hpp"
-#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
 #include "svokit/core/utf8.hpp"
 #include "svokit/formats/container/grid_section.hpp"
-#include "svokit/voxelize/voxelize.hpp"
+#include "svokit/formats/vfrag/vfrag_detail.hpp"
 
 namespace svokit {
 
+namespace vfrag_detail {
+
+std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
+  const nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
+                            {"options", EscapeInvalidUtf8(meta.options)},
+                            {"generator", "svokit " SVOKIT_VERSION}};
+  const std::string text = j.dump();
+  return {text.begin(), text.end()};
+}
+
+VfragMetadata ParseMetadata(std::span<const std::uint8_t> text) {
+  VfragMetadata meta;
+  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_object()) {
+    // value() throws on a member of another type; such metadata is ignored, not fatal.
+    const auto text_of = [&](const char* key) {
+      const auto it = j.find(key);
+      return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+    };
+    meta.source = text_of("source");
+    meta.options = text_of("options");
+  }
+  return meta;
+}
+
+}  // namespace vfrag_detail
+
 namespace {
 
-using container::MakeTag;
-constexpr container::Tag kGrid = MakeTag("GRID");
-constexpr container::Tag kKeys = MakeTag("KEYS");
-constexpr container::Tag kColors = MakeTag("COLR");
-constexpr container::Tag kNormals = MakeTag("NORM");
-constexpr container::Tag kCoverage = MakeTag("COVR");
-constexpr container::Tag kMetadata = MakeTag("META");
+using namespace vfrag_detail;
 
 template <class T, class A>
 std::span<const std::uint8_t> Bytes(const std::vector<T, A>& v) {
@@ -116,10 +135,6 @@ Status ReadNormalsAsOctahedral(const container::Reader& file, std::size_t voxels
   return Status::Ok();
 }
 
-bool IsFiniteHalf(Half h) {
-  return (h.bits & 0x7c00u) != 0x7c00u;
-}
-
 StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, VfragMetadata* meta) {
   if (!file.ok()) return file.status();
   const std::string& name = file->name();
@@ -182,19 +197,8 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
     }
   }
   if (meta != nullptr) {
-    *meta = {};
-    if (const auto text = file->Find(kMetadata)) {
-      const nlohmann::json j = nlohmann::json::parse(text->begin(), text->end(), nullptr, false);
-      if (j.is_object()) {
-        // value() throws on a member of another type; such metadata is ignored, not fatal.
-        const auto text_of = [&](const char* key) {
-          const auto it = j.find(key);
-          return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
-        };
-        meta->source = text_of("source");
-        meta->options = text_of("options");
-      }
-    }
+    const auto text = file->Find(kMetadata);
+    *meta = text ? ParseMetadata(*text) : VfragMetadata{};
   }
   return set;
 }
@@ -299,14 +303,6 @@ container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set) {
     const std::span<const std::uint8_t> gaps = Bytes(set.key_gaps);
     return BytesProducer(gaps, gaps, false)(emit);
   };
-}
-
-std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
-  const nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
-                            {"options", EscapeInvalidUtf8(meta.options)},
-                            {"generator", "svokit " SVOKIT_VERSION}};
-  const std::string text = j.dump();
-  return {text.begin(), text.end()};
 }
 
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
@@ -442,158 +438,6 @@ StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::s
 
 StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta) {
   return DecodeSections(container::Reader::Open(path, kVfragFormat), meta);
-}
-
-namespace {
-
-// The bytes of a scratch file, in pieces of a few MB.
-Status EmitScratch(const ScratchFile& file, const container::Writer::Emit& emit) {
-  constexpr std::uint64_t kPiece = std::uint64_t{4} << 20;
-  for (std::uint64_t at = 0; at < file.size(); at += kPiece) {
-    StatusOr<std::vector<std::uint8_t>> piece = file.Read(at, std::min(kPiece, file.size() - at));
-    if (!piece.ok()) return piece.status();
-    SVOKIT_RETURN_IF_ERROR(emit(*piece));
-  }
-  return Status::Ok();
-}
-
-// A per-voxel array streamed to a scratch file, with what StoredBytes() decides: whether every
-// value equals the first.
-template <class T>
-class ScratchArray {
- public:
-  static StatusOr<ScratchArray> Create(const std::filesystem::path& of) {
-    StatusOr<std::unique_ptr<ScratchFile>> file = ScratchFile::Create(of);
-    if (!file.ok()) return file.status();
-    return ScratchArray(std::move(*file));
-  }
-  Status Append(std::span<const T> values) {
-    if (values.empty()) return Status::Ok();
-    if (count_ == 0) first_ = values[0];
-    uniform_ = uniform_ && std::all_of(values.begin(), values.end(),
-                                       [&](const T& v) { return v == first_; });
-    count_ += values.size();
-    return file_
-        ->Append({reinterpret_cast<const std::uint8_t*>(values.data()), values.size_bytes()})
-        .status();
-  }
-  // The section: one value when all are equal (and more than one), else all of them.
-  container::Writer::Producer Producer() const {
-    return [this](const container::Writer::Emit& emit) -> Status {
-      if (uniform_ && count_ > 1) {
-        return emit({reinterpret_cast<const std::uint8_t*>(&first_), sizeof(T)});
-      }
-      return EmitScratch(*file_, emit);
-    };
-  }
-
- private:
-  explicit ScratchArray(std::unique_ptr<ScratchFile> file) : file_(std::move(file)) {}
-  std::unique_ptr<ScratchFile> file_;
-  std::uint64_t count_ = 0;
-  T first_{};
-  bool uniform_ = true;
-};
-
-}  // namespace
-
-StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
-                                          const VfragMetadata& meta,
-                                          const std::filesystem::path& path,
-                                          std::uint64_t memory_limit, Progress& progress) {
-  constexpr int kCubeBits = 7;
-  RegionVoxelizer::Bins bins;
-  {
-    Progress::Stage stage(progress, "bin", 1);
-    bins = voxelizer.BinTriangles(kCubeBits, 0);
-  }
-  // Held whatever the cube: the snapped mesh and the bins; then per cube in flight at most a
-  // surface's voxels across it with their keys and attributes (~24 B a voxel).
-  const std::uint64_t fixed = voxelizer.bytes() + bins.bytes();
-  const std::uint64_t cube = std::uint64_t{24} * 4 << (2 * kCubeBits);
-  if (memory_limit != 0 && memory_limit < fixed + cube) {
-    const std::uint64_t mib = (fixed + cube + (1 << 20) - 1) >> 20;
-    return Status::BadInput(
-        "a memory limit of {} MiB is too small for this mesh and grid: its bins and one cube "
-        "need {} MiB (use --memory-limit {}M or more)",
-        memory_limit >> 20, mib, mib);
-  }
-  const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  const std::size_t in_flight =
-      memory_limit == 0 ? tokens
-                        : std::clamp<std::size_t>((memory_limit - fixed) / cube, 1, tokens);
-
-  const VoxelizeOptions& options = voxelizer.options();
-  const bool shared = voxelizer.shared_color().has_value();
-  StatusOr<std::unique_ptr<ScratchFile>> keys = ScratchFile::Create(path);
-  if (!keys.ok()) return keys.status();
-  auto colors = ScratchArray<HalfRgba>::Create(path);
-  auto normals = ScratchArray<OctNormal>::Create(path);
-  auto coverage = ScratchArray<Half>::Create(path);
-  if (!colors.ok()) return colors.status();
-  if (!normals.ok()) return normals.status();
-  if (!coverage.ok()) return coverage.status();
-  std::uint64_t count = 0, previous = kNoPreviousKey;
-  Status made;
-  {
-    Progress::Stage stage(progress, "cubes", bins.cells.size());
-    struct Cube {
-      StatusOr<VoxelSet> voxels = Status::Ok();
-    };
-    made = ParallelInOrder<Cube>(
-        0, bins.cells.size(), in_flight,
-        [&](std::size_t i) {
-          const MortonCoord c = MortonDecode(bins.cells[i]);
-          const std::int64_t s = std::int64_t{1} << kCubeBits;
-          const IBox3 box{{c.x * s, c.y * s, c.z * s}, {c.x * s + s, c.y * s + s, c.z * s + s}};
-          return Cube{voxelizer.Voxelize(box, bins.Of(i))};
-        },
-        [&](Cube cube_made) -> Status {
-          stage.Advance(1);
-          if (!cube_made.voxels.ok()) return cube_made.voxels.status();
-          const VoxelSet& v = *cube_made.voxels;
-          if (v.keys.empty()) return Status::Ok();
-          DefaultInitVector<std::uint8_t> gaps;
-          AppendKeyGaps(std::span<const std::uint64_t>(v.keys), previous, gaps);
-          previous = v.keys.back();
-          count += v.keys.size();
-          stage.AddBytes(gaps.size());
-          SVOKIT_RETURN_IF_ERROR((*keys)->Append(gaps).status());
-          if (options.colors && !shared) SVOKIT_RETURN_IF_ERROR(colors->Append(v.colors));
-          if (options.normals) SVOKIT_RETURN_IF_ERROR(normals->Append(v.normals));
-          if (!v.coverage.empty()) SVOKIT_RETURN_IF_ERROR(coverage->Append(v.coverage));
-          return Status::Ok();
-        });
-  }
-  SVOKIT_RETURN_IF_ERROR(made);
-  if (count == 0) return Status::BadInput("{}: the mesh has no voxels in the grid", path.string());
-
-  container::Writer file(kVfragFormat, 0);
-  file.AddSection(kGrid, EncodeGridSection(voxelizer.grid(), options.mode));
-  file.AddSectionProduced(kKeys, [&](const container::Writer::Emit& emit) -> Status {
-    std::uint8_t head[sizeof(count)];
-    std::memcpy(head, &count, sizeof(count));
-    SVOKIT_RETURN_IF_ERROR(emit(head));
-    return EmitScratch(**keys, emit);
-  });
-  if (options.colors) {
-    if (shared) {
-      const HalfRgba one(*voxelizer.shared_color());
-      file.AddSection(kColors, std::vector<std::uint8_t>(
-                                   reinterpret_cast<const std::uint8_t*>(&one),
-                                   reinterpret_cast<const std::uint8_t*>(&one) + sizeof(one)));
-    } else {
-      file.AddSectionProduced(kColors, colors->Producer());
-    }
-  }
-  if (options.normals) file.AddSectionProduced(kNormals, normals->Producer());
-  if (options.colors || options.normals) file.AddSectionProduced(kCoverage, coverage->Producer());
-  file.AddSection(kMetadata, MetadataSection(meta));
-  {
-    Progress::Stage stage(progress, "write", 1);
-    SVOKIT_RETURN_IF_ERROR(file.WriteFile(path));
-  }
-  return count;
 }
 
 }  // namespace svokit

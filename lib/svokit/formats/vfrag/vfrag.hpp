@@ -4,10 +4,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "svokit/core/box.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
@@ -69,6 +72,59 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
                                           const std::filesystem::path& path,
                                           std::uint64_t memory_limit,
                                           Progress& progress = Progress::Silent());
+
+/// A .vfrag read a box of voxels at a time, never whole (svo-build --memory-limit): Open() makes
+/// one pass over the file, checking its keys and every section's checksum, and keeps where each
+/// cube of 2^cube_bits voxels that holds voxels begins; Read() then reads any box's voxels from
+/// the cubes it meets. Version 5 files (what svo-voxelize writes). Reads may run in parallel.
+class VfragCubes {
+ public:
+  static StatusOr<std::unique_ptr<VfragCubes>> Open(const std::filesystem::path& path,
+                                                    int cube_bits, VfragMetadata* meta = nullptr);
+  ~VfragCubes();
+  VfragCubes(const VfragCubes&) = delete;
+  VfragCubes& operator=(const VfragCubes&) = delete;
+
+  const GridTransform& grid() const { return grid_; }
+  VoxelMode mode() const { return mode_; }
+  bool has_colors() const { return colors_.present; }
+  bool has_normals() const { return normals_.present; }
+  /// The colour every voxel has, when the file stores one for all.
+  std::optional<HalfRgba> shared_color() const;
+  std::uint64_t voxel_count() const { return count_; }
+  /// The cubes that hold voxels, by Morton key at the cube size, ascending.
+  const std::vector<std::uint64_t>& cubes() const { return cube_keys_; }
+  /// Bytes held: the cubes' index.
+  std::size_t bytes() const { return cube_keys_.size() * (8 + sizeof(CubeStart)); }
+  /// The voxels inside `box`, keys ascending, with their attributes as ReadVfrag() gives them.
+  StatusOr<VoxelSet> Read(const IBox3& box) const;
+
+ private:
+  struct CubeStart {
+    std::uint64_t voxel = 0;     ///< index of its first voxel
+    std::uint64_t offset = 0;    ///< of its first key's varint, in the file
+    std::uint64_t previous = 0;  ///< the key before its first
+  };
+  struct Array {
+    bool present = false, shared = false;
+    std::uint64_t offset = 0;  ///< in the file
+  };
+  template <class T>
+  Status ReadRun(const Array& array, std::uint64_t first, std::uint64_t n,
+                 std::vector<T>& out) const;
+  VfragCubes() = default;
+
+  std::string name_;
+  int fd_ = -1;
+  int bits_ = 0;
+  GridTransform grid_;
+  VoxelMode mode_ = VoxelMode::kConservative;
+  std::uint64_t count_ = 0, keys_end_ = 0;
+  std::vector<std::uint64_t> cube_keys_;
+  std::vector<CubeStart> cube_starts_;
+  Array colors_, normals_, coverage_;
+  HalfRgba shared_color_value_{};
+};
 
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
