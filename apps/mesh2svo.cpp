@@ -62,8 +62,7 @@ int main(int argc, char** argv) {
     // machine's memory (held whole, ~48 B a voxel, ~100 with bricks): the same file either way.
     const bool may_go_by_pages = memory_limit.empty() && pages.empty();
     const double per_voxel = build.Options().brick_side == 0 ? 48.0 : 100.0;
-    const double whole_bytes =
-        may_go_by_pages ? per_voxel * EstimateVoxelCount(*mesh, *grid) : 0.0;
+    const double whole_bytes = may_go_by_pages ? per_voxel * EstimateVoxelCount(*mesh, *grid) : 0.0;
     const std::uint64_t half_machine = app::MachineMemory() / 2;
     const bool by_pages_by_default =
         may_go_by_pages && half_machine > 0 && whole_bytes > static_cast<double>(half_machine);

@@ -173,14 +173,16 @@ TEST(SvoBuildCli, BuildFromAVfragByPagesWritesTheSameFile) {
   const std::string vfrag = (dir / "t.vfrag").string(), svm = (dir / "t.svm").string();
   RunOk("svo-import", {Torus(), "-o", svm, "-q"});
   RunOk("svo-voxelize", {svm, "-o", vfrag, "-r", "300", "-q"});
-  for (const std::vector<std::string>& options : std::vector<std::vector<std::string>>{
-           {"--mesh", svm}, {"--bricks", "2", "--no-contours"}, {"--bricks", "none", "--mesh", svm}}) {
+  for (const std::vector<std::string>& options :
+       std::vector<std::vector<std::string>>{{"--mesh", svm},
+                                             {"--bricks", "2", "--no-contours"},
+                                             {"--bricks", "none", "--mesh", svm}}) {
     std::vector<std::string> whole = {vfrag, "-o", (dir / "whole.svo").string(), "-q"};
     whole.insert(whole.end(), options.begin(), options.end());
     RunOk("svo-build", whole);
     for (const char* threads : {"1", "2"}) {
-      std::vector<std::string> paged = {vfrag, "-o", (dir / "paged.svo").string(), "-q",
-                                        "--memory-limit", "64M", "-j", threads};
+      std::vector<std::string> paged = {
+          vfrag, "-o", (dir / "paged.svo").string(), "-q", "--memory-limit", "64M", "-j", threads};
       paged.insert(paged.end(), options.begin(), options.end());
       RunOk("svo-build", paged);
       EXPECT_TRUE(ReadText(dir / "paged.svo") == ReadText(dir / "whole.svo"))
@@ -197,9 +199,7 @@ TEST(SvoBuildCli, BuildFromAVfragByPagesWritesTheSameFile) {
     std::string damaged = bytes;
     damaged[at] = static_cast<char>(damaged[at] ^ 0x10);
     const std::filesystem::path bad = dir / "bad.vfrag";
-    {
-      std::ofstream(bad, std::ios::binary) << damaged;
-    }
+    { std::ofstream(bad, std::ios::binary) << damaged; }
     const ToolResult r = RunTool("svo-build", {bad.string(), "-o", (dir / "bad.svo").string(),
                                                "--no-contours", "--memory-limit", "64M", "-q"});
     EXPECT_EQ(r.exit_code, 2) << r.err;

@@ -57,8 +57,8 @@ TEST(SvoVoxelizeCli, MemoryLimitWritesTheSameFile) {
     whole.insert(whole.end(), options.begin(), options.end());
     ASSERT_EQ(RunTool("svo-voxelize", whole).exit_code, 0) << mesh;
     for (const char* threads : {"1", "2"}) {
-      std::vector<std::string> cubes = {mesh, "-o", (dir / "cubes.vfrag").string(), "-q",
-                                        "--memory-limit", "64M", "-j", threads};
+      std::vector<std::string> cubes = {
+          mesh, "-o", (dir / "cubes.vfrag").string(), "-q", "--memory-limit", "64M", "-j", threads};
       cubes.insert(cubes.end(), options.begin(), options.end());
       const ToolResult r = RunTool("svo-voxelize", cubes);
       ASSERT_EQ(r.exit_code, 0) << r.err;

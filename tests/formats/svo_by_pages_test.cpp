@@ -64,8 +64,7 @@ void ExpectSameFileAsWhole(const std::filesystem::path& mesh_path, std::uint32_t
   for (const std::uint64_t limit : {std::uint64_t{0}, std::uint64_t{64} << 20}) {
     for (const std::size_t threads : {1, 2}) {
       ThreadLimit limit_threads(threads);
-      auto stats =
-          BuildSvoByPages(**regions, options, meta, dir / "paged.svo", {}, limit);
+      auto stats = BuildSvoByPages(**regions, options, meta, dir / "paged.svo", {}, limit);
       ASSERT_TRUE(stats.ok()) << stats.status().message();
       EXPECT_EQ(stats->voxels, whole->voxel_count());
       EXPECT_TRUE(Bytes(dir / "paged.svo") == want) << "limit " << limit << ", threads " << threads;
@@ -80,8 +79,7 @@ void ExpectSameFileAsWhole(const std::filesystem::path& mesh_path, std::uint32_t
     std::vector<std::filesystem::path> parts;
     for (std::uint32_t k = n; k-- > 0;) {
       parts.push_back(dir / fmt::format("p{}.svopart", k));
-      auto made =
-          BuildSvoPart(**regions, options, meta, {k, n, 42}, parts.back(), {}, 0);
+      auto made = BuildSvoPart(**regions, options, meta, {k, n, 42}, parts.back(), {}, 0);
       ASSERT_TRUE(made.ok()) << made.status().message();
     }
     auto merged = MergeSvoParts(parts, dir / "merged.svo");

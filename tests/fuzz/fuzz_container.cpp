@@ -4,8 +4,14 @@
 // octree: the lenient reader reads it as the strict one does); a mesh must also pass the mesh
 // targets' checks.
 
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <string>
 #include <string_view>
 
+#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 
 #include "svokit/formats/svm/svm.hpp"
@@ -17,6 +23,46 @@ namespace svokit::fuzz {
 namespace {
 
 constexpr std::string_view kFormat = SVOKIT_FUZZ_FORMAT;
+
+// The cube-by-cube reader (svo-build --memory-limit) accepts a version-5 file exactly when the
+// whole reader does, and reads the same voxels from it, whole and a half at a time.
+void CheckCubes(std::span<const std::uint8_t> bytes, const StatusOr<VoxelSet>& whole) {
+  std::uint32_t version = 0;
+  if (bytes.size() >= 12) std::memcpy(&version, bytes.data() + 8, sizeof version);
+  if (version != kVfragFormat.version) return;
+  const int fd = ::memfd_create("fuzz.vfrag", MFD_CLOEXEC);
+  if (fd < 0) return;
+  if (::write(fd, bytes.data(), bytes.size()) != static_cast<ssize_t>(bytes.size())) {
+    ::close(fd);
+    return;
+  }
+  StatusOr<std::unique_ptr<VfragCubes>> cubes =
+      VfragCubes::Open("/proc/self/fd/" + std::to_string(fd), 2);
+  ::close(fd);  // the reader holds a descriptor of its own
+  if (cubes.ok() != whole.ok()) {
+    Fail(whole.ok() ? "VfragCubes refuses a .vfrag ReadVfrag accepts"
+                    : "VfragCubes accepts a .vfrag ReadVfrag refuses");
+  }
+  if (!cubes.ok() || !whole.ok()) return;
+  const auto& d = whole->grid.dims();
+  const std::int64_t half = (d[0] + 1) / 2;
+  for (const IBox3& box :
+       {IBox3{{0, 0, 0}, {d[0], d[1], d[2]}}, IBox3{{0, 0, 0}, {half, d[1], d[2]}}}) {
+    StatusOr<VoxelSet> read = (*cubes)->Read(box);
+    if (!read.ok()) Fail("VfragCubes cannot read a box of a file it opened");
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < whole->keys.size(); ++i) {
+      if (MortonDecode(whole->keys[i]).x >= static_cast<std::uint64_t>(box.hi.x)) continue;
+      const bool same = k < read->keys.size() && read->keys[k] == whole->keys[i] &&
+                        (whole->colors.empty() || read->color(k) == whole->color(i)) &&
+                        (whole->normals.empty() || read->normals[k] == whole->normals[i]) &&
+                        (whole->coverage.empty() || read->coverage[k] == whole->coverage[i]);
+      if (!same) Fail("VfragCubes reads other voxels than ReadVfrag");
+      ++k;
+    }
+    if (k != read->keys.size()) Fail("VfragCubes reads more voxels than ReadVfrag");
+  }
+}
 
 void Decode(std::span<const std::uint8_t> bytes) {
   if constexpr (kFormat == "svm") {
@@ -33,6 +79,7 @@ void Decode(std::span<const std::uint8_t> bytes) {
       if (!again.ok() || EncodeVfrag(*again, meta) != encoded)
         Fail("a decoded .vfrag does not round-trip");
     }
+    CheckCubes(bytes, set);
   } else {
     StatusOr<Svo> svo = DecodeSvo(bytes, "fuzz.svo");
     ExpectAccepted(svo.status(), bytes.size());

@@ -383,8 +383,8 @@ StatusOr<std::uint64_t> ScratchFile::Append(std::span<const std::uint8_t> bytes)
   const std::uint64_t at = size_;
   std::size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done,
-                               static_cast<off_t>(size_ + done));
+    const ssize_t n =
+        ::pwrite(fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(size_ + done));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       return Status::CannotWrite("{}: cannot write the build's scratch data ({})", of_.string(),

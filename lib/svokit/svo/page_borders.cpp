@@ -237,9 +237,11 @@ Status PatchPageFaces(SvoChunk& page, const SvoShape& shape,
                         ? PremultipliedSample{}
                         : DecodePremultiplied(it->second, color, normal);
         }
-        computed.emplace(packed, Encode(color, normal, brick_math::Tent([&](int x, int y, int z) -> const PremultipliedSample& {
-                                          return taps[x + 3 * y + 9 * z];
-                                        })));
+        computed.emplace(
+            packed, Encode(color, normal,
+                           brick_math::Tent([&](int x, int y, int z) -> const PremultipliedSample& {
+                             return taps[x + 3 * y + 9 * z];
+                           })));
       }
     }
     Status missing;

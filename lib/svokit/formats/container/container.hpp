@@ -161,9 +161,9 @@ class Frame {
   struct Section {
     Tag tag{};
     std::uint64_t offset = 0, size = 0;
-    bool in_file = false;  ///< inside the file and aligned; `bytes` is empty otherwise
-    bool loaded = false;   ///< the section filter asked for it (its checksum was verified)
-    bool crc_ok = false;   ///< loaded and its checksum matches
+    bool in_file = false;   ///< inside the file and aligned; `bytes` is empty otherwise
+    bool loaded = false;    ///< the section filter asked for it (its checksum was verified)
+    bool crc_ok = false;    ///< loaded and its checksum matches
     std::uint32_t crc = 0;  ///< the checksum the table states (for a reader that streams it)
     std::span<const std::uint8_t> bytes;
   };

@@ -92,9 +92,8 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
     const std::string name = fmt::format("{}: page {:#x}", built.name, key);
     StatusOr<std::vector<std::uint8_t>> bytes = built.page(i);
     if (!bytes.ok()) return bytes.status();
-    StatusOr<SvoChunk> page =
-        DecodeChunk(*bytes, frame.shape, {page_level, key, frame.depth - page_level + 1, true},
-                    name);
+    StatusOr<SvoChunk> page = DecodeChunk(
+        *bytes, frame.shape, {page_level, key, frame.depth - page_level + 1, true}, name);
     if (!page.ok()) return page.status();
     // The shells of the pages around, by their keys.
     const MortonCoord c = MortonDecode(key);
@@ -733,7 +732,8 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
       return Status::BadInput("{}: the parts' pages are not in key order", head.name);
     }
     const auto copy = [](std::span<const std::uint8_t> bytes) {
-      return StatusOr<std::vector<std::uint8_t>>(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
+      return StatusOr<std::vector<std::uint8_t>>(
+          std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
     };
     built.name = path.string();
     built.page = [&](std::size_t i) {
@@ -741,7 +741,7 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
     };
     built.shell = [&](std::size_t i) {
       return copy(where[i].part->shell_bytes.subspan(where[i].page->shell_offset,
-                                                       where[i].page->shell_size));
+                                                     where[i].page->shell_size));
     };
     const std::size_t in_flight =
         2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());

@@ -48,8 +48,8 @@ class ScratchArray {
   Status Append(std::span<const T> values) {
     if (values.empty()) return Status::Ok();
     if (count_ == 0) first_ = values[0];
-    uniform_ = uniform_ && std::all_of(values.begin(), values.end(),
-                                       [&](const T& v) { return v == first_; });
+    uniform_ = uniform_ &&
+               std::all_of(values.begin(), values.end(), [&](const T& v) { return v == first_; });
     count_ += values.size();
     return file_
         ->Append({reinterpret_cast<const std::uint8_t*>(values.data()), values.size_bytes()})
@@ -174,15 +174,14 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
   return count;
 }
 
-
 namespace {
 
 // Reads `size` bytes at `offset` of `fd`; an error names the file.
 Status ReadAt(int fd, const std::string& name, std::uint64_t offset, std::span<std::uint8_t> out) {
   std::size_t done = 0;
   while (done < out.size()) {
-    const ssize_t n = ::pread(fd, out.data() + done, out.size() - done,
-                              static_cast<off_t>(offset + done));
+    const ssize_t n =
+        ::pread(fd, out.data() + done, out.size() - done, static_cast<off_t>(offset + done));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       return Status::BadInput("{}: cannot read ({})", name,
@@ -253,7 +252,8 @@ StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::pa
   cubes->fd_ = *fd;
 
   // The keys, once: checked as ReadVfrag checks them, and where each cube's run begins.
-  if (keys->size < sizeof(std::uint64_t)) return Status::BadInput("{}: KEYS section is truncated", name);
+  if (keys->size < sizeof(std::uint64_t))
+    return Status::BadInput("{}: KEYS section is truncated", name);
   std::uint64_t count = 0;
   SVOKIT_RETURN_IF_ERROR(ReadAt(cubes->fd_, name, keys->offset,
                                 {reinterpret_cast<std::uint8_t*>(&count), sizeof(count)}));
@@ -340,9 +340,9 @@ StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::pa
   SVOKIT_RETURN_IF_ERROR(array(kNormals, sizeof(OctNormal), cubes->normals_));
   SVOKIT_RETURN_IF_ERROR(array(kCoverage, sizeof(Half), cubes->coverage_));
   if (cubes->colors_.shared) {
-    SVOKIT_RETURN_IF_ERROR(ReadAt(cubes->fd_, name, cubes->colors_.offset,
-                                  {reinterpret_cast<std::uint8_t*>(&cubes->shared_color_value_),
-                                   sizeof(HalfRgba)}));
+    SVOKIT_RETURN_IF_ERROR(
+        ReadAt(cubes->fd_, name, cubes->colors_.offset,
+               {reinterpret_cast<std::uint8_t*>(&cubes->shared_color_value_), sizeof(HalfRgba)}));
   }
   return cubes;
 }
@@ -369,7 +369,8 @@ StatusOr<VoxelSet> VfragCubes::Read(const IBox3& box) const {
   out.grid = grid_;
   out.mode = mode_;
   const auto& dims = grid_.dims();
-  const std::int64_t lo[3] = {std::max<std::int64_t>(box.lo.x, 0), std::max<std::int64_t>(box.lo.y, 0),
+  const std::int64_t lo[3] = {std::max<std::int64_t>(box.lo.x, 0),
+                              std::max<std::int64_t>(box.lo.y, 0),
                               std::max<std::int64_t>(box.lo.z, 0)};
   const std::int64_t hi[3] = {std::min<std::int64_t>(box.hi.x, dims[0]),
                               std::min<std::int64_t>(box.hi.y, dims[1]),
@@ -380,9 +381,9 @@ StatusOr<VoxelSet> VfragCubes::Read(const IBox3& box) const {
   for (std::int64_t z = lo[2] >> bits_; z <= (hi[2] - 1) >> bits_; ++z) {
     for (std::int64_t y = lo[1] >> bits_; y <= (hi[1] - 1) >> bits_; ++y) {
       for (std::int64_t x = lo[0] >> bits_; x <= (hi[0] - 1) >> bits_; ++x) {
-        const std::uint64_t key = MortonEncode(static_cast<std::uint32_t>(x),
-                                               static_cast<std::uint32_t>(y),
-                                               static_cast<std::uint32_t>(z));
+        const std::uint64_t key =
+            MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                         static_cast<std::uint32_t>(z));
         const auto it = std::lower_bound(cube_keys_.begin(), cube_keys_.end(), key);
         if (it != cube_keys_.end() && *it == key) {
           runs.push_back(static_cast<std::size_t>(it - cube_keys_.begin()));
@@ -408,7 +409,8 @@ StatusOr<VoxelSet> VfragCubes::Read(const IBox3& box) const {
         n) {
       return Status::BadInput("{}: the file changed while it was read", name_);
     }
-    if (colors_.present && !colors_.shared) SVOKIT_RETURN_IF_ERROR(ReadRun(colors_, start.voxel, n, colors));
+    if (colors_.present && !colors_.shared)
+      SVOKIT_RETURN_IF_ERROR(ReadRun(colors_, start.voxel, n, colors));
     if (normals_.present) SVOKIT_RETURN_IF_ERROR(ReadRun(normals_, start.voxel, n, normals));
     if (coverage_.present) SVOKIT_RETURN_IF_ERROR(ReadRun(coverage_, start.voxel, n, coverage));
     for (std::uint64_t j = 0; j < n; ++j) {
