@@ -15,6 +15,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <new>
@@ -241,14 +242,6 @@ inline void PrintTimes(const Progress& progress) {
   fmt::print("time        {}total {:.2f} s\n", times, total);
 }
 
-/// The machine's physical memory in bytes (0 if unknown).
-inline std::uint64_t MachineMemory() {
-  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0
-             ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size)
-             : 0;
-}
-
 /// "K/N": part K (0-based) of N.
 inline StatusOr<SvoPartOf> ParsePart(const std::string& option, const std::string& text) {
   SvoPartOf part;
@@ -300,6 +293,55 @@ inline StatusOr<std::uint64_t> ParseByteSize(const std::string& option, const st
                             text);
   }
   return value << shift;
+}
+
+/// "4.0 GiB" or "120 MiB".
+inline std::string ByteSizeText(double bytes) {
+  return bytes >= 1073741824.0 ? fmt::format("{:.1f} GiB", bytes / 1073741824.0)
+                               : fmt::format("{:.0f} MiB", bytes / 1048576.0);
+}
+
+/// The summary's words for a run within a memory limit: "within 4.0 GiB", and when the limit is
+/// the default (half the machine), what the whole run would have needed.
+inline std::string WithinLimitText(std::uint64_t limit, bool by_default, double whole_bytes) {
+  return fmt::format("within {}{}", ByteSizeText(static_cast<double>(limit)),
+                     by_default ? fmt::format(" (half the machine: whole, it would need ~{})",
+                                              ByteSizeText(whole_bytes))
+                                : "");
+}
+
+/// The memory the tools may count on, in bytes (0 if unknown): the machine's physical memory, or
+/// less where the process's cgroup (a container's or batch job's allocation) allows less; the
+/// environment variable SVOKIT_MACHINE_MEMORY (a size such as 8G) overrides both.
+inline std::uint64_t MachineMemory() {
+  if (const char* env = std::getenv("SVOKIT_MACHINE_MEMORY"); env != nullptr) {
+    if (const StatusOr<std::uint64_t> v = ParseByteSize("SVOKIT_MACHINE_MEMORY", env); v.ok()) {
+      return *v;
+    }
+  }
+  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+  std::uint64_t memory = pages > 0 && size > 0
+                             ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size)
+                             : 0;
+  // The cgroup's limit: v2 "0::/PATH" in /proc/self/cgroup, limit in /sys/fs/cgroup/PATH/
+  // memory.max; v1 "N:memory:/PATH", in /sys/fs/cgroup/memory/PATH/memory.limit_in_bytes (or at
+  // the top of that hierarchy, where a container sees its own). "max" or a huge value: none.
+  std::ifstream self("/proc/self/cgroup");
+  std::string line;
+  std::vector<std::string> limits = {"/sys/fs/cgroup/memory/memory.limit_in_bytes"};
+  while (std::getline(self, line)) {
+    if (line.starts_with("0::"))
+      limits.push_back("/sys/fs/cgroup" + line.substr(3) + "/memory.max");
+    if (const std::size_t at = line.find(":memory:"); at != std::string::npos) {
+      limits.push_back("/sys/fs/cgroup/memory" + line.substr(at + 8) + "/memory.limit_in_bytes");
+    }
+  }
+  for (const std::string& path : limits) {
+    std::ifstream file(path);
+    std::uint64_t allowed = 0;
+    if (file >> allowed && allowed > 0 && (memory == 0 || allowed < memory)) memory = allowed;
+  }
+  return memory;
 }
 
 /// Prints each of `warnings` as one line on stderr.

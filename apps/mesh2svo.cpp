@@ -102,12 +102,8 @@ int main(int argc, char** argv) {
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
       print_mesh_and_grid();
       if (*limit > 0) {
-        fmt::print("build       by pages within {:.1f} GiB{}\n",
-                   static_cast<double>(*limit) / 1073741824.0,
-                   by_pages_by_default
-                       ? fmt::format(" (half the machine: whole, it would need ~{:.0f} GiB)",
-                                     whole_bytes / 1073741824.0)
-                       : "");
+        fmt::print("build       by pages {}\n",
+                   app::WithinLimitText(*limit, by_pages_by_default, whole_bytes));
       }
       fmt::print("voxels      {} ({})\n", written->voxels, voxelize.ModeName());
       app::PrintFileSummary(*written);

@@ -44,14 +44,31 @@ int main(int argc, char** argv) {
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
+    // Without a limit, a file whose voxels would not fit whole in half the machine's memory
+    // (~48 B a voxel held whole, ~100 with bricks) is built by pages within that half.
+    StatusOr<std::uint64_t> limit = std::uint64_t{0};
+    double whole_bytes = 0;
+    bool by_default = false;
     if (!memory_limit.empty()) {
-      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+      limit = app::ParseByteSize("--memory-limit", memory_limit);
       if (!limit.ok()) return app::Fail(tool, limit.status());
-      VfragMetadata source;
-      StatusOr<std::unique_ptr<VfragCubes>> cubes = app::RunStage(
+    } else if (const StatusOr<std::uint64_t> count = VfragVoxelCount(input); count.ok()) {
+      whole_bytes = (build.Options().brick_side == 0 ? 48.0 : 100.0) * static_cast<double>(*count);
+      const std::uint64_t half_machine = app::MachineMemory() / 2;
+      by_default = half_machine > 0 && whole_bytes > static_cast<double>(half_machine);
+      if (by_default) limit = half_machine;
+    }
+    VfragMetadata source;
+    std::unique_ptr<VfragCubes> cubes;
+    if (*limit > 0) {
+      StatusOr<std::unique_ptr<VfragCubes>> opened = app::RunStage(
           progress, "index", [&] { return VfragCubes::Open(input, kPageSideBits, &source); });
-      if (!cubes.ok()) return app::Fail(tool, cubes.status());
-      const VfragCubes& vfrag = **cubes;
+      // A file only the whole reader reads (an older version) goes whole when nobody asked.
+      if (!opened.ok() && !by_default) return app::Fail(tool, opened.status());
+      if (opened.ok()) cubes = std::move(*opened);
+    }
+    if (cubes) {
+      const VfragCubes& vfrag = *cubes;
       std::optional<Mesh> mesh;
       if (!mesh_path.empty()) {
         StatusOr<Mesh> m =
@@ -73,15 +90,14 @@ int main(int argc, char** argv) {
                           *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
       fmt::print("input       {} ({} voxels)\n", input.string(), vfrag.voxel_count());
-      fmt::print("octree      depth {}, bricks {}, contours {}, by pages within {:.1f} GiB\n",
+      fmt::print("octree      depth {}, bricks {}, contours {}, by pages {}\n",
                  OctreeDepth(vfrag.grid()), build.bricks, build.contours ? "on" : "off",
-                 static_cast<double>(*limit) / 1073741824.0);
+                 app::WithinLimitText(*limit, by_default, whole_bytes));
       app::PrintFileSummary(*written);
       app::PrintTimes(progress);
       fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
       return 0;
     }
-    VfragMetadata source;
     StatusOr<VoxelSet> voxels =
         app::RunStage(progress, "read", [&] { return ReadVfrag(input, &source); });
     if (!voxels.ok()) return app::Fail(tool, voxels.status());

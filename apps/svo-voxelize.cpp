@@ -51,13 +51,27 @@ int main(int argc, char** argv) {
     std::size_t voxel_count = 0;
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
+    // Without a limit, a .vfrag whose voxels would not fit in half the machine's memory (~8 B a
+    // voxel, ~16 with attributes) is written cube by cube within that half.
+    StatusOr<std::uint64_t> limit = std::uint64_t{0};
+    double whole_bytes = 0;
+    std::string by_cubes;  // the summary's line for a file written cube by cube
     if (!memory_limit.empty()) {
       if (ext != "vfrag") {
         return app::Fail(tool, Status::BadInput("--memory-limit writes .vfrag files only, not {}",
                                                 output.string()));
       }
-      const StatusOr<std::uint64_t> limit = app::ParseByteSize("--memory-limit", memory_limit);
+      limit = app::ParseByteSize("--memory-limit", memory_limit);
       if (!limit.ok()) return app::Fail(tool, limit.status());
+    } else if (ext == "vfrag") {
+      const VoxelizeOptions& o = voxelize.Options();
+      whole_bytes = (o.colors || o.normals ? 16.0 : 8.0) * EstimateVoxelCount(*mesh, *grid);
+      const std::uint64_t half_machine = app::MachineMemory() / 2;
+      if (half_machine > 0 && whole_bytes > static_cast<double>(half_machine)) {
+        limit = half_machine;
+      }
+    }
+    if (*limit > 0) {
       StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
           RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
       if (!regions.ok()) return app::Fail(tool, regions.status().WithContext(input.string()));
@@ -65,6 +79,8 @@ int main(int argc, char** argv) {
       StatusOr<std::uint64_t> count = WriteVfragByCubes(**regions, meta, output, *limit, progress);
       if (!count.ok()) return app::Fail(tool, count.status().WithContext(input.string()));
       voxel_count = *count;
+      by_cubes = "voxelize    by cubes " +
+                 app::WithinLimitText(*limit, memory_limit.empty(), whole_bytes) + "\n";
     } else if (ext == "vfrag") {
       // Keys packed as they are found, everything written in place into the file's mapped
       // sections. Methods and thread counts give the same file, byte for byte: they are not
@@ -90,6 +106,7 @@ int main(int argc, char** argv) {
     const auto& d = grid->dims();
     fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
     fmt::print("grid        {} x {} x {} voxels of {:.9g}\n", d[0], d[1], d[2], grid->voxel_size());
+    fmt::print("{}", by_cubes);
     fmt::print("voxels      {} ({})\n", voxel_count, voxelize.ModeName());
     fmt::print("output      {}\n", output.string());
     return 0;

@@ -209,6 +209,50 @@ TEST(SvoBuildCli, BuildFromAVfragByPagesWritesTheSameFile) {
   }
 }
 
+// Without --memory-limit, each tool goes page (or cube) by page when the whole run would not fit
+// in half the memory it may count on (SVOKIT_MACHINE_MEMORY stands in for a small machine or
+// a batch job's allocation), says so, and writes the same file.
+TEST(SvoBuildCli, ASmallMachineGoesByPagesByItselfToTheSameFile) {
+  TempDir dir;
+  const std::string vfrag = (dir / "t.vfrag").string();
+  const auto small = [](const char* size) {
+    return RunOptions{120, 0, 0, {"env", std::string("SVOKIT_MACHINE_MEMORY=") + size}};
+  };
+  struct Case {
+    std::string tool;
+    std::vector<std::string> args;
+    const char* machine;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"svo-voxelize",
+       {Torus(), "-r", "1000", "-o", "{out}"},
+       "32M",
+       "voxelize    by cubes within"},
+      {"mesh2svo", {Torus(), "-r", "300", "-o", "{out}"}, "40M", "build       by pages within"},
+      {"svo-build", {"{vfrag}", "--no-contours", "-o", "{out}"}, "40M", "by pages within"}};
+  RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "300", "-q"});
+  for (const Case& c : cases) {
+    const std::string ext = c.tool == "svo-voxelize" ? ".vfrag" : ".svo";
+    std::vector<std::string> whole, small_run;
+    for (const std::string& a : c.args) {
+      const std::string v = a == "{vfrag}" ? vfrag : a;
+      whole.push_back(v == "{out}" ? (dir / ("whole" + ext)).string() : v);
+      small_run.push_back(v == "{out}" ? (dir / ("small" + ext)).string() : v);
+    }
+    RunOk(c.tool, whole);
+    const ToolResult r = RunTool(c.tool, small_run, small(c.machine));
+    ASSERT_EQ(r.exit_code, 0) << c.tool << ": " << r.err;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << c.tool << ": " << r.out;
+    EXPECT_NE(r.out.find("half the machine"), std::string::npos) << r.out;
+    EXPECT_TRUE(ReadText(dir / ("small" + ext)) == ReadText(dir / ("whole" + ext))) << c.tool;
+    // A machine far larger: the whole run, as before.
+    const ToolResult big = RunTool(c.tool, small_run, small("1T"));
+    ASSERT_EQ(big.exit_code, 0) << big.err;
+    EXPECT_EQ(big.out.find("half the machine"), std::string::npos) << big.out;
+  }
+}
+
 // mesh2svo --pages K/N as separate jobs, then svo-merge: the whole build's file. A wrong set of
 // parts, a part number that does not exist or a part file for an .svo are one-line errors.
 TEST(SvoBuildCli, PartsMergeIntoTheSameFile) {

@@ -73,6 +73,9 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
                                           std::uint64_t memory_limit,
                                           Progress& progress = Progress::Silent());
 
+/// The voxel count a .vfrag states, without reading its voxels: for choosing how to read it.
+StatusOr<std::uint64_t> VfragVoxelCount(const std::filesystem::path& path);
+
 /// A .vfrag read a box of voxels at a time, never whole (svo-build --memory-limit): Open() makes
 /// one pass over the file, checking its keys and every section's checksum, and keeps where each
 /// cube of 2^cube_bits voxels that holds voxels begins; Read() then reads any box's voxels from

@@ -214,6 +214,22 @@ Status StreamSection(int fd, const std::string& name, const container::Frame::Se
 
 }  // namespace
 
+StatusOr<std::uint64_t> VfragVoxelCount(const std::filesystem::path& path) {
+  const auto none = [](container::Tag, const void*) { return false; };
+  StatusOr<container::Frame> frame = container::Frame::Open(path, kVfragFormat, none);
+  if (!frame.ok()) return frame.status();
+  const container::Frame::Section* keys = frame->Find(kKeys);
+  if (keys == nullptr)
+    return Status::BadInput("{}: required section 'KEYS' is missing", frame->name());
+  if (frame->version() < 3) return keys->size / sizeof(std::uint64_t);  // raw keys
+  std::uint64_t count = 0;
+  if (keys->bytes.size() < sizeof(count)) {
+    return Status::BadInput("{}: KEYS section is truncated", frame->name());
+  }
+  std::memcpy(&count, keys->bytes.data(), sizeof(count));
+  return count;
+}
+
 StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::path& path,
                                                        int cube_bits, VfragMetadata* meta) {
   // The frame, with only the small sections loaded (and checked); the large ones are streamed.
