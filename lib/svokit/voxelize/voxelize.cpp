@@ -30,6 +30,9 @@ using voxelize_detail::VoxelOutput;
 constexpr std::int64_t kCoordinateLimit = std::int64_t{1} << (22 + kFixedPointBits);
 // Voxel sets beyond 2³² voxels (32 GiB of keys alone) are refused.
 constexpr double kMaxVoxels = 4294967296.0;
+// What a voxelization region by region (RegionVoxelizer) may make: 2^40, a hundred times a
+// 65536³ scan.
+constexpr double kMaxRegionVoxels = 1099511627776.0;
 // Fragment path: a triangle's footprint is cut into tiles of this many columns per side.
 constexpr std::int64_t kTileColumns = 32;
 constexpr std::size_t kTilesPerTask = 16;
@@ -357,6 +360,13 @@ StatusOr<std::unique_ptr<RegionVoxelizer>> RegionVoxelizer::Create(const Mesh& m
                                                                    const VoxelizeOptions& options) {
   StatusOr<std::vector<FixedPoint3>> snapped = SnapChecked(mesh, grid);
   if (!snapped.ok()) return snapped.status();
+  // Region by region nothing is held, but a grid can still be beyond any disk or day: refused up
+  // front, as Voxelize() refuses what memory could not hold (65536³ of a scan: ~10¹⁰ voxels).
+  if (const double estimate = EstimateVoxelCount(mesh, grid); estimate > kMaxRegionVoxels) {
+    return Status::BadInput(
+        "this grid would hold about {:.3g} voxels (limit {:.3g}); use a coarser resolution",
+        estimate, kMaxRegionVoxels);
+  }
   std::unique_ptr<RegionVoxelizer> r(new RegionVoxelizer(mesh, grid, options));
   r->vertices_ = std::move(*snapped);
   r->sampler_ =

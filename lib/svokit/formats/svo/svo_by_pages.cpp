@@ -293,18 +293,26 @@ class PagePlan {
   // How many pages may be in flight: held whatever the page, `fixed` bytes (the snapped mesh
   // and `what`); then each page in flight, at most a surface's voxels across its cube with their
   // attributes and nodes (~40 B a voxel; with bricks, their samples too).
+  // The top levels' contours are fitted before the pages, to all triangles at once (~320 B a
+  // triangle at their peak).
   Status SetLimit(std::uint64_t fixed, std::uint64_t memory_limit, const char* what) {
     const std::size_t tokens =
         2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     const std::uint64_t per_voxel = frame_.shape.brick_side == 0 ? 40 : 160;
     const std::uint64_t page = per_voxel * 4 << (2 * bits_);
-    const std::uint64_t smallest = fixed + page;
+    const std::uint64_t top =
+        contours_ && page_level_ > 0 ? std::uint64_t{320} * mesh_->triangles.size() : 0;
+    const std::uint64_t smallest = fixed + std::max(page, top);
     if (memory_limit != 0 && memory_limit < smallest) {
       const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
       return Status::BadInput(
-          "a memory limit of {} MiB is too small for this mesh and grid: {} and one page need "
-          "{} MiB (use --memory-limit {}M or more)",
-          memory_limit >> 20, what, mib, mib);
+          "a memory limit of {} MiB is too small for this mesh and grid: {} and {} need {} MiB "
+          "(use --memory-limit {}M or more)",
+          memory_limit >> 20, what,
+          top > page ? fmt::format("the top levels' contours ({} triangles at once)",
+                                   mesh_->triangles.size())
+                     : std::string("one page"),
+          mib, mib);
     }
     in_flight_ = memory_limit == 0
                      ? tokens
