@@ -26,7 +26,8 @@ constexpr std::string_view kFormat = SVOKIT_FUZZ_FORMAT;
 
 // The cube-by-cube reader (svo-build --memory-limit) accepts a version-5 file exactly when the
 // whole reader does, and reads the same voxels from it, whole and a half at a time.
-void CheckCubes(std::span<const std::uint8_t> bytes, const StatusOr<VoxelSet>& whole) {
+[[maybe_unused]] void CheckCubes(std::span<const std::uint8_t> bytes,
+                                 const StatusOr<VoxelSet>& whole) {
   std::uint32_t version = 0;
   if (bytes.size() >= 12) std::memcpy(&version, bytes.data() + 8, sizeof version);
   if (version != kVfragFormat.version) return;
