@@ -67,26 +67,33 @@ int main(int argc, char** argv) {
       if (!opened.ok() && !by_default) return app::Fail(tool, opened.status());
       if (opened.ok()) cubes = std::move(*opened);
     }
+    // Read whole otherwise; either way the mesh is imported into the file's grid.
+    StatusOr<VoxelSet> voxels = VoxelSet{};
+    if (!cubes) {
+      voxels = app::RunStage(progress, "read", [&] { return ReadVfrag(input, &source); });
+      if (!voxels.ok()) return app::Fail(tool, voxels.status());
+    }
+    const GridTransform& grid = cubes ? cubes->grid() : voxels->grid;
+    std::optional<Mesh> mesh;
+    if (!mesh_path.empty()) {
+      StatusOr<Mesh> m =
+          app::ImportSourceMesh(progress, mesh_path, grid, input, "that was voxelized");
+      if (!m.ok()) return app::Fail(tool, m.status());
+      mesh = std::move(*m);
+    }
+    const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
     if (cubes) {
       const VfragCubes& vfrag = *cubes;
-      std::optional<Mesh> mesh;
-      if (!mesh_path.empty()) {
-        StatusOr<Mesh> m =
-            app::ImportSourceMesh(progress, mesh_path, vfrag.grid(), input, "that was voxelized");
-        if (!m.ok()) return app::Fail(tool, m.status());
-        mesh = std::move(*m);
-      }
-      const BoxVoxels voxels{vfrag.grid(),
-                             vfrag.mode(),
-                             vfrag.has_colors(),
-                             vfrag.has_normals(),
-                             vfrag.shared_color(),
-                             vfrag.cubes(),
-                             [&vfrag](const IBox3& box) { return vfrag.Read(box); },
-                             vfrag.bytes()};
-      const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
+      const BoxVoxels paged{vfrag.grid(),
+                            vfrag.mode(),
+                            vfrag.has_colors(),
+                            vfrag.has_normals(),
+                            vfrag.shared_color(),
+                            vfrag.cubes(),
+                            [&vfrag](const IBox3& box) { return vfrag.Read(box); },
+                            vfrag.bytes()};
       StatusOr<SvoFileStats> written =
-          BuildSvoByPages(voxels, mesh ? &*mesh : nullptr, build.Options(), meta, output,
+          BuildSvoByPages(paged, mesh ? &*mesh : nullptr, build.Options(), meta, output,
                           *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
       fmt::print("input       {} ({} voxels)\n", input.string(), vfrag.voxel_count());
@@ -98,17 +105,6 @@ int main(int argc, char** argv) {
       fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
       return 0;
     }
-    StatusOr<VoxelSet> voxels =
-        app::RunStage(progress, "read", [&] { return ReadVfrag(input, &source); });
-    if (!voxels.ok()) return app::Fail(tool, voxels.status());
-    std::optional<Mesh> mesh;
-    if (!mesh_path.empty()) {
-      StatusOr<Mesh> m =
-          app::ImportSourceMesh(progress, mesh_path, voxels->grid, input, "that was voxelized");
-      if (!m.ok()) return app::Fail(tool, m.status());
-      mesh = std::move(*m);
-    }
-    const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
     StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), mesh ? &*mesh : nullptr,
                                                build.Options(), meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));

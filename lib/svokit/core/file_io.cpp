@@ -399,18 +399,35 @@ StatusOr<std::uint64_t> ScratchFile::Append(std::span<const std::uint8_t> bytes)
 StatusOr<std::vector<std::uint8_t>> ScratchFile::Read(std::uint64_t offset,
                                                       std::uint64_t size) const {
   std::vector<std::uint8_t> bytes(size);
-  std::size_t done = 0;
-  while (done < size) {
-    const ssize_t n =
-        ::pread(fd_, bytes.data() + done, size - done, static_cast<off_t>(offset + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      return Status::CannotWrite("{}: cannot read the build's scratch data back ({})", of_.string(),
-                                 n < 0 ? std::strerror(errno) : "it is shorter than written");
-    }
-    done += static_cast<std::size_t>(n);
+  if (const std::string why = ReadFullyAt(fd_, offset, bytes); !why.empty()) {
+    return Status::CannotWrite("{}: cannot read the build's scratch data back ({})", of_.string(),
+                               why);
   }
   return bytes;
+}
+
+Status ScratchFile::ForEachPiece(
+    const std::function<Status(std::span<const std::uint8_t>)>& each) const {
+  constexpr std::uint64_t kPiece = std::uint64_t{4} << 20;
+  for (std::uint64_t at = 0; at < size_; at += kPiece) {
+    StatusOr<std::vector<std::uint8_t>> piece = Read(at, std::min(kPiece, size_ - at));
+    if (!piece.ok()) return piece.status();
+    SVOKIT_RETURN_IF_ERROR(each(*piece));
+  }
+  return Status::Ok();
+}
+
+std::string ReadFullyAt(int fd, std::uint64_t offset, std::span<std::uint8_t> out) {
+  std::size_t done = 0;
+  while (done < out.size()) {
+    const ssize_t n =
+        ::pread(fd, out.data() + done, out.size() - done, static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return std::strerror(errno);
+    if (n == 0) return "the file is shorter than stated";
+    done += static_cast<std::size_t>(n);
+  }
+  return {};
 }
 
 }  // namespace svokit

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -109,6 +110,10 @@ std::string TemporaryName(const std::string& name, long pid, std::string_view un
 /// processes of this host that no longer run; other hosts' and live processes' are kept.
 void RemoveStaleTemporaries(int dir_fd, const std::string& name);
 
+/// Reads out.size() bytes at `offset` of descriptor `fd` (pread, resumed after a signal): an empty
+/// string, or why not (the system's reason, or "the file is shorter than stated").
+std::string ReadFullyAt(int fd, std::uint64_t offset, std::span<std::uint8_t> out);
+
 /// A file a process writes and reads back (one pass of a build for the next), beside output `of`:
 /// unnamed from the start (O_TMPFILE, or unlinked at once), so nothing is left whatever happens
 /// to the process. Errors name the output: a full disk is "OUT: cannot write the build's scratch
@@ -124,6 +129,8 @@ class ScratchFile {
   StatusOr<std::uint64_t> Append(std::span<const std::uint8_t> bytes);
   /// The `size` bytes at `offset`.
   StatusOr<std::vector<std::uint8_t>> Read(std::uint64_t offset, std::uint64_t size) const;
+  /// Hands every byte written, in pieces of a few MB, to `each`; stops at its first error.
+  Status ForEachPiece(const std::function<Status(std::span<const std::uint8_t>)>& each) const;
   std::uint64_t size() const { return size_; }
 
  private:

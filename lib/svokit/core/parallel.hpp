@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "svokit/core/status.hpp"
 
@@ -50,6 +52,32 @@ T OrderedReduce(std::size_t n, std::size_t chunk, T init, const Map& map, const 
   });
   for (auto& p : parts) combine(init, p);
   return init;
+}
+
+/// The most items a streaming run (ParallelInOrder) keeps in flight: twice the worker threads,
+/// so every thread has the next one while the slowest is handed on.
+inline std::size_t MostInFlight() {
+  return 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+}
+
+/// How many items of `item` bytes a streaming run (ParallelInOrder) may have in flight within
+/// `limit` bytes (0: no limit), besides `fixed` bytes it holds throughout: as many as fit, at most
+/// MostInFlight(). A limit below fixed + `least` (what the run needs at its peak, at
+/// least one item) is an error naming the smallest limit that works; `needs` says what needs it
+/// ("its bins and one page").
+inline StatusOr<std::size_t> InFlightWithin(std::uint64_t limit, std::uint64_t fixed,
+                                            std::uint64_t item, std::uint64_t least,
+                                            std::string_view needs) {
+  const std::size_t most = MostInFlight();
+  if (limit == 0) return most;
+  if (limit < fixed + least) {
+    const std::uint64_t mib = (fixed + least + (1 << 20) - 1) >> 20;
+    return Status::BadInput(
+        "a memory limit of {} MiB is too small for this mesh and grid: {} need {} MiB (use "
+        "--memory-limit {}M or more)",
+        limit >> 20, needs, mib, mib);
+  }
+  return std::clamp<std::size_t>((limit - fixed) / item, 1, most);
 }
 
 /// Items [first, end) made by make(i) → Made in parallel, at most `in_flight` at a time, and handed

@@ -8,6 +8,7 @@
 
 #include "svokit/svo/bricks.hpp"
 #include "svokit/svo/sample_codec.hpp"
+#include "svokit/svo/sample_filter.hpp"
 
 namespace svokit::brick_math {
 
@@ -32,6 +33,18 @@ struct EncodedSample {
   std::uint32_t color = 0;
   std::uint16_t normal = 0;
 };
+
+/// Sample `at` of a level's distinct samples (LevelSamples: planes absent without colour or
+/// normals), and back.
+inline EncodedSample LoadSample(const LevelSamples& in, std::uint64_t at) {
+  return {in.opacity[at], in.color.empty() ? 0u : in.color[at],
+          in.normal.empty() ? std::uint16_t{0} : in.normal[at]};
+}
+inline void StoreSample(const EncodedSample& e, std::uint64_t at, LevelSamples& out) {
+  out.opacity[at] = e.opacity;
+  if (!out.color.empty()) out.color[at] = e.color;
+  if (!out.normal.empty()) out.normal[at] = e.normal;
+}
 
 /// A sample whose opacity rounds to 0 is empty: no colour, no normal.
 inline EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {

@@ -14,6 +14,8 @@ namespace {
 using brick_math::DecodePremultiplied;
 using brick_math::Encode;
 using brick_math::EncodedSample;
+using brick_math::LoadSample;
+using brick_math::StoreSample;
 
 // A lattice point of one level (sample k of node n is (side − 1)·n + k), packed 21 bits an axis.
 struct Point {
@@ -111,17 +113,6 @@ void Append(LevelSamples& to, const LevelSamples& from, std::uint64_t at) {
   if (!from.normal.empty()) to.normal.push_back(from.normal[at]);
 }
 
-EncodedSample Load(const LevelSamples& in, std::uint64_t at) {
-  return {in.opacity[at], in.color.empty() ? 0u : in.color[at],
-          in.normal.empty() ? std::uint16_t{0} : in.normal[at]};
-}
-
-void Store(const EncodedSample& e, std::uint64_t at, LevelSamples& out) {
-  out.opacity[at] = e.opacity;
-  if (!out.color.empty()) out.color[at] = e.color;
-  if (!out.normal.empty()) out.normal[at] = e.normal;
-}
-
 // One level of a shell: the face points its nodes hold (with their samples at the level above the
 // voxels, which the page has right) and its samples one step inside its faces.
 struct ShellLevel {
@@ -211,11 +202,11 @@ Status PatchPageFaces(SvoChunk& page, const SvoShape& shape,
       const ShellLevel& level = shell[l - top];
       if (faces) {
         for (std::size_t i = 0; i < level.face.size(); ++i) {
-          known.emplace(level.face[i], Load(level.face_values, i));
+          known.emplace(level.face[i], LoadSample(level.face_values, i));
         }
       }
       for (std::size_t i = 0; i < level.layer.size(); ++i) {
-        known.emplace(level.layer[i], Load(level.layer_values, i));
+        known.emplace(level.layer[i], LoadSample(level.layer_values, i));
       }
     }
   };
@@ -253,7 +244,7 @@ Status PatchPageFaces(SvoChunk& page, const SvoShape& shape,
         missing = Status::BadInput("{}: its shell does not hold a point of its faces", name);
         return;
       }
-      Store(it->second, at, samples);
+      StoreSample(it->second, at, samples);
     });
     SVOKIT_RETURN_IF_ERROR(missing);
     known = std::move(computed);
@@ -288,7 +279,7 @@ void FilterTopSamples(SvoChunk& top, std::uint32_t side, const LevelSamples& roo
     for (unsigned s = 0; s < n; ++s) {
       // Only the samples the page's root stores: a point shared with another page is written once.
       if (!t.is_home[s] && !(layouts.back().orphans[i] >> t.index[s] & 1u)) continue;
-      Store(Load(root_bricks, i * n + s), SampleIndex(layouts.back(), nb, s), last);
+      StoreSample(LoadSample(root_bricks, i * n + s), SampleIndex(layouts.back(), nb, s), last);
     }
   });
   top.samples = FilterSamplesAbove(top.tree, layouts, side, std::move(last));

@@ -15,6 +15,8 @@ using brick_math::Accumulate;
 using brick_math::DecodePremultiplied;
 using brick_math::Encode;
 using brick_math::EncodedSample;
+using brick_math::LoadSample;
+using brick_math::StoreSample;
 using brick_math::Tent;
 
 struct Flags {
@@ -318,17 +320,6 @@ class TapCache {
   std::array<PremultipliedSample, 343> taps_;
 };
 
-void Store(const EncodedSample& e, std::uint64_t at, LevelSamples& out) {
-  out.opacity[at] = e.opacity;
-  if (!out.color.empty()) out.color[at] = e.color;
-  if (!out.normal.empty()) out.normal[at] = e.normal;
-}
-
-EncodedSample Load(const LevelSamples& in, std::uint64_t at) {
-  return {in.opacity[at], in.color.empty() ? 0u : in.color[at],
-          in.normal.empty() ? std::uint16_t{0} : in.normal[at]};
-}
-
 // Filters and stores the samples a node stores, in layout order: its home samples, then its
 // orphans. fetch(tx, ty, tz) is the decoded finer sample at tap index t = 2k + d (k the sample,
 // d ∈ 0..2 the tap, t ∈ [0, 2·side]). With side 3 the eight home samples share one separable pass
@@ -386,18 +377,18 @@ void StoreNodeSamples(std::uint32_t side, std::uint32_t orphans, Fetch&& fetch, 
           }
           PremultipliedSample p;
           std::memcpy(&p, o, sizeof o);
-          Store(Encode(f.color, f.normal, p),
-                first + static_cast<std::uint64_t>(kx + 2 * ky + 4 * kz), out);
+          StoreSample(Encode(f.color, f.normal, p),
+                      first + static_cast<std::uint64_t>(kx + 2 * ky + 4 * kz), out);
         }
       }
     }
   } else {
-    Store(Encode(f.color, f.normal, tent_of(0)), first, out);
+    StoreSample(Encode(f.color, f.normal, tent_of(0)), first, out);
   }
   std::uint64_t next = first + t.home_count;
   for (unsigned s = 0; s < side * side * side; ++s) {
     if (!t.is_home[s] && (orphans >> t.index[s] & 1u)) {
-      Store(Encode(f.color, f.normal, tent_of(s)), next++, out);
+      StoreSample(Encode(f.color, f.normal, tent_of(s)), next++, out);
     }
   }
 }
@@ -458,7 +449,7 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
                                                home[2] - static_cast<int>(fb >> 2 & 1))];
                      });
       if (at == ~std::uint64_t{0}) return PremultipliedSample{};
-      const EncodedSample e = Load(finer, at);
+      const EncodedSample e = LoadSample(finer, at);
       return e.opacity == 0 ? PremultipliedSample{} : DecodePremultiplied(e, f.color, f.normal);
     };
     TapCache taps(finer_sample);

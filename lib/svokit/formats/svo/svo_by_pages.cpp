@@ -11,8 +11,6 @@
 #include <numeric>
 #include <optional>
 
-#include <tbb/task_arena.h>
-
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
@@ -128,11 +126,10 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
         stage.Advance(1);
         SVOKIT_RETURN_IF_ERROR(made.status);
         stage.AddBytes(made.page->bytes.size());
-        for (std::size_t s = 0; s < made.root.opacity.size(); ++s) {
-          roots.opacity.push_back(made.root.opacity[s]);
-          if (!made.root.color.empty()) roots.color.push_back(made.root.color[s]);
-          if (!made.root.normal.empty()) roots.normal.push_back(made.root.normal[s]);
-        }
+        roots.opacity.insert(roots.opacity.end(), made.root.opacity.begin(),
+                             made.root.opacity.end());
+        roots.color.insert(roots.color.end(), made.root.color.begin(), made.root.color.end());
+        roots.normal.insert(roots.normal.end(), made.root.normal.begin(), made.root.normal.end());
         return take(std::move(*made.page));
       });
 }
@@ -226,8 +223,8 @@ class PagePlan {
       std::vector<std::uint8_t> shell;
       Status status;
     };
-    return InOrder<Made>(
-        first, end,
+    return ParallelInOrder<Made>(
+        first, end, in_flight_,
         [&](std::size_t i) {
           Made made;
           made.status = MakePage(writer, i, made.page, made.shell);
@@ -296,27 +293,18 @@ class PagePlan {
   // The top levels' contours are fitted before the pages, to all triangles at once (~320 B a
   // triangle at their peak).
   Status SetLimit(std::uint64_t fixed, std::uint64_t memory_limit, const char* what) {
-    const std::size_t tokens =
-        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     const std::uint64_t per_voxel = frame_.shape.brick_side == 0 ? 40 : 160;
     const std::uint64_t page = per_voxel * 4 << (2 * bits_);
     const std::uint64_t top =
         contours_ && page_level_ > 0 ? std::uint64_t{320} * mesh_->triangles.size() : 0;
-    const std::uint64_t smallest = fixed + std::max(page, top);
-    if (memory_limit != 0 && memory_limit < smallest) {
-      const std::uint64_t mib = (smallest + (1 << 20) - 1) >> 20;
-      return Status::BadInput(
-          "a memory limit of {} MiB is too small for this mesh and grid: {} and {} need {} MiB "
-          "(use --memory-limit {}M or more)",
-          memory_limit >> 20, what,
-          top > page ? fmt::format("the top levels' contours ({} triangles at once)",
-                                   mesh_->triangles.size())
-                     : std::string("one page"),
-          mib, mib);
-    }
-    in_flight_ = memory_limit == 0
-                     ? tokens
-                     : std::clamp<std::size_t>((memory_limit - fixed) / page, 1, tokens);
+    const std::string needs =
+        top > page ? fmt::format("{} and the top levels' contours ({} triangles at once)", what,
+                                 mesh_->triangles.size())
+                   : fmt::format("{} and one page", what);
+    const StatusOr<std::size_t> in_flight =
+        InFlightWithin(memory_limit, fixed, page, std::max(page, top), needs);
+    if (!in_flight.ok()) return in_flight.status();
+    in_flight_ = *in_flight;
     return Status::Ok();
   }
 
@@ -345,13 +333,6 @@ class PagePlan {
     shell = EncodePageShell(chunk, frame_.shape);
     out = writer.Encode(chunk);
     return Status::Ok();
-  }
-
-  // Work items [first, end) made in parallel (as many in flight as the limit allows) and handed
-  // to `take` in order; stops at take's first error.
-  template <class Made, class MakeFn, class TakeFn>
-  Status InOrder(std::size_t first, std::size_t end, const MakeFn& make, const TakeFn& take) const {
-    return ParallelInOrder<Made>(first, end, in_flight_, make, take);
   }
 
   BuildOptions page_options_;
@@ -383,10 +364,6 @@ std::size_t PartStart(const RegionVoxelizer::Bins& bins, std::uint32_t part, std
   return static_cast<std::size_t>(
       std::lower_bound(bins.starts.begin(), bins.starts.end() - 1, target) - bins.starts.begin());
 }
-
-}  // namespace
-
-namespace {
 
 // The file of a build by pages: pages in order as `p` makes them, then the top levels; with
 // bricks, in two passes through a scratch file.
@@ -547,15 +524,8 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   });
   file.AddSectionProduced(kPartTable,
                           [&](const container::Writer::Emit& emit) { return emit(table.bytes()); });
-  file.AddSectionProduced(kPartShells, [&](const container::Writer::Emit& emit) -> Status {
-    constexpr std::uint64_t kBlock = std::uint64_t{16} << 20;
-    for (std::uint64_t at = 0; shells && at < shells->size(); at += kBlock) {
-      StatusOr<std::vector<std::uint8_t>> bytes =
-          shells->Read(at, std::min(kBlock, shells->size() - at));
-      if (!bytes.ok()) return bytes.status();
-      SVOKIT_RETURN_IF_ERROR(emit(*bytes));
-    }
-    return Status::Ok();
+  file.AddSectionProduced(kPartShells, [&](const container::Writer::Emit& emit) {
+    return shells ? shells->ForEachPiece(emit) : Status::Ok();
   });
   // The top levels' contours travel with part 0: every part has the mesh, the merge need not.
   ByteWriter top;
@@ -751,12 +721,10 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
       return copy(where[i].part->shell_bytes.subspan(where[i].page->shell_offset,
                                                      where[i].page->shell_size));
     };
-    const std::size_t in_flight =
-        2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     return writer.Write(
         path,
         [&](const PagedSvoWriter::Take& take) {
-          return FinishPages(head.frame, writer, built, in_flight, take, roots, progress);
+          return FinishPages(head.frame, writer, built, MostInFlight(), take, roots, progress);
         },
         [&](std::span<const std::uint64_t> keys) {
           return TopOfPages(keys, PageLevel(head.frame.depth), top_words, side, roots);

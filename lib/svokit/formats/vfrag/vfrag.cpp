@@ -161,11 +161,7 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
     }
   }
   for (std::size_t i = 0; i < set.keys.size(); ++i) {
-    const MortonCoord c = MortonDecode(set.keys[i]);
-    if (set.keys[i] >> 63 || c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) {
-      return Status::BadInput("{}: voxel {} lies outside the {}x{}x{} grid", name, i, dims[0],
-                              dims[1], dims[2]);
-    }
+    SVOKIT_RETURN_IF_ERROR(CheckKeyInGrid(set.keys[i], i, dims, name));
   }
   const bool v4 = file->version() >= 4;
   const Shared expanded = v4 ? Shared::kExpanded : Shared::kRefused;

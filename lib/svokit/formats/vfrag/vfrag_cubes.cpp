@@ -6,8 +6,6 @@
 
 #include <unistd.h>
 
-#include <tbb/task_arena.h>
-
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/key_gaps.hpp"
@@ -23,17 +21,6 @@ namespace svokit {
 using namespace vfrag_detail;
 
 namespace {
-
-// The bytes of a scratch file, in pieces of a few MB.
-Status EmitScratch(const ScratchFile& file, const container::Writer::Emit& emit) {
-  constexpr std::uint64_t kPiece = std::uint64_t{4} << 20;
-  for (std::uint64_t at = 0; at < file.size(); at += kPiece) {
-    StatusOr<std::vector<std::uint8_t>> piece = file.Read(at, std::min(kPiece, file.size() - at));
-    if (!piece.ok()) return piece.status();
-    SVOKIT_RETURN_IF_ERROR(emit(*piece));
-  }
-  return Status::Ok();
-}
 
 // A per-voxel array streamed to a scratch file, with what StoredBytes() decides: whether every
 // value equals the first.
@@ -61,7 +48,7 @@ class ScratchArray {
       if (uniform_ && count_ > 1) {
         return emit({reinterpret_cast<const std::uint8_t*>(&first_), sizeof(T)});
       }
-      return EmitScratch(*file_, emit);
+      return file_->ForEachPiece(emit);
     };
   }
 
@@ -89,17 +76,9 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
   // surface's voxels across it with their keys and attributes (~24 B a voxel).
   const std::uint64_t fixed = voxelizer.bytes() + bins.bytes();
   const std::uint64_t cube = std::uint64_t{24} * 4 << (2 * kCubeBits);
-  if (memory_limit != 0 && memory_limit < fixed + cube) {
-    const std::uint64_t mib = (fixed + cube + (1 << 20) - 1) >> 20;
-    return Status::BadInput(
-        "a memory limit of {} MiB is too small for this mesh and grid: its bins and one cube "
-        "need {} MiB (use --memory-limit {}M or more)",
-        memory_limit >> 20, mib, mib);
-  }
-  const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  const std::size_t in_flight =
-      memory_limit == 0 ? tokens
-                        : std::clamp<std::size_t>((memory_limit - fixed) / cube, 1, tokens);
+  const StatusOr<std::size_t> in_flight =
+      InFlightWithin(memory_limit, fixed, cube, cube, "its bins and one cube");
+  if (!in_flight.ok()) return in_flight.status();
 
   const VoxelizeOptions& options = voxelizer.options();
   const bool shared = voxelizer.shared_color().has_value();
@@ -119,7 +98,7 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
       StatusOr<VoxelSet> voxels = Status::Ok();
     };
     made = ParallelInOrder<Cube>(
-        0, bins.cells.size(), in_flight,
+        0, bins.cells.size(), *in_flight,
         [&](std::size_t i) {
           const MortonCoord c = MortonDecode(bins.cells[i]);
           const std::int64_t s = std::int64_t{1} << kCubeBits;
@@ -152,7 +131,7 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
     std::uint8_t head[sizeof(count)];
     std::memcpy(head, &count, sizeof(count));
     SVOKIT_RETURN_IF_ERROR(emit(head));
-    return EmitScratch(**keys, emit);
+    return (*keys)->ForEachPiece(emit);
   });
   if (options.colors) {
     if (shared) {
@@ -178,16 +157,8 @@ namespace {
 
 // Reads `size` bytes at `offset` of `fd`; an error names the file.
 Status ReadAt(int fd, const std::string& name, std::uint64_t offset, std::span<std::uint8_t> out) {
-  std::size_t done = 0;
-  while (done < out.size()) {
-    const ssize_t n =
-        ::pread(fd, out.data() + done, out.size() - done, static_cast<off_t>(offset + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      return Status::BadInput("{}: cannot read ({})", name,
-                              n < 0 ? std::strerror(errno) : "the file is shorter than stated");
-    }
-    done += static_cast<std::size_t>(n);
+  if (const std::string why = ReadFullyAt(fd, offset, out); !why.empty()) {
+    return Status::BadInput("{}: cannot read ({})", name, why);
   }
   return Status::Ok();
 }
@@ -308,11 +279,7 @@ StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::pa
       return Status::BadInput("{}: voxel keys are not strictly increasing at index {}", name, i);
     }
     const std::uint64_t key = previous + 1 + gap;
-    const MortonCoord c = MortonDecode(key);
-    if (key >> 63 || c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) {
-      return Status::BadInput("{}: voxel {} lies outside the {}x{}x{} grid", name, i, dims[0],
-                              dims[1], dims[2]);
-    }
+    SVOKIT_RETURN_IF_ERROR(CheckKeyInGrid(key, i, dims, name));
     if (cubes->cube_keys_.empty() || key >> shift != cubes->cube_keys_.back()) {
       cubes->cube_keys_.push_back(key >> shift);
       cubes->cube_starts_.push_back({i, at, previous});
