@@ -57,6 +57,9 @@ struct SvoLevel {
   /// ESVO contours of this level's nodes that have one, in node order (membership: the parents'
   /// contour masks; at level 0 the root has one when this holds one element).
   std::vector<std::uint32_t> contours;
+  /// Baked ambient occlusion per node (svo-bake; empty without): 8-bit linear, 0 open, 255 fully
+  /// occluded. A voxel's is traced from its centre; a node's is the mean of its voxels'.
+  std::vector<std::uint8_t> ao;
 
   bool operator==(const SvoLevel&) const = default;
 };
@@ -70,6 +73,7 @@ struct Svo {
   bool has_color = false;   ///< bricks carry colour
   bool has_normal = false;  ///< bricks carry normals
   bool has_contours = false;
+  bool has_ao = false;           ///< every level holds `ao`
   std::string metadata;          ///< JSON: source, options, tool version
   std::vector<SvoLevel> levels;  ///< depth + 1 levels
 

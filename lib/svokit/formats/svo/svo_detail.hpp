@@ -21,6 +21,7 @@ using container::Tag;
 inline constexpr Tag kGrid = MakeTag("GRID");
 inline constexpr Tag kHead = MakeTag("HEAD");
 inline constexpr Tag kMetadata = MakeTag("META");
+inline constexpr Tag kAo = MakeTag("AOCC");
 inline constexpr std::uint32_t kMaxDepth = 20;
 inline constexpr std::uint32_t kHasColor = 1, kHasNormal = 2, kHasContours = 4;  // HEAD flags
 
@@ -62,6 +63,11 @@ bool DecodeVersion1(const container::Frame& file, std::optional<std::uint32_t> m
 /// The same for version 2.
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
                     IssueSink& sink, Svo& svo);
+
+/// The `AOCC` section of `svo`'s levels' ambient occlusion (svo_ao.cpp).
+std::vector<std::uint8_t> EncodeAoSection(const Svo& svo);
+/// Reads the file's `AOCC` section, if any, into the decoded levels (0 .. `last`) of `svo`.
+bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo);
 
 /// A version-2 file's frame, parsed and checked (HEAD, page table): what a page decoder needs.
 struct Version2 {

@@ -31,8 +31,9 @@ using namespace svo_detail;
 
 bool Decode(const container::Frame& file, std::optional<std::uint32_t> max_level, IssueSink& sink,
             Svo& svo) {
-  return file.version() == 1 ? DecodeVersion1(file, max_level, sink, svo)
-                             : DecodeVersion2(file, max_level, sink, svo);
+  if (file.version() == 1) return DecodeVersion1(file, max_level, sink, svo);
+  return DecodeVersion2(file, max_level, sink, svo) &&
+         DecodeAo(file, max_level.value_or(svo.depth), sink, svo);
 }
 
 // The strict readers: a frame with issues fails on its first, an octree on its first issue.

@@ -182,6 +182,12 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> part
                                      const std::filesystem::path& path,
                                      Progress& progress = Progress::Silent());
 
+/// Writes `input` (a version-2 .svo) again as `output` with `baked`'s per-node ambient occlusion
+/// (every level's `ao`) as its `AOCC` section and `bake_options` as META's "bake"; every other
+/// section is copied as it is.
+Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked,
+                     const std::string& bake_options, const std::filesystem::path& output);
+
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);

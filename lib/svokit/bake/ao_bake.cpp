@@ -1,0 +1,334 @@
+#include "svokit/bake/ao_bake.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "svokit/core/bytes.hpp"
+#include "svokit/core/file_io.hpp"
+#include "svokit/core/hash.hpp"
+#include "svokit/core/morton.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/svo/sample_codec.hpp"
+
+namespace svokit {
+
+namespace {
+
+constexpr int kMaxTextureSide = 16384;
+
+Vec3d Normalized(const Vec3d& v) {
+  const double length = Length(v);
+  return length > 0 ? v / length : Vec3d{0, 0, 0};
+}
+
+// The unit normal a voxel's brick holds: the centre sample's (side 3), or the opacity-weighted
+// mean of the corners' (side 2).
+Vec3d VoxelNormal(const Svo& svo, std::uint64_t voxel) {
+  const SvoLevel& level = svo.levels[svo.depth];
+  const std::uint32_t samples = svo.brick_samples();
+  const std::uint64_t first = voxel * samples;
+  if (svo.brick_side == 3) {
+    const Vec3f n = DecodeNormal(level.normal[first + 13]);
+    return {n.x, n.y, n.z};
+  }
+  Vec3d sum{0, 0, 0};
+  for (std::uint32_t s = 0; s < samples; ++s) {
+    const Vec3f n = DecodeNormal(level.normal[first + s]);
+    sum = sum + Vec3d{n.x, n.y, n.z} * DecodeUnorm8(level.opacity[first + s]);
+  }
+  return Normalized(sum);
+}
+
+// A number after `flag` in the recorded options ("--resolution 512"), if there is one.
+std::optional<double> RecordedNumber(const std::string& metadata, std::string_view flag) {
+  const std::size_t at = metadata.find(std::string(flag) + " ");
+  if (at == std::string::npos) return std::nullopt;
+  const char* begin = metadata.c_str() + at + flag.size() + 1;
+  char* end = nullptr;
+  const double value = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::uint8_t EncodeAo(float ao) {
+  return static_cast<std::uint8_t>(std::lround(255.f * std::clamp(ao, 0.f, 1.f)));
+}
+
+StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo) {
+  if (!svo.has_normal || svo.brick_side == 0) {
+    return Status::BadInput("the octree's voxels have no normals to bake along (voxelize with "
+                            "--attributes normal or color,normal)");
+  }
+  const std::vector<std::uint64_t> keys = svo.LevelKeys(svo.depth);
+  std::vector<AoPoint> points(keys.size());
+  ParallelChunks(keys.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const MortonCoord c = MortonDecode(keys[i]);
+      points[i] = {svo.grid.VoxelCenter({static_cast<int>(c.x), static_cast<int>(c.y),
+                                         static_cast<int>(c.z)}),
+                   VoxelNormal(svo, i)};
+    }
+  });
+  return points;
+}
+
+void SetNodeAo(std::span<const float> voxel_ao, Svo& svo) {
+  // Sums and counts of the encoded voxel AO below each node, level by level from the voxels up.
+  std::vector<std::uint64_t> sum(voxel_ao.size()), count(voxel_ao.size(), 1);
+  for (std::size_t i = 0; i < voxel_ao.size(); ++i) sum[i] = EncodeAo(voxel_ao[i]);
+  svo.levels[svo.depth].ao.resize(voxel_ao.size());
+  for (std::size_t i = 0; i < voxel_ao.size(); ++i) {
+    svo.levels[svo.depth].ao[i] = static_cast<std::uint8_t>(sum[i]);
+  }
+  for (std::uint32_t l = svo.depth; l-- > 0;) {
+    SvoLevel& level = svo.levels[l];
+    std::vector<std::uint64_t> up_sum(level.node_count), up_count(level.node_count);
+    level.ao.resize(level.node_count);
+    for (std::uint64_t i = 0; i < level.node_count; ++i) {
+      const SvoNode& node = level.nodes[i];
+      const std::uint32_t children = static_cast<std::uint32_t>(std::popcount(node.child_mask));
+      for (std::uint32_t c = 0; c < children; ++c) {
+        up_sum[i] += sum[node.first_child + c];
+        up_count[i] += count[node.first_child + c];
+      }
+      level.ao[i] = static_cast<std::uint8_t>((2 * up_sum[i] + up_count[i]) / (2 * up_count[i]));
+    }
+    sum = std::move(up_sum);
+    count = std::move(up_count);
+  }
+  svo.has_ao = true;
+}
+
+std::vector<AoPoint> VertexPoints(const Mesh& mesh) {
+  std::vector<Vec3d> normals(mesh.positions.size(), Vec3d{0, 0, 0});
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3d& a = mesh.positions[t[0]];
+    const Vec3d n = Cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
+    for (const std::uint32_t v : t) normals[v] = normals[v] + n;
+  }
+  std::vector<AoPoint> points(mesh.positions.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3d n = Normalized(normals[i]);
+    points[i] = {mesh.positions[i], Length(n) > 0 ? n : Vec3d{0, 0, 1}};
+  }
+  return points;
+}
+
+std::vector<AoPoint> SurfacePoints(const Mesh& mesh, std::size_t count, std::uint64_t seed) {
+  std::vector<double> cumulative(mesh.triangles.size());
+  double total = 0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    total += Length(Cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
+                          mesh.positions[tri[2]] - mesh.positions[tri[0]]));
+    cumulative[t] = total;
+  }
+  std::vector<AoPoint> points;
+  if (total <= 0) return points;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::uint64_t h = HashIndex(seed, k);
+    const double at = (static_cast<double>(k) + UnitInterval(h)) / static_cast<double>(count) * total;
+    const std::size_t t = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), at) -
+                                 cumulative.begin()),
+        cumulative.size() - 1);
+    double u = UnitInterval(SplitMix64(h)), v = UnitInterval(SplitMix64(h + 1));
+    if (u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    const Triangle& tri = mesh.triangles[t];
+    const Vec3d& a = mesh.positions[tri[0]];
+    const Vec3d e1 = mesh.positions[tri[1]] - a, e2 = mesh.positions[tri[2]] - a;
+    points.push_back({a + e1 * u + e2 * v, Normalized(Cross(e1, e2))});
+  }
+  return points;
+}
+
+StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
+  if (!mesh.has_uvs()) {
+    return Status::BadInput("the mesh has no texture coordinates to bake a texture over");
+  }
+  if (size < 1 || size > kMaxTextureSide) {
+    return Status::BadInput("--size {}: must be 1..{}", size, kMaxTextureSide);
+  }
+  const std::vector<AoPoint> vertices = VertexPoints(mesh);
+  const std::size_t side = static_cast<std::size_t>(size);
+  // Owner triangle and barycentrics per texel; the first triangle to cover a texel keeps it.
+  std::vector<std::int64_t> owner(side * side, -1);
+  std::vector<std::array<double, 3>> weights(side * side);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    std::array<double, 3> x, y;
+    for (int c = 0; c < 3; ++c) {
+      const Vec2f uv = mesh.uvs[3 * t + static_cast<std::size_t>(c)];
+      x[c] = static_cast<double>(uv.u) * size - 0.5;
+      y[c] = (1 - static_cast<double>(uv.v)) * size - 0.5;
+    }
+    const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (area == 0 || !std::isfinite(area)) continue;
+    const auto lo = [&](const std::array<double, 3>& v) {
+      return std::clamp(static_cast<long>(std::ceil(std::min({v[0], v[1], v[2]}))), 0L,
+                        static_cast<long>(size));
+    };
+    const auto hi = [&](const std::array<double, 3>& v) {
+      return std::clamp(static_cast<long>(std::floor(std::max({v[0], v[1], v[2]}))), -1L,
+                        static_cast<long>(size) - 1);
+    };
+    for (long py = lo(y); py <= hi(y); ++py) {
+      for (long px = lo(x); px <= hi(x); ++px) {
+        const double cx = static_cast<double>(px), cy = static_cast<double>(py);
+        std::array<double, 3> w;
+        for (int c = 0; c < 3; ++c) {
+          const int a = (c + 1) % 3, b = (c + 2) % 3;
+          w[c] = ((x[b] - x[a]) * (cy - y[a]) - (cx - x[a]) * (y[b] - y[a])) / area;
+        }
+        if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
+        const std::size_t texel = static_cast<std::size_t>(py) * side + static_cast<std::size_t>(px);
+        if (owner[texel] >= 0) continue;
+        owner[texel] = static_cast<std::int64_t>(t);
+        weights[texel] = w;
+      }
+    }
+  }
+  TexelPoints out;
+  out.size = size;
+  for (std::size_t texel = 0; texel < owner.size(); ++texel) {
+    if (owner[texel] < 0) continue;
+    const Triangle& tri = mesh.triangles[static_cast<std::size_t>(owner[texel])];
+    Vec3d p{0, 0, 0}, n{0, 0, 0};
+    for (int c = 0; c < 3; ++c) {
+      p = p + mesh.positions[tri[c]] * weights[texel][c];
+      n = n + vertices[tri[c]].normal * weights[texel][c];
+    }
+    if (Length(n) == 0) {
+      n = Cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
+                mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+    }
+    n = Normalized(n);
+    out.texels.push_back(static_cast<std::uint32_t>(texel));
+    out.points.push_back({p, Length(n) > 0 ? n : Vec3d{0, 0, 1}});
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> AoTexture(const TexelPoints& texels, std::span<const float> ao) {
+  const std::size_t side = static_cast<std::size_t>(texels.size);
+  std::vector<float> value(side * side, 0.f);
+  std::vector<std::uint8_t> filled(side * side, 0);
+  std::vector<std::size_t> ring;
+  for (std::size_t i = 0; i < texels.texels.size(); ++i) {
+    value[texels.texels[i]] = 1.f - std::clamp(ao[i], 0.f, 1.f);
+    filled[texels.texels[i]] = 1;
+    ring.push_back(texels.texels[i]);
+  }
+  // Dilation ring by ring (8-neighbourhood): each empty texel next to the filled ones takes the
+  // mean of those, then the ring counts as filled.
+  auto neighbours = [&](std::size_t texel, auto&& visit) {
+    const long x = static_cast<long>(texel % side), y = static_cast<long>(texel / side);
+    for (long dy = -1; dy <= 1; ++dy) {
+      for (long dx = -1; dx <= 1; ++dx) {
+        const long nx = x + dx, ny = y + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= static_cast<long>(side) ||
+            ny >= static_cast<long>(side)) {
+          continue;
+        }
+        visit(static_cast<std::size_t>(ny) * side + static_cast<std::size_t>(nx));
+      }
+    }
+  };
+  while (!ring.empty()) {
+    std::vector<std::size_t> next;
+    for (const std::size_t texel : ring) {
+      neighbours(texel, [&](std::size_t n) {
+        if (filled[n] == 0) {
+          filled[n] = 2;  // in the next ring
+          next.push_back(n);
+        }
+      });
+    }
+    std::sort(next.begin(), next.end());
+    std::vector<float> next_value(next.size());
+    for (std::size_t i = 0; i < next.size(); ++i) {
+      float sum = 0;
+      int count = 0;
+      neighbours(next[i], [&](std::size_t n) {
+        if (filled[n] == 1) {
+          sum += value[n];
+          ++count;
+        }
+      });
+      next_value[i] = sum / static_cast<float>(count);
+    }
+    for (std::size_t i = 0; i < next.size(); ++i) {
+      value[next[i]] = next_value[i];
+      filled[next[i]] = 1;
+    }
+    ring = std::move(next);
+  }
+  std::vector<std::uint8_t> pixels(side * side, 255);
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    if (filled[i] == 1) pixels[i] = static_cast<std::uint8_t>(std::lround(255.f * value[i]));
+  }
+  return pixels;
+}
+
+Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<const float> ao,
+                  const std::filesystem::path& path) {
+  ByteWriter w;
+  const std::string header = fmt::format(
+      "ply\nformat binary_little_endian 1.0\ncomment svokit baked ambient occlusion (ao: 0 open, "
+      "1 occluded; colour: 1 - ao)\nelement vertex {}\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+      "property float ao\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+      mesh.positions.size(), mesh.triangles.size());
+  w.PutArray<char>(std::span<const char>(header.data(), header.size()));
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    for (const double v : {mesh.positions[i].x, mesh.positions[i].y, mesh.positions[i].z,
+                           points[i].normal.x, points[i].normal.y, points[i].normal.z}) {
+      w.Put(static_cast<float>(v));
+    }
+    w.Put(ao[i]);
+    const std::uint8_t grey = static_cast<std::uint8_t>(255 - EncodeAo(ao[i]));
+    for (int c = 0; c < 3; ++c) w.Put(grey);
+  }
+  for (const Triangle& t : mesh.triangles) {
+    w.Put(std::uint8_t{3});
+    for (const std::uint32_t v : t) w.Put(static_cast<std::int32_t>(v));
+  }
+  return WriteFileAtomic(path, w.bytes());
+}
+
+Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name) {
+  const std::optional<double> resolution = RecordedNumber(svo.metadata, "--resolution");
+  const std::optional<double> voxel_size = RecordedNumber(svo.metadata, "--voxel-size");
+  const double pad = RecordedNumber(svo.metadata, "--pad").value_or(0);
+  const Box3d bounds = mesh.Bounds();
+  if (!resolution && !voxel_size) {
+    // No recorded grid options: the mesh must at least lie inside the grid.
+    if (svo.grid.GridBounds().Contains(bounds)) return Status::Ok();
+    return Status::BadInput("{}: the mesh lies outside the octree's grid: not its mesh", mesh_name);
+  }
+  const StatusOr<GridTransform> fitted =
+      resolution ? GridTransform::FitResolution(bounds, static_cast<std::uint32_t>(*resolution),
+                                                static_cast<std::uint32_t>(pad))
+                 : GridTransform::FitVoxelSize(bounds, *voxel_size, static_cast<std::uint32_t>(pad));
+  const GridTransform& g = svo.grid;
+  const double tolerance = 1e-6 * g.voxel_size();
+  if (!fitted.ok() || fitted->dims() != g.dims() ||
+      std::abs(fitted->voxel_size() - g.voxel_size()) > 1e-9 * g.voxel_size() ||
+      Length(fitted->origin() - g.origin()) > tolerance) {
+    return Status::BadInput(
+        "{}: the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] do not give the "
+        "octree's grid: not the mesh it was voxelized from",
+        mesh_name, bounds.lo.x, bounds.lo.y, bounds.lo.z, bounds.hi.x, bounds.hi.y, bounds.hi.z);
+  }
+  return Status::Ok();
+}
+
+}  // namespace svokit

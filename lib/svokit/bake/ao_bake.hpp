@@ -1,0 +1,64 @@
+#pragma once
+// What svo-bake bakes ambient occlusion into, given a ConeTracer: the octree's nodes (a voxel's
+// AO traced from its centre along its normal, a node's the mean of its voxels'), a mesh's vertices
+// and a texture over a mesh's UVs.
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "svokit/bake/cone_tracer.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+/// AO 0..1 → the byte stored (0 open, 255 fully occluded).
+std::uint8_t EncodeAo(float ao);
+
+/// The voxels of `svo` as bake points: centre and the voxel brick's normal (zero where a voxel has
+/// none). Bad input: an octree without normals.
+StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo);
+/// Sets every level's `ao` from the voxels' AO (VoxelPoints' order): a node's is the mean of the
+/// encoded AO of the voxels below it, rounded to nearest.
+void SetNodeAo(std::span<const float> voxel_ao, Svo& svo);
+
+/// Each vertex with its normal: the sum of its triangles' area-weighted normals, normalized (a
+/// vertex of no triangle or of degenerate ones only gets +z).
+std::vector<AoPoint> VertexPoints(const Mesh& mesh);
+
+/// `count` points spread over the surface by area (stratified: point k falls in the k-th of
+/// `count` equal shares of the total area, at a place hashed from `seed` and k), each with its
+/// triangle's normal: where a mesh's vertices sample it poorly (a room's corners), the points
+/// its AO is measured at.
+std::vector<AoPoint> SurfacePoints(const Mesh& mesh, std::size_t count, std::uint64_t seed);
+
+/// The texels of a size × size texture that triangles cover in UV space (texel (x, y) has its
+/// centre at u = (x + ½)/size, v = 1 − (y + ½)/size; a texel two triangles cover belongs to the
+/// first), each with its surface point: position and vertex normals interpolated.
+struct TexelPoints {
+  int size = 0;
+  std::vector<std::uint32_t> texels;  ///< y·size + x, ascending
+  std::vector<AoPoint> points;
+};
+/// Bad input: a mesh without UVs, a size outside 1..16384.
+StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size);
+/// The 8-bit grey AO map: 255·(1 − AO) on covered texels (white is open), every other texel
+/// dilated from its nearest covered ones (ring by ring, the mean of the ring inside), so mip
+/// levels do not bleed the background into the charts.
+std::vector<std::uint8_t> AoTexture(const TexelPoints& texels, std::span<const float> ao);
+
+/// The mesh with per-vertex AO as binary PLY: x y z, nx ny nz (VertexPoints' normals), `ao`
+/// (float, 0 open) and red green blue = 255·(1 − AO).
+Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<const float> ao,
+                  const std::filesystem::path& path);
+
+/// Whether `mesh` is the mesh the octree was voxelized from: the grid that the octree's recorded
+/// voxelization options fit around the mesh's bounds must be the octree's grid. Bad input names
+/// `mesh_name` and what differs.
+Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name);
+
+}  // namespace svokit

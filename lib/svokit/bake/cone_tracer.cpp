@@ -1,0 +1,230 @@
+#include "svokit/bake/cone_tracer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "svokit/core/hash.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/svo/sample_codec.hpp"
+
+namespace svokit {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// Mean thickness of a surface shell along its normal, in voxels: a conservative voxelization of a
+// plane with unit normal n is |n|₁ thick (mean 1.5 over directions), a thin one |n|∞ (mean ≈ 0.8).
+constexpr double kConservativeShell = 1.5, kThinShell = 0.8;
+// Coverage of a sample = gain × opacity × node size / shell thickness: the tent cascade spreads a
+// wall over about two node sizes, so its peak reaches about half of what the wall covers.
+constexpr double kCoverageGain = 2.0;
+// Step along the cone, in cone diameters (each step's opacity corrected for it).
+constexpr double kStep = 0.5;
+// A cone that lets less than this through is fully occluded.
+constexpr float kClear = 0.002f;
+// Near the point's own surface a sample's footprint is kept off its tangent plane: the shell
+// reaches kShellReach voxels above the plane, and a sample of node size s reads about
+// s·kFootprint / 2 around it (tent cascade plus trilinear tails).
+constexpr double kShellReach = 1.5, kFootprint = 3.0;
+
+// One ring of a constellation: `count` cones over the band sin²θ ∈ [u0, u1] (equal cosine-weighted
+// shares), azimuths rotated by `phase` of a cone's spacing.
+struct Ring {
+  std::uint32_t count;
+  double u0, u1, phase;
+};
+
+std::vector<Ring> Rings(std::uint32_t cones) {
+  switch (cones) {
+    case 3:
+      return {{3, 0, 1, 0}};
+    case 5:
+      return {{1, 0, 0.2, 0}, {4, 0.2, 1, 0}};
+    case 8:
+      return {{1, 0, 0.125, 0}, {7, 0.125, 1, 0}};
+    case 16:
+      return {{1, 0, 1.0 / 16, 0}, {5, 1.0 / 16, 6.0 / 16, 0}, {10, 6.0 / 16, 1, 0.5}};
+    default:
+      return {};
+  }
+}
+
+bool Finite(double v) {
+  return std::isfinite(v);
+}
+
+}  // namespace
+
+std::vector<Cone> ConeConstellation(std::uint32_t count, double aperture) {
+  std::vector<Cone> cones;
+  for (const Ring& ring : Rings(count)) {
+    // The band's solid angle shared by its cones; a cone of solid angle Ω has 1 − cos h = Ω/2π.
+    const double cos0 = std::sqrt(1 - ring.u0), cos1 = std::sqrt(1 - ring.u1);
+    const double share = (cos0 - cos1) / ring.count;
+    const double half = std::min(std::acos(1 - share) * aperture, kPi / 2);
+    const double theta = ring.u0 == 0 && ring.count == 1 ? 0 : std::asin(std::sqrt((ring.u0 + ring.u1) / 2));
+    for (std::uint32_t j = 0; j < ring.count; ++j) {
+      const double phi = 2 * kPi * (j + ring.phase) / ring.count;
+      cones.push_back({{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                        std::cos(theta)},
+                       half});
+    }
+  }
+  return cones;
+}
+
+void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b) {
+  // Duff et al. 2017, "Building an orthonormal basis, revisited".
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1 / (sign + n.z);
+  const double c = n.x * n.y * a;
+  t = {1 + sign * n.x * n.x * a, sign * c, -sign * n.x};
+  b = {c, sign + n.y * n.y * a, -n.y};
+}
+
+StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options) {
+  if (svo.brick_side == 0) {
+    return Status::BadInput("the octree has no bricks to trace cones through (build it with "
+                            "--bricks 3 or 2)");
+  }
+  if (Rings(options.cones).empty()) {
+    return Status::BadInput("--cones {}: constellations have 3, 5, 8 or 16 cones", options.cones);
+  }
+  if (!Finite(options.aperture) || options.aperture <= 0 || options.aperture > 4) {
+    return Status::BadInput("--aperture {}: must be in (0, 4]", options.aperture);
+  }
+  if (!Finite(options.distance) || options.distance <= 0) {
+    return Status::BadInput("--distance {}: must be > 0", options.distance);
+  }
+  if (!Finite(options.falloff) || options.falloff < 0) {
+    return Status::BadInput("--falloff {}: must be ≥ 0", options.falloff);
+  }
+  if (!Finite(options.offset) || options.offset < 0) {
+    return Status::BadInput("--offset {}: must be ≥ 0", options.offset);
+  }
+  if (svo.levels.size() != svo.depth + 1) {
+    return Status::BadInput("the octree's levels are not all loaded");
+  }
+  return ConeTracer(svo, options);
+}
+
+ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
+    : svo_(&svo), options_(options), cones_(ConeConstellation(options.cones, options.aperture)) {
+  const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
+  for (std::uint32_t l = 0; l <= svo.depth; ++l) {
+    level_gain_.push_back(
+        static_cast<float>(kCoverageGain * std::ldexp(1.0, static_cast<int>(svo.depth - l)) / shell));
+  }
+  distance_voxels_ = options.distance / svo.grid.voxel_size();
+  offset_voxels_ = options.offset * std::sqrt(3.0);
+  root_side_ = std::ldexp(1.0, static_cast<int>(svo.depth));
+}
+
+float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level) const {
+  const std::uint32_t shift = svo_->depth - level;
+  const double size = std::ldexp(1.0, static_cast<int>(shift));
+  if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
+        v.z < root_side_)) {
+    return 0;
+  }
+  const auto kx = static_cast<std::uint32_t>(v.x) >> shift;
+  const auto ky = static_cast<std::uint32_t>(v.y) >> shift;
+  const auto kz = static_cast<std::uint32_t>(v.z) >> shift;
+  std::uint64_t index = 0;
+  for (std::uint32_t l = 0; l < level; ++l) {
+    const std::uint32_t bit = level - 1 - l;
+    const unsigned c = ((kx >> bit) & 1u) | (((ky >> bit) & 1u) << 1) | (((kz >> bit) & 1u) << 2);
+    const SvoNode& node = svo_->levels[l].nodes[index];
+    if (((node.child_mask >> c) & 1u) == 0) return 0;
+    index = node.Child(c);
+  }
+  // Trilinear over the brick's lattice (side 3: spacing half the node; side 2: the corners).
+  const std::uint32_t side = svo_->brick_side;
+  const double cells = side - 1;
+  const double gx = (v.x / size - kx) * cells, gy = (v.y / size - ky) * cells,
+               gz = (v.z / size - kz) * cells;
+  const int ix = std::min(static_cast<int>(gx), static_cast<int>(side) - 2);
+  const int iy = std::min(static_cast<int>(gy), static_cast<int>(side) - 2);
+  const int iz = std::min(static_cast<int>(gz), static_cast<int>(side) - 2);
+  const float fx = static_cast<float>(gx - ix), fy = static_cast<float>(gy - iy),
+              fz = static_cast<float>(gz - iz);
+  const std::uint8_t* brick = svo_->levels[level].opacity.data() + index * svo_->brick_samples();
+  auto at = [&](int x, int y, int z) {
+    return static_cast<float>(brick[(ix + x) + side * ((iy + y) + side * (iz + z))]);
+  };
+  const float x00 = at(0, 0, 0) + fx * (at(1, 0, 0) - at(0, 0, 0));
+  const float x10 = at(0, 1, 0) + fx * (at(1, 1, 0) - at(0, 1, 0));
+  const float x01 = at(0, 0, 1) + fx * (at(1, 0, 1) - at(0, 0, 1));
+  const float x11 = at(0, 1, 1) + fx * (at(1, 1, 1) - at(0, 1, 1));
+  const float y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
+  const float opacity = (y0 + fz * (y1 - y0)) * (1.f / 255.f);
+  return std::min(1.f, opacity * level_gain_[level]);
+}
+
+float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta,
+                           double tan_half) const {
+  const std::uint32_t depth = svo_->depth;
+  const double lambda = options_.falloff / distance_voxels_;
+  const double o = offset_voxels_;
+  // Occlusion as the rays define it: the mean falloff at the first hit, E[f(r)]. Each sample
+  // occludes its share of what the samples before it let through (the transmittance).
+  float occlusion = 0, transmittance = 1;
+  for (double t = 1;;) {
+    // Distance from the surface point (the origin sits `o` above it along the normal).
+    const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
+    if (r > distance_voxels_) break;
+    const double diameter = std::max(1.0, 2 * t * tan_half);
+    // The sample's footprint (about a node size plus the shell's half-thickness around it) stays
+    // off the point's own tangent plane: near it, the cone reads finer levels than its diameter.
+    const double height = o + t * cos_theta;
+    const double footprint = std::clamp((height - kShellReach) / kFootprint, 1.0, diameter);
+    const double lod = std::clamp(static_cast<double>(depth) - std::log2(footprint), 0.0,
+                                  static_cast<double>(depth));
+    const auto coarse = static_cast<std::uint32_t>(lod);
+    const float fine_weight = static_cast<float>(lod - coarse);
+    const Vec3d p = origin + axis * t;
+    float coverage = Coverage(p, coarse);
+    if (fine_weight > 0 && coarse < depth) {
+      coverage += fine_weight * (Coverage(p, coarse + 1) - coverage);
+    }
+    if (coverage > 0) {
+      // Corrected for the step: a wall is seen by diameter/step samples.
+      const float alpha = 1.f - std::pow(1.f - coverage, static_cast<float>(kStep));
+      occlusion += transmittance * alpha * static_cast<float>(1 / (1 + lambda * r));
+      transmittance *= 1 - alpha;
+      if (transmittance <= kClear) break;
+    }
+    t += kStep * footprint;
+  }
+  return occlusion;
+}
+
+float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
+  const Vec3d n = point.normal;
+  Vec3d t, b;
+  TangentFrame(n, t, b);
+  if (options_.jitter_seed) {
+    const double phi = 2 * kPi * UnitInterval(HashIndex(*options_.jitter_seed, index));
+    const Vec3d t2 = t * std::cos(phi) + b * std::sin(phi);
+    b = Cross(n, t2);
+    t = t2;
+  }
+  const Vec3d origin = svo_->grid.WorldToVoxel(point.position) + n * offset_voxels_;
+  float sum = 0;
+  for (const Cone& cone : cones_) {
+    const Vec3d axis = t * cone.axis.x + b * cone.axis.y + n * cone.axis.z;
+    sum += TraceCone(origin, axis, cone.axis.z, std::tan(cone.half_angle));
+  }
+  return sum / static_cast<float>(cones_.size());
+}
+
+std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points) const {
+  std::vector<float> ao(points.size());
+  ParallelChunks(points.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) ao[i] = Occlusion(points[i], i);
+  });
+  return ao;
+}
+
+}  // namespace svokit

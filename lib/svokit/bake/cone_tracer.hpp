@@ -1,0 +1,83 @@
+#pragma once
+// Ambient occlusion by approximate voxel cone tracing over an octree's opacity bricks (Crassin et
+// al. 2011; Basgier 2015, ch. 5). From a surface point, a constellation of cones covers the
+// hemisphere around the normal; each marches front to back, reading the bricks trilinearly at
+// the two levels whose node sizes bracket its diameter (quadrilinear), and accumulates
+// a += (1 − a)·α·f(r) with the falloff f(r) = 1/(1 + λ·r/distance), until a is 1 or the cone is
+// `distance` long. The point's AO is the mean over its cones, each covering an equal share of
+// the cosine-weighted hemisphere, so it estimates the same integral as cosine-weighted rays.
+//
+// A brick sample is the filled fraction of its footprint; the octree is a surface shell, so the
+// fraction of a wall falls as 1/node size. A sample's opacity is read as coverage instead: the
+// fraction times the node size over the shell's thickness (docs/design.md, "Ambient occlusion").
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+#include "svokit/core/vec.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+struct ConeOptions {
+  std::uint32_t cones = 8;  ///< constellation: 3, 5, 8 or 16 cones
+  double aperture = 1;      ///< scales each cone's half-angle (> 1: cones overlap)
+  double distance = 0;      ///< world units, > 0: how far cones (and reference rays) reach
+  double falloff = 0;       ///< λ ≥ 0 of f(r) = 1/(1 + λ·r/distance)
+  double offset = 1;        ///< cone origins' offset along the normal, in finest voxel diagonals
+  /// Rotates each point's constellation about its normal by an angle hashed from the seed and
+  /// the point's number (adjacent points stop sharing cone directions).
+  std::optional<std::uint64_t> jitter_seed;
+};
+
+/// One cone: its axis in the point's frame (z along the normal) and its half-angle.
+struct Cone {
+  Vec3d axis;
+  double half_angle = 0;
+};
+/// The constellation of `count` cones (3, 5, 8 or 16): rings of equal cosine-weighted area, each
+/// cone's half-angle giving it its region's solid angle, times `aperture`.
+std::vector<Cone> ConeConstellation(std::uint32_t count, double aperture);
+
+/// An orthonormal frame whose z is `n` (unit), continuous in n except where n.z = −1.
+void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b);
+
+/// A point the AO is baked at: world position and unit normal.
+struct AoPoint {
+  Vec3d position;
+  Vec3d normal;
+};
+
+class ConeTracer {
+ public:
+  /// Bad input: an octree without bricks, options out of range (cones not 3/5/8/16, aperture
+  /// or distance ≤ 0, falloff or offset < 0, non-finite values).
+  static StatusOr<ConeTracer> Make(const Svo& svo, const ConeOptions& options);
+
+  /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded); `index` numbers the point
+  /// for the jitter. Thread-safe.
+  float Occlusion(const AoPoint& point, std::uint64_t index) const;
+  /// Occlusion of every point, in parallel; the result does not depend on the thread count.
+  std::vector<float> Occlusion(std::span<const AoPoint> points) const;
+
+  const ConeOptions& options() const { return options_; }
+
+ private:
+  ConeTracer(const Svo& svo, const ConeOptions& options);
+  // Coverage at continuous voxel coordinates `v`, read at `level` (trilinear in its brick).
+  float Coverage(const Vec3d& v, std::uint32_t level) const;
+  float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half) const;
+
+  const Svo* svo_;
+  ConeOptions options_;
+  std::vector<Cone> cones_;
+  std::vector<float> level_gain_;  // per level: node size over the shell's thickness
+  double distance_voxels_ = 0;
+  double offset_voxels_ = 0;
+  double root_side_ = 0;
+};
+
+}  // namespace svokit

@@ -1,0 +1,129 @@
+// The `AOCC` section of a version-2 .svo (README.md, "Ambient occlusion"): one byte of baked
+// ambient occlusion per node of every level, in node order, zstd-compressed as one stream.
+
+#include <zstd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "svokit/core/bytes.hpp"
+#include "svokit/formats/svo/svo_detail.hpp"
+
+namespace svokit {
+
+namespace svo_detail {
+
+namespace {
+
+constexpr std::uint32_t kStored = 0, kZstd = 1;
+constexpr std::size_t kAoHeader = 24;
+
+// The first out.size() bytes a zstd frame decodes to.
+bool DecompressPrefix(std::span<const std::uint8_t> frame, std::span<std::uint8_t> out) {
+  ZSTD_DCtx* ctx = ZSTD_createDCtx();
+  ZSTD_inBuffer in{frame.data(), frame.size(), 0};
+  ZSTD_outBuffer to{out.data(), out.size(), 0};
+  bool ok = true;
+  while (to.pos < to.size) {
+    const std::size_t in_before = in.pos, out_before = to.pos;
+    const std::size_t r = ZSTD_decompressStream(ctx, &to, &in);
+    if (ZSTD_isError(r) || r == 0 || (in.pos == in_before && to.pos == out_before)) {
+      ok = !ZSTD_isError(r) && to.pos == to.size;
+      break;
+    }
+  }
+  ZSTD_freeDCtx(ctx);
+  return ok && to.pos == to.size;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> EncodeAoSection(const Svo& svo) {
+  std::vector<std::uint8_t> raw;
+  for (const SvoLevel& level : svo.levels) raw.insert(raw.end(), level.ao.begin(), level.ao.end());
+  std::vector<std::uint8_t> stored(ZSTD_compressBound(raw.size()));
+  const std::size_t n = ZSTD_compress(stored.data(), stored.size(), raw.data(), raw.size(), 9);
+  const bool zstd = !ZSTD_isError(n) && n < raw.size();
+  stored.resize(zstd ? n : 0);
+  ByteWriter out;
+  out.Put(static_cast<std::uint32_t>(svo.levels.size()));
+  out.Put(zstd ? kZstd : kStored);
+  out.Put(static_cast<std::uint64_t>(raw.size()));
+  out.Put(static_cast<std::uint64_t>(zstd ? n : raw.size()));
+  out.PutArray(std::span<const std::uint8_t>(zstd ? stored : raw));
+  return std::move(out.bytes());
+}
+
+bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo) {
+  const std::optional<std::span<const std::uint8_t>> section = Loaded(file, kAo);
+  if (!section) return true;
+  const std::string& name = file.name();
+  ByteReader in(*section, name + ": AOCC");
+  std::uint32_t levels = 0, codec = 0;
+  std::uint64_t raw = 0, stored = 0;
+  if (!in.Get(levels).ok() || !in.Get(codec).ok() || !in.Get(raw).ok() || !in.Get(stored).ok()) {
+    sink.Add("ao", name, "the AOCC section is shorter than its header");
+    return false;
+  }
+  if (levels != svo.depth + 1 || (codec != kStored && codec != kZstd) ||
+      stored != section->size() - kAoHeader || (codec == kStored && stored != raw)) {
+    sink.Add("ao", name, "the AOCC section's header is inconsistent ({} levels, codec {})", levels,
+             codec);
+    return false;
+  }
+  // Levels past `last` were not decoded: their bytes follow the decoded levels' and are dropped.
+  std::uint64_t nodes = 0;
+  for (std::uint32_t l = 0; l <= last && l < svo.levels.size(); ++l) nodes += svo.levels[l].node_count;
+  // A whole octree needs every byte; one read down to `last` the first `nodes` (levels in order).
+  if (last >= svo.depth ? raw != nodes : raw < nodes) {
+    sink.Add("ao", name, "the AOCC section holds {} bytes for {} nodes", raw, nodes);
+    return false;
+  }
+  std::vector<std::uint8_t> bytes(nodes);
+  const std::uint8_t* p = section->data() + kAoHeader;
+  if (codec == kStored) {
+    std::copy(p, p + nodes, bytes.begin());
+  } else if (ZSTD_getFrameContentSize(p, stored) != raw || !DecompressPrefix({p, stored}, bytes)) {
+    sink.Add("ao", name, "the AOCC stream does not decode to its {} bytes", raw);
+    return false;
+  }
+  std::uint64_t at = 0;
+  for (SvoLevel& level : svo.levels) {
+    level.ao.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                    bytes.begin() + static_cast<std::ptrdiff_t>(at + level.node_count));
+    at += level.node_count;
+  }
+  svo.has_ao = true;
+  return true;
+}
+
+}  // namespace svo_detail
+
+Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked,
+                     const std::string& bake_options, const std::filesystem::path& output) {
+  using namespace svo_detail;
+  StatusOr<container::Frame> frame = container::Frame::Open(input, kSvoFormat);
+  if (!frame.ok()) return frame.status();
+  if (!frame->issues().empty()) return Status::BadInput("{}", frame->issues().front().message);
+  if (frame->version() != kSvoFormat.version) {
+    return Status::BadInput("{}: a version-{} file; rebuild it to bake into it", input.string(),
+                            frame->version());
+  }
+  nlohmann::json meta = nlohmann::json::object();
+  if (const container::Frame::Section* m = frame->Find(kMetadata)) {
+    meta = nlohmann::json::parse(m->bytes.begin(), m->bytes.end(), nullptr, false);
+    if (!meta.is_object()) meta = nlohmann::json::object();
+  }
+  meta["bake"] = bake_options;
+  std::string meta_text = meta.dump();
+
+  container::Writer writer(kSvoFormat, frame->flags());
+  for (const container::Frame::Section& s : frame->sections()) {
+    if (s.tag == kAo || s.tag == kMetadata) continue;
+    writer.AddSectionView(s.tag, s.bytes);
+  }
+  writer.AddSection(kMetadata, std::vector<std::uint8_t>(meta_text.begin(), meta_text.end()));
+  writer.AddSection(kAo, EncodeAoSection(baked));
+  return writer.WriteFile(output);
+}
+
+}  // namespace svokit
