@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       ->option_text("WxH")
       ->capture_default_str();
   cli.add_option("--shade", shade_name, "What the render's pixels show")
-      ->option_text("color|normal|depth")
+      ->option_text("color|normal|depth|ao")
       ->capture_default_str();
   cli.add_flag("--no-contours", no_contours, "Render leaves as full cubes, ignoring contours");
   cli.add_option("--slice", slice_args, "Write slice K across axis x, y or z of the grid as PNG")

@@ -1,15 +1,21 @@
-// The cone tracer against analytic ambient occlusion: nothing over a plane, the exact integral at
-// the centre of a closed box's floor, full occlusion inside a closed sphere.
+// The cone tracer and the Embree reference against analytic ambient occlusion (nothing over a
+// plane, the exact integral at the centre of a closed box's floor, full occlusion inside a closed
+// sphere, the falloff at a sphere's centre), against each other on a real mesh, and their
+// determinism.
 
 #include <gtest/gtest.h>
 
-#include <iostream>
+#include <algorithm>
 
+#include "svokit/bake/ao_bake.hpp"
+#include "svokit/bake/ray_ao.hpp"
 #include "svokit/core/parallel.hpp"
 #include "tests/bake/bake_scenes.hpp"
 
 namespace svokit::test {
 namespace {
+
+constexpr std::uint32_t kConstellations[] = {3, 5, 8, 16};
 
 ConeOptions Options(std::uint32_t cones, double distance, double falloff) {
   ConeOptions o;
@@ -19,10 +25,18 @@ ConeOptions Options(std::uint32_t cones, double distance, double falloff) {
   return o;
 }
 
-float TraceOne(const Svo& svo, const ConeOptions& options, const AoPoint& point) {
+float Cones(const Svo& svo, const ConeOptions& options, const AoPoint& point) {
   StatusOr<ConeTracer> tracer = ConeTracer::Make(svo, options);
   EXPECT_TRUE(tracer.ok()) << tracer.status().message();
   return tracer.ok() ? tracer->Occlusion(point, 0) : -1.f;
+}
+
+float Rays(const Mesh& mesh, double distance, double falloff, const AoPoint& point) {
+  StatusOr<RayAoReference> reference = RayAoReference::Make(mesh);
+  EXPECT_TRUE(reference.ok()) << reference.status().message();
+  if (!reference.ok()) return -1.f;
+  const AoPoint points[] = {point};
+  return reference->Occlusion(points, {4096, distance, falloff, 7})[0];
 }
 
 const Svo& Plane256() {
@@ -39,36 +53,151 @@ const Svo& Sphere256() {
 }
 
 TEST(ConeTracer, APlaneOccludesNothingAboveIt) {
-  for (const std::uint32_t cones : {3u, 5u, 8u, 16u}) {
-    const StatusOr<ConeTracer> tracer = ConeTracer::Make(Plane256(), Options(cones, 0.5, 0));
-    ASSERT_TRUE(tracer.ok());
-    float worst = 0;
-    for (int i = 0; i <= 10; ++i) {
-      for (int j = 0; j <= 10; ++j) {
-        const AoPoint p{{-0.5 + 0.1 * i, -0.5 + 0.1 * j, 0}, {0, 0, 1}};
-        worst = std::max(worst, tracer->Occlusion(p, 0));
+  for (const std::uint32_t cones : kConstellations) {
+    for (const bool jitter : {false, true}) {
+      ConeOptions options = Options(cones, 0.5, 0);
+      if (jitter) options.jitter_seed = 3;
+      const StatusOr<ConeTracer> tracer = ConeTracer::Make(Plane256(), options);
+      ASSERT_TRUE(tracer.ok());
+      float worst = 0;
+      for (int i = 0; i <= 10; ++i) {
+        for (int j = 0; j <= 10; ++j) {
+          const AoPoint p{{-0.5 + 0.1 * i, -0.5 + 0.1 * j, 0}, {0, 0, 1}};
+          worst = std::max(worst, tracer->Occlusion(p, static_cast<std::uint64_t>(11 * i + j)));
+        }
       }
+      EXPECT_LE(worst, 0.01f) << cones << " cones, jitter " << jitter;
     }
-    std::cout << "plane cones " << cones << " worst " << worst << "\n";
   }
 }
 
 TEST(ConeTracer, TheCentreOfABoxFloorHasTheAnalyticValue) {
-  for (const auto& [distance, falloff] : {std::pair{1.2, 0.0}, std::pair{2.0, 1.0}, std::pair{4.0, 0.0}}) {
-    const double exact = AnalyticAo([](const Vec3d& d) { return BoxFloorExit(d, 1, 1); }, distance, falloff);
-    for (const std::uint32_t cones : {3u, 5u, 8u, 16u}) {
-      const float ao = TraceOne(Box256(), Options(cones, distance, falloff), {{0, 0, 0}, {0, 0, 1}});
-      std::cout << "box D " << distance << " l " << falloff << " cones " << cones << " ao " << ao << " exact " << exact << "\n";
+  const AoPoint centre{{0, 0, 0}, {0, 0, 1}};
+  // Distance 2 with falloff 1: every wall and the lid count, each weighed by its distance.
+  const double exact = AnalyticAo([](const Vec3d& d) { return BoxFloorExit(d, 1, 1); }, 2, 1);
+  EXPECT_NEAR(exact, 0.6198, 1e-3);
+  EXPECT_NEAR(Rays(BoxMesh(1, 1), 2, 1, centre), exact, 0.01);
+  for (const std::uint32_t cones : kConstellations) {
+    EXPECT_NEAR(Cones(Box256(), Options(cones, 2, 1), centre), exact, 0.1) << cones << " cones";
+    // Closed and all within reach: every direction is blocked.
+    EXPECT_GE(Cones(Box256(), Options(cones, 4, 0), centre), 0.85f) << cones << " cones";
+  }
+  EXPECT_NEAR(Rays(BoxMesh(1, 1), 4, 0, centre), 1.0, 1e-6);
+}
+
+TEST(ConeTracer, InsideAClosedSphereIsFullyOccluded) {
+  for (const std::uint32_t cones : kConstellations) {
+    // On the wall, facing in: every cone crosses the far wall within 2 radii.
+    EXPECT_GE(Cones(Sphere256(), Options(cones, 2.5, 0), {{0, 0, -1}, {0, 0, 1}}), 0.99f)
+        << cones << " cones";
+    EXPECT_GE(Cones(Sphere256(), Options(cones, 1.5, 0), {{0, 0, 0}, {0, 0, 1}}), 0.85f)
+        << cones << " cones";
+  }
+  EXPECT_NEAR(Rays(Icosphere(5), 2.5, 0, {{0, 0, -1}, {0, 0, 1}}), 1.0, 1e-6);
+}
+
+TEST(ConeTracer, TheFalloffWeighsTheFirstHit) {
+  // From the centre every ray meets the sphere at r = 1: AO = 1/(1 + λ·1/distance).
+  for (const double falloff : {1.0, 3.0}) {
+    const double exact = 1 / (1 + falloff / 2);
+    EXPECT_NEAR(Rays(Icosphere(5), 2, falloff, {{0, 0, 0}, {0, 0, 1}}), exact, 2e-3);
+    for (const std::uint32_t cones : kConstellations) {
+      EXPECT_NEAR(Cones(Sphere256(), Options(cones, 2, falloff), {{0, 0, 0}, {0, 0, 1}}), exact,
+                  0.1)
+          << cones << " cones, falloff " << falloff;
     }
   }
 }
 
-TEST(ConeTracer, InsideAClosedSphereIsFullyOccluded) {
-  for (const std::uint32_t cones : {3u, 5u, 8u, 16u}) {
-    const float wall = TraceOne(Sphere256(), Options(cones, 2.5, 0), {{0, 0, -1}, {0, 0, 1}});
-    const float centre = TraceOne(Sphere256(), Options(cones, 1.5, 0), {{0, 0, 0}, {0, 0, 1}});
-    const float fall = TraceOne(Sphere256(), Options(cones, 2, 1), {{0, 0, 0}, {0, 0, 1}});
-    std::cout << "sphere cones " << cones << " wall " << wall << " centre " << centre << " falloff(0.667) " << fall << "\n";
+// The vertices of CGAL's armadillo at 512³: cones against 512 Embree rays per vertex.
+TEST(ConeTracer, AgreesWithRayTracedAoOnARealMesh) {
+  const std::filesystem::path path = CgalMeshes() / "armadillo.off";
+  if (!std::filesystem::exists(path)) {
+    if (TestDataRequired()) FAIL() << path << " is missing (scripts/deps --test-data)";
+    GTEST_SKIP() << path << " is missing";
+  }
+  StatusOr<Mesh> mesh = ImportMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  const Svo svo = BakeScene(*mesh, 512);
+  const Box3d bounds = svo.grid.GridBounds();
+  const double distance = 0.25 * Length(bounds.hi - bounds.lo);
+  ConeOptions options = Options(8, distance, 1);
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(svo, options);
+  ASSERT_TRUE(tracer.ok());
+  StatusOr<RayAoReference> reference = RayAoReference::Make(*mesh);
+  ASSERT_TRUE(reference.ok());
+  const std::vector<AoPoint> points = VertexPoints(*mesh);
+  const std::vector<float> cones = tracer->Occlusion(points);
+  const std::vector<float> rays = reference->Occlusion(points, {512, distance, 1, 0});
+  std::vector<double> errors;
+  double mean = 0, cone_mean = 0, ray_mean = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    errors.push_back(std::abs(double{cones[i]} - rays[i]));
+    mean += errors.back();
+    cone_mean += cones[i];
+    ray_mean += rays[i];
+  }
+  const double n = static_cast<double>(points.size());
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LE(mean / n, 0.06);
+  EXPECT_LE(errors[static_cast<std::size_t>(0.95 * n)], 0.16);
+  // Not a constant that happens to be close: the AO varies, and the means agree.
+  EXPECT_GE(ray_mean / n, 0.05);
+  EXPECT_NEAR(cone_mean / n, ray_mean / n, 0.03);
+}
+
+TEST(ConeTracer, TheResultDoesNotDependOnTheThreadCount) {
+  const Mesh mesh = Icosphere(3);
+  ConeOptions options = Options(16, 1.5, 1);
+  options.jitter_seed = 11;
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(Sphere256(), options);
+  ASSERT_TRUE(tracer.ok());
+  StatusOr<RayAoReference> reference = RayAoReference::Make(Icosphere(5));
+  ASSERT_TRUE(reference.ok());
+  // Points inside the sphere facing every way, so that cones and rays see different walls.
+  std::vector<AoPoint> points = VertexPoints(mesh);
+  for (AoPoint& p : points) p.position = p.position * 0.5;
+  std::vector<float> cones[2], rays[2];
+  for (const std::size_t threads : {1, 2}) {
+    ThreadLimit limit(threads);
+    cones[threads - 1] = tracer->Occlusion(points);
+    rays[threads - 1] = reference->Occlusion(points, {64, 1.5, 1, 5});
+  }
+  EXPECT_EQ(cones[0], cones[1]);
+  EXPECT_EQ(rays[0], rays[1]);
+  EXPECT_NE(*std::min_element(cones[0].begin(), cones[0].end()),
+            *std::max_element(cones[0].begin(), cones[0].end()));
+}
+
+TEST(ConeTracer, BadOptionsAreRefused) {
+  const Svo& svo = Plane256();
+  EXPECT_FALSE(ConeTracer::Make(svo, Options(4, 1, 0)).ok());
+  EXPECT_FALSE(ConeTracer::Make(svo, Options(8, 0, 0)).ok());
+  EXPECT_FALSE(ConeTracer::Make(svo, Options(8, -1, 0)).ok());
+  EXPECT_FALSE(ConeTracer::Make(svo, Options(8, std::nan(""), 0)).ok());
+  EXPECT_FALSE(ConeTracer::Make(svo, Options(8, 1, -1)).ok());
+  ConeOptions aperture = Options(8, 1, 0);
+  aperture.aperture = 0;
+  EXPECT_FALSE(ConeTracer::Make(svo, aperture).ok());
+  Svo bare = svo;
+  bare.brick_side = 0;
+  const StatusOr<ConeTracer> none = ConeTracer::Make(bare, Options(8, 1, 0));
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.status().message().find("no bricks"), std::string::npos);
+}
+
+TEST(ConeConstellation, ConesCoverTheHemisphereAboveTheSurface) {
+  for (const std::uint32_t count : kConstellations) {
+    const std::vector<Cone> cones = ConeConstellation(count, 1);
+    ASSERT_EQ(cones.size(), count);
+    double solid_angle = 0;
+    for (const Cone& c : cones) {
+      EXPECT_NEAR(Length(c.axis), 1, 1e-12);
+      EXPECT_GT(c.axis.z, 0);
+      solid_angle += 2 * std::numbers::pi * (1 - std::cos(c.half_angle));
+    }
+    // Each cone has its region's solid angle: together, the hemisphere's.
+    EXPECT_NEAR(solid_angle, 2 * std::numbers::pi, 1e-9) << count;
   }
 }
 

@@ -1,6 +1,7 @@
 #include "svokit/bake/cone_tracer.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 
@@ -121,37 +122,51 @@ ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
   root_side_ = std::ldexp(1.0, static_cast<int>(svo.depth));
 }
 
-float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level) const {
-  const std::uint32_t shift = svo_->depth - level;
-  const double size = std::ldexp(1.0, static_cast<int>(shift));
+int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
   if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
         v.z < root_side_)) {
-    return 0;
+    return -1;
   }
-  const auto kx = static_cast<std::uint32_t>(v.x) >> shift;
-  const auto ky = static_cast<std::uint32_t>(v.y) >> shift;
-  const auto kz = static_cast<std::uint32_t>(v.z) >> shift;
-  std::uint64_t index = 0;
-  for (std::uint32_t l = 0; l < level; ++l) {
-    const std::uint32_t bit = level - 1 - l;
-    const unsigned c = ((kx >> bit) & 1u) | (((ky >> bit) & 1u) << 1) | (((kz >> bit) & 1u) << 2);
-    const SvoNode& node = svo_->levels[l].nodes[index];
-    if (((node.child_mask >> c) & 1u) == 0) return 0;
-    index = node.Child(c);
+  const std::uint32_t depth = svo_->depth;
+  const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
+             z = static_cast<std::uint32_t>(v.z);
+  // The levels whose node holds both this point and the last one keep their indices.
+  const std::uint32_t differ =
+      static_cast<std::uint32_t>(std::bit_width((x ^ cursor.x) | (y ^ cursor.y) | (z ^ cursor.z)));
+  std::uint32_t l = std::min(cursor.valid, depth - differ);
+  cursor.x = x;
+  cursor.y = y;
+  cursor.z = z;
+  for (; l < level; ++l) {
+    const std::uint32_t bit = depth - 1 - l;
+    const unsigned c = ((x >> bit) & 1u) | (((y >> bit) & 1u) << 1) | (((z >> bit) & 1u) << 2);
+    const SvoNode& node = svo_->levels[l].nodes[cursor.index[l]];
+    if (((node.child_mask >> c) & 1u) == 0) {
+      cursor.valid = l;
+      return static_cast<int>(l);
+    }
+    cursor.index[l + 1] = node.Child(c);
   }
+  cursor.valid = level;
+  return static_cast<int>(level);
+}
+
+float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const {
   // Trilinear over the brick's lattice (side 3: spacing half the node; side 2: the corners).
   const std::uint32_t side = svo_->brick_side;
+  const double scale = std::ldexp(1.0, -static_cast<int>(svo_->depth - level));
   const double cells = side - 1;
-  const double gx = (v.x / size - kx) * cells, gy = (v.y / size - ky) * cells,
-               gz = (v.z / size - kz) * cells;
+  const double nx = v.x * scale, ny = v.y * scale, nz = v.z * scale;
+  const double gx = (nx - std::floor(nx)) * cells, gy = (ny - std::floor(ny)) * cells,
+               gz = (nz - std::floor(nz)) * cells;
   const int ix = std::min(static_cast<int>(gx), static_cast<int>(side) - 2);
   const int iy = std::min(static_cast<int>(gy), static_cast<int>(side) - 2);
   const int iz = std::min(static_cast<int>(gz), static_cast<int>(side) - 2);
   const float fx = static_cast<float>(gx - ix), fy = static_cast<float>(gy - iy),
               fz = static_cast<float>(gz - iz);
   const std::uint8_t* brick = svo_->levels[level].opacity.data() + index * svo_->brick_samples();
-  auto at = [&](int x, int y, int z) {
-    return static_cast<float>(brick[(ix + x) + side * ((iy + y) + side * (iz + z))]);
+  auto at = [&](int dx, int dy, int dz) {
+    return static_cast<float>(brick[(ix + dx) + side * ((iy + dy) + side * (iz + dz))]);
   };
   const float x00 = at(0, 0, 0) + fx * (at(1, 0, 0) - at(0, 0, 0));
   const float x10 = at(0, 1, 0) + fx * (at(1, 1, 0) - at(0, 1, 0));
@@ -170,6 +185,7 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
   // Occlusion as the rays define it: the mean falloff at the first hit, E[f(r)]. Each sample
   // occludes its share of what the samples before it let through (the transmittance).
   float occlusion = 0, transmittance = 1;
+  Cursor cursor;
   for (double t = 1;;) {
     // Distance from the surface point (the origin sits `o` above it along the normal).
     const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
@@ -184,9 +200,19 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
     const auto coarse = static_cast<std::uint32_t>(lod);
     const float fine_weight = static_cast<float>(lod - coarse);
     const Vec3d p = origin + axis * t;
-    float coverage = Coverage(p, coarse);
-    if (fine_weight > 0 && coarse < depth) {
-      coverage += fine_weight * (Coverage(p, coarse + 1) - coverage);
+    // One descent serves both levels: to the finer one, the coarser on its way.
+    const bool fine = fine_weight > 0 && coarse < depth;
+    const std::uint32_t deepest = fine ? coarse + 1 : coarse;
+    float coverage = 0;
+    const int reached = Descend(p, deepest, cursor);
+    if (reached >= static_cast<int>(coarse)) {
+      coverage = Coverage(p, coarse, cursor.index[coarse]);
+      if (fine) {
+        // An absent finer node covers nothing.
+        const float finer =
+            reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor.index[deepest]) : 0;
+        coverage += fine_weight * (finer - coverage);
+      }
     }
     if (coverage > 0) {
       // Corrected for the step: a wall is seen by diameter/step samples.

@@ -11,6 +11,7 @@
 // fraction of a wall falls as 1/node size. A sample's opacity is read as coverage instead: the
 // fraction times the node size over the shell's thickness (docs/design.md, "Ambient occlusion").
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -67,8 +68,18 @@ class ConeTracer {
 
  private:
   ConeTracer(const Svo& svo, const ConeOptions& options);
-  // Coverage at continuous voxel coordinates `v`, read at `level` (trilinear in its brick).
-  float Coverage(const Vec3d& v, std::uint32_t level) const;
+  // The path of the last lookup: node indices at levels 0 .. valid of the nodes holding the voxel
+  // (x, y, z). A cone's samples move little, so most of the path is reused.
+  struct Cursor {
+    std::uint32_t x = 0, y = 0, z = 0;
+    std::uint32_t valid = 0;
+    std::array<std::uint64_t, 32> index{};
+  };
+  // Walks `cursor` towards the node of `level` holding voxel-space point `v`: the deepest level
+  // reached (`level` when that node exists), or −1 outside the octree's cube.
+  int Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
+  // Coverage at `v` in node `index` of `level` (trilinear in its brick).
+  float Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const;
   float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half) const;
 
   const Svo* svo_;

@@ -21,7 +21,7 @@ constexpr double kMargin = 0.02;  // of the image per side, around the fitted bo
 
 constexpr std::array<std::string_view, 7> kViewNames = {"front", "back",   "left", "right",
                                                         "top",   "bottom", "iso"};
-constexpr std::array<std::string_view, 3> kShadeNames = {"color", "normal", "depth"};
+constexpr std::array<std::string_view, 4> kShadeNames = {"color", "normal", "depth", "ao"};
 
 Vec3d Normalized(const Vec3d& v) {
   return v / Length(v);
@@ -324,7 +324,7 @@ StatusOr<Shade> ParseShade(std::string_view name) {
   for (std::size_t i = 0; i < kShadeNames.size(); ++i) {
     if (kShadeNames[i] == name) return static_cast<Shade>(i);
   }
-  return Status::BadInput("--shade '{}' is not color, normal or depth", name);
+  return Status::BadInput("--shade '{}' is not color, normal, depth or ao", name);
 }
 
 StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {
@@ -402,6 +402,9 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
   if (level > loaded) {
     return Status::BadInput("--level {} is beyond the octree's levels 0..{}", level, loaded);
   }
+  if (options.shade == Shade::kAo && !svo.has_ao) {
+    return Status::BadInput("--shade ao: the octree has no baked ambient occlusion (svo-bake --ao)");
+  }
   RenderResult result;
   result.level = level;
   result.camera = FitCamera(svo, options.view, options.width, options.height);
@@ -444,6 +447,12 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
         case Shade::kDepth: {
           const double v = 1 - 0.85 * (hit.t - near) / std::max(far - near, 1e-300);
           px[0] = px[1] = px[2] = Byte(v);
+          break;
+        }
+        case Shade::kAo: {
+          // The hit node's baked AO as grey, white where open (not lit: the term alone).
+          const std::uint8_t ao = svo.levels[hit.level].ao[hit.node];
+          px[0] = px[1] = px[2] = static_cast<std::uint8_t>(255 - ao);
           break;
         }
       }

@@ -23,6 +23,7 @@ enum class Shade {
   kColor,   ///< brick colour (trilinear at the hit), lit from the viewer's upper left
   kNormal,  ///< shading normal as RGB = (n + 1)/2
   kDepth,   ///< grey, near bright, over the grid's depth range along the view
+  kAo,      ///< the hit node's baked ambient occlusion (svo-bake), grey: white open, black occluded
 };
 
 /// "front", "back", "left", "right", "top", "bottom", "iso"; anything else is bad input.

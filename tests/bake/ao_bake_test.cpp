@@ -1,0 +1,192 @@
+// What svo-bake bakes into: node AO as the mean of the voxels below (recomputed from the keys),
+// the AOCC section read back whole and down to a level, UV texels and their dilated gutters, and
+// the check that a mesh is the octree's.
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "svokit/bake/ao_bake.hpp"
+#include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/compact_svo.hpp"
+#include "tests/bake/bake_scenes.hpp"
+
+namespace svokit::test {
+namespace {
+
+// The sample torus (UVs, a texture) at 48³, written as a file, read back and baked at its voxels.
+struct BakedTorus {
+  TempDir dir;
+  std::filesystem::path plain;
+  Svo svo;
+  std::vector<float> voxel_ao;
+};
+const BakedTorus& Torus48() {
+  static const BakedTorus& baked = *[] {
+    auto* b = new BakedTorus;
+    StatusOr<Mesh> mesh = ImportMesh(DataDir() / "uv-torus.obj");
+    EXPECT_TRUE(mesh.ok());
+    auto grid = GridTransform::FitResolution(mesh->Bounds(), 48);
+    VoxelizeOptions vo;
+    vo.colors = vo.normals = true;
+    StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, vo);
+    EXPECT_TRUE(voxels.ok());
+    StatusOr<CompactSvo> compact =
+        BuildCompactSvo(std::move(*voxels), &*mesh, BuildOptions{}, R"({"source":"torus"})");
+    EXPECT_TRUE(compact.ok());
+    b->plain = b->dir / "plain.svo";
+    EXPECT_TRUE(WriteSvo(*compact, b->plain).ok());
+    StatusOr<Svo> read = ReadSvo(b->plain);
+    EXPECT_TRUE(read.ok());
+    BakedTorus* out = b;
+    b->svo = std::move(*read);
+    ConeOptions options;
+    options.distance = 2.5;
+    StatusOr<ConeTracer> tracer = ConeTracer::Make(b->svo, options);
+    StatusOr<std::vector<AoPoint>> points = VoxelPoints(b->svo);
+    EXPECT_TRUE(tracer.ok() && points.ok());
+    b->voxel_ao = tracer->Occlusion(*points);
+    SetNodeAo(b->voxel_ao, b->svo);
+    return out;
+  }();
+  return baked;
+}
+
+TEST(SetNodeAo, ANodeHoldsTheMeanOfItsVoxels) {
+  const Svo& svo = Torus48().svo;
+  ASSERT_TRUE(svo.has_ao);
+  const std::vector<std::uint64_t> voxels = svo.LevelKeys(svo.depth);
+  const std::vector<float>& ao = Torus48().voxel_ao;
+  for (std::uint32_t level = 0; level <= svo.depth; ++level) {
+    // Sums per node key at this level, from the voxels' keys alone.
+    std::map<std::uint64_t, std::pair<std::uint64_t, std::uint64_t>> sums;
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      auto& [sum, count] = sums[voxels[i] >> (3 * (svo.depth - level))];
+      sum += EncodeAo(ao[i]);
+      ++count;
+    }
+    const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
+    ASSERT_EQ(keys.size(), svo.levels[level].ao.size());
+    for (std::size_t n = 0; n < keys.size(); ++n) {
+      const auto [sum, count] = sums.at(keys[n]);
+      const double mean = static_cast<double>(sum) / static_cast<double>(count);
+      EXPECT_LE(std::abs(svo.levels[level].ao[n] - mean), 0.5) << "level " << level;
+    }
+  }
+  // Some voxels are occluded (the torus' inner ring), some open.
+  EXPECT_LT(*std::min_element(ao.begin(), ao.end()), 0.05f);
+  EXPECT_GT(*std::max_element(ao.begin(), ao.end()), 0.1f);
+}
+
+TEST(AoSection, ReadsBackWholeAndDownToALevel) {
+  TempDir dir;
+  const Svo& baked = Torus48().svo;
+  const std::filesystem::path plain = Torus48().plain, out = dir / "baked.svo";
+  ASSERT_TRUE(WriteBakedSvo(plain, baked, "--ao", out).ok());
+  StatusOr<Svo> whole = ReadSvo(out);
+  ASSERT_TRUE(whole.ok()) << whole.status().message();
+  ASSERT_TRUE(whole->has_ao);
+  for (std::uint32_t l = 0; l <= baked.depth; ++l) EXPECT_EQ(whole->levels[l].ao, baked.levels[l].ao);
+  EXPECT_NE(whole->metadata.find("\"bake\":\"--ao\""), std::string::npos);
+  StatusOr<Svo> top = ReadSvo(out, 2);
+  ASSERT_TRUE(top.ok()) << top.status().message();
+  ASSERT_EQ(top->levels.size(), 3u);
+  for (std::uint32_t l = 0; l <= 2; ++l) EXPECT_EQ(top->levels[l].ao, baked.levels[l].ao);
+  // The plain file has none; baking again replaces the section.
+  EXPECT_FALSE(ReadSvo(plain)->has_ao);
+  ASSERT_TRUE(WriteBakedSvo(out, baked, "--ao --cones 5", dir / "again.svo").ok());
+  StatusOr<Svo> again = ReadSvo(dir / "again.svo");
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->levels.back().ao, baked.levels.back().ao);
+  // A damaged section is refused (its checksum), naming the file.
+  std::vector<std::uint8_t> bytes = ReadBytes(out);
+  bytes[bytes.size() - 3] ^= 0x40;
+  const StatusOr<Svo> damaged = DecodeSvo(bytes, "damaged.svo");
+  ASSERT_FALSE(damaged.ok());
+  EXPECT_NE(damaged.status().message().find("damaged.svo"), std::string::npos);
+}
+
+TEST(RasterizeUvs, TexelsOfTheUvTrianglesAndDilatedGutters) {
+  // One triangle over the lower-left half of UV space: texel centres with u + v ≤ 1.
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}};
+  mesh.uvs = {{0, 0}, {1, 0}, {0, 1}};
+  EnsureDefaultMaterial(mesh);
+  const int size = 16;
+  StatusOr<TexelPoints> texels = RasterizeUvs(mesh, size);
+  ASSERT_TRUE(texels.ok());
+  int expected = 0;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const double u = (x + 0.5) / size, v = 1 - (y + 0.5) / size;
+      expected += u + v <= 1;
+    }
+  }
+  ASSERT_EQ(texels->texels.size(), static_cast<std::size_t>(expected));
+  for (std::size_t i = 0; i < texels->texels.size(); ++i) {
+    const int x = static_cast<int>(texels->texels[i] % size), y = static_cast<int>(texels->texels[i] / size);
+    // The surface point is the texel centre's (u, v) on this triangle (x = u, y = v, z = 0).
+    EXPECT_NEAR(texels->points[i].position.x, (x + 0.5) / size, 1e-12);
+    EXPECT_NEAR(texels->points[i].position.y, 1 - (y + 0.5) / size, 1e-12);
+    EXPECT_NEAR(texels->points[i].normal.z, 1, 1e-12);
+  }
+  // AO = u on the covered texels; each texel of the first gutter ring holds the mean of its
+  // covered 8-neighbours, and every texel is filled with a value from the covered range.
+  std::vector<float> ao;
+  for (const AoPoint& p : texels->points) ao.push_back(static_cast<float>(p.position.x));
+  const std::vector<std::uint8_t> pixels = AoTexture(*texels, ao);
+  ASSERT_EQ(pixels.size(), static_cast<std::size_t>(size * size));
+  std::vector<int> covered(size * size, 0);
+  for (const std::uint32_t t : texels->texels) covered[t] = 1;
+  auto value = [&](int x, int y) { return pixels[static_cast<std::size_t>(y * size + x)] / 255.0; };
+  int first_ring = 0;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const double u = (x + 0.5) / size;
+      if (covered[y * size + x]) {
+        EXPECT_NEAR(value(x, y), 1 - u, 0.5 / 255 + 1e-6);
+        continue;
+      }
+      double sum = 0;
+      int n = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 0 || ny < 0 || nx >= size || ny >= size || !covered[ny * size + nx]) continue;
+          sum += 1 - (nx + 0.5) / size;
+          ++n;
+        }
+      }
+      if (n > 0) {
+        ++first_ring;
+        EXPECT_NEAR(value(x, y), sum / n, 0.5 / 255 + 1e-6) << x << "," << y;
+      }
+      EXPECT_GE(value(x, y), 1 - (size - 0.5) / size - 1e-6);
+      EXPECT_LE(value(x, y), 1 - 0.5 / size + 1e-6);
+    }
+  }
+  EXPECT_GE(first_ring, size);
+  Mesh no_uvs = mesh;
+  no_uvs.uvs.clear();
+  EXPECT_FALSE(RasterizeUvs(no_uvs, size).ok());
+  EXPECT_FALSE(RasterizeUvs(mesh, 0).ok());
+}
+
+TEST(CheckMeshMatchesOctree, OnlyTheOctreesOwnMeshPasses) {
+  Svo svo = Torus48().svo;
+  svo.metadata = R"({"voxelize":"--resolution 48 --pad 0 --mode conservative"})";
+  StatusOr<Mesh> torus = ImportMesh(DataDir() / "uv-torus.obj");
+  ASSERT_TRUE(torus.ok());
+  EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+  Mesh moved = *torus;
+  for (Vec3d& p : moved.positions) p.x += 1e-3;
+  const Status s = CheckMeshMatchesOctree(moved, svo, "moved.obj");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("moved.obj"), std::string::npos);
+  EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), svo, "sphere").ok());
+}
+
+}  // namespace
+}  // namespace svokit::test
