@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   app::AddFile(cli, "-o,--output", output, "The octree again, with AO per node (.svo)");
   app::AddFile(cli, "--mesh", mesh_path,
                "The mesh the octree was made from (for --vertex-out, --texture-out, --reference)");
-  app::AddFile(cli, "--vertex-out", vertex_out, "The mesh with per-vertex AO and grey colours (.ply)");
+  app::AddFile(cli, "--vertex-out", vertex_out,
+               "The mesh with per-vertex AO and grey colours (.ply)");
   app::AddFile(cli, "--texture-out", texture_out, "AO map over the mesh's UVs (.png, .tif, ...)");
   cli.add_option("--size", size, "--texture-out's width and height, in texels")
       ->option_text("N")
@@ -88,8 +89,9 @@ int main(int argc, char** argv) {
                  "λ of the falloff 1/(1 + λ·r/distance) that weighs an occluder at distance r")
       ->option_text("X")
       ->capture_default_str();
-  cli.add_option("--offset", cones.offset,
-                 "Cone origins' offset along the normal, in voxel diagonals (avoids self-occlusion)")
+  cli.add_option(
+         "--offset", cones.offset,
+         "Cone origins' offset along the normal, in voxel diagonals (avoids self-occlusion)")
       ->option_text("X")
       ->capture_default_str();
   cli.add_option("--jitter", jitter,
@@ -108,7 +110,8 @@ int main(int argc, char** argv) {
                  "Also ray trace the mesh's vertices with N rays (Embree) and print the cones' "
                  "error against that")
       ->option_text("N");
-  app::AddCommonOptions(cli, common, "svo-bake bunny.svo --ao --mesh bunny.obj --vertex-out ao.ply");
+  app::AddCommonOptions(cli, common,
+                        "svo-bake bunny.svo --ao --mesh bunny.obj --vertex-out ao.ply");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     auto fail = [&](const Status& s) { return app::Fail(tool, s); };
@@ -122,8 +125,9 @@ int main(int argc, char** argv) {
                                    input.string()));
     }
     if (method == "rays" && (vertex_out.empty() && texture_out.empty())) {
-      return fail(Status::BadInput("--method rays bakes onto the mesh only: give --vertex-out or "
-                                   "--texture-out"));
+      return fail(
+          Status::BadInput("--method rays bakes onto the mesh only: give --vertex-out or "
+                           "--texture-out"));
     }
     if (rays == 0 || (reference && *reference == 0)) {
       return fail(Status::BadInput("--rays and --reference need at least 1 ray"));
@@ -172,7 +176,8 @@ int main(int argc, char** argv) {
     if (method == "rays" || reference) {
       StatusOr<RayAoReference> made =
           app::RunStage(progress, "embree scene", [&] { return RayAoReference::Make(*mesh); });
-      if (!made.ok()) return fail(Status::BadInput("{}: {}", mesh_path.string(), made.status().message()));
+      if (!made.ok())
+        return fail(Status::BadInput("{}: {}", mesh_path.string(), made.status().message()));
       rays_scene = std::move(*made);
     }
     // AO at mesh points by the chosen method.
@@ -183,9 +188,10 @@ int main(int argc, char** argv) {
 
     fmt::print("octree      {} (depth {}, {} voxels)\n", input.string(), svo->depth,
                svo->voxel_count());
-    fmt::print("cones       {} (aperture x{}), distance {:.6g}, falloff {}, offset {} voxel diagonals{}\n",
-               cones.cones, cones.aperture, cones.distance, cones.falloff, cones.offset,
-               jitter ? fmt::format(", jitter seed {}", *jitter) : std::string());
+    fmt::print(
+        "cones       {} (aperture x{}), distance {:.6g}, falloff {}, offset {} voxel diagonals{}\n",
+        cones.cones, cones.aperture, cones.distance, cones.falloff, cones.offset,
+        jitter ? fmt::format(", jitter seed {}", *jitter) : std::string());
     if (!output.empty()) {
       StatusOr<std::vector<AoPoint>> points = VoxelPoints(*svo);
       if (!points.ok()) {
@@ -194,16 +200,16 @@ int main(int argc, char** argv) {
       const std::vector<float> voxel_ao =
           app::RunStage(progress, "voxels", [&] { return tracer->Occlusion(*points); });
       SetNodeAo(voxel_ao, *svo);
-      const std::string options = fmt::format(
-          "--ao --cones {} --aperture {} --distance {} --falloff {} --offset {}{}", cones.cones,
-          cones.aperture, cones.distance, cones.falloff, cones.offset,
-          jitter ? fmt::format(" --jitter {}", *jitter) : std::string());
-      const Status written = app::RunStage(progress, "write", [&] {
-        return WriteBakedSvo(input, *svo, options, output);
-      });
+      const std::string options =
+          fmt::format("--ao --cones {} --aperture {} --distance {} --falloff {} --offset {}{}",
+                      cones.cones, cones.aperture, cones.distance, cones.falloff, cones.offset,
+                      jitter ? fmt::format(" --jitter {}", *jitter) : std::string());
+      const Status written = app::RunStage(
+          progress, "write", [&] { return WriteBakedSvo(input, *svo, options, output); });
       if (!written.ok()) return fail(written);
       fmt::print("voxels      {} traced, mean AO {:.4f}\n", voxel_ao.size(), Mean(voxel_ao));
-      fmt::print("output      {} ({} bytes)\n", output.string(), std::filesystem::file_size(output));
+      fmt::print("output      {} ({} bytes)\n", output.string(),
+                 std::filesystem::file_size(output));
     }
     if (!vertex_out.empty() || reference) {
       const std::vector<AoPoint> points = VertexPoints(*mesh);
@@ -216,9 +222,10 @@ int main(int argc, char** argv) {
           return rays_scene->Occlusion(points, {*reference, cones.distance, cones.falloff, 0});
         });
         const Errors e = CompareAo(vertex_ao, truth);
-        fmt::print("reference   {} rays per vertex, mean AO {:.4f}; error: mean {:.4f}, 95th "
-                   "percentile {:.4f}, max {:.4f}\n",
-                   *reference, Mean(truth), e.mean, e.p95, e.max);
+        fmt::print(
+            "reference   {} rays per vertex, mean AO {:.4f}; error: mean {:.4f}, 95th "
+            "percentile {:.4f}, max {:.4f}\n",
+            *reference, Mean(truth), e.mean, e.p95, e.max);
       }
       if (!vertex_out.empty()) {
         const Status written = app::RunStage(progress, "write ply", [&] {
@@ -236,11 +243,12 @@ int main(int argc, char** argv) {
       const std::vector<float> texel_ao =
           app::RunStage(progress, "texels", [&] { return bake_points(texels->points); });
       const std::vector<std::uint8_t> pixels = AoTexture(*texels, texel_ao);
-      const Status written = app::RunStage(
-          progress, "write texture", [&] { return WriteImage(texture_out, size, size, 1, pixels); });
+      const Status written = app::RunStage(progress, "write texture", [&] {
+        return WriteImage(texture_out, size, size, 1, pixels);
+      });
       if (!written.ok()) return fail(written);
-      fmt::print("texture-out {} ({}x{}, {} texels covered, mean AO {:.4f})\n", texture_out.string(),
-                 size, size, texels->texels.size(), Mean(texel_ao));
+      fmt::print("texture-out {} ({}x{}, {} texels covered, mean AO {:.4f})\n",
+                 texture_out.string(), size, size, texels->texels.size(), Mean(texel_ao));
     }
     app::PrintTimes(progress);
     return 0;

@@ -87,7 +87,8 @@ TEST(AoSection, ReadsBackWholeAndDownToALevel) {
   StatusOr<Svo> whole = ReadSvo(out);
   ASSERT_TRUE(whole.ok()) << whole.status().message();
   ASSERT_TRUE(whole->has_ao);
-  for (std::uint32_t l = 0; l <= baked.depth; ++l) EXPECT_EQ(whole->levels[l].ao, baked.levels[l].ao);
+  for (std::uint32_t l = 0; l <= baked.depth; ++l)
+    EXPECT_EQ(whole->levels[l].ao, baked.levels[l].ao);
   EXPECT_NE(whole->metadata.find("\"bake\":\"--ao\""), std::string::npos);
   StatusOr<Svo> top = ReadSvo(out, 2);
   ASSERT_TRUE(top.ok()) << top.status().message();
@@ -126,7 +127,8 @@ TEST(RasterizeUvs, TexelsOfTheUvTrianglesAndDilatedGutters) {
   }
   ASSERT_EQ(texels->texels.size(), static_cast<std::size_t>(expected));
   for (std::size_t i = 0; i < texels->texels.size(); ++i) {
-    const int x = static_cast<int>(texels->texels[i] % size), y = static_cast<int>(texels->texels[i] / size);
+    const int x = static_cast<int>(texels->texels[i] % size),
+              y = static_cast<int>(texels->texels[i] / size);
     // The surface point is the texel centre's (u, v) on this triangle (x = u, y = v, z = 0).
     EXPECT_NEAR(texels->points[i].position.x, (x + 0.5) / size, 1e-12);
     EXPECT_NEAR(texels->points[i].position.y, 1 - (y + 0.5) / size, 1e-12);

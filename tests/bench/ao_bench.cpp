@@ -14,7 +14,7 @@
 //   --image NAME D    DIR/NAME.png at depth D: reference, cones and |cones − reference| × 4
 //   --per-pixel       the picture traces the visible surface point of every pixel (face normals)
 //                     instead of Gouraud-shading the per-vertex AO
-//   --view X,Y,Z      the picture's view direction (default 0,0,-1: the front, +y up)
+//   --view X,Y,Z      the picture's view direction (default 0,0,-1: svo-inspect's front, +y up)
 //   --cull            the picture drops back faces (a room seen from outside through its walls)
 // Prints a table per part, header lines starting "mesh".
 
@@ -373,7 +373,7 @@ int main(int argc, char** argv) {
       std::vector<float> cones8;
       for (const std::uint32_t count : kConeCounts) {
         const ConeTracer tracer = MakeTracer(svo, DefaultCones(svo, count));
-        auto [ao, t] = Timed(1, [&] { return tracer.Occlusion(points); });
+        auto [ao, t] = Timed(3, [&] { return tracer.Occlusion(points); });
         const Errors e = Compare(ao, truth);
         fmt::print(
             "{:<18} {:>5} {:>5} {:>5} {:>9} {:>8.4f} {:>8.4f} {:>8.4f} {:>7.4f} {:>7.4f} "
@@ -427,7 +427,7 @@ int main(int argc, char** argv) {
           }
         }
         equal_rows.push_back(fmt::format(
-            "{:<18} {:>5} {:>5} {:>8.4f} {:>13.0f} {:>10.1f} {:>12.0f} {:>10.1f}x", l.spec.name,
+            "{:<18} {:>5} {:>5} {:>8.4f} {:>13.0f} {:>10.1f} {:>12.0f} {:>10.2f}x", l.spec.name,
             depth, 8, ce.mean, cone_rate, equal_rays, ray_rate, cone_rate / ray_rate));
       }
 

@@ -61,16 +61,17 @@ std::uint8_t EncodeAo(float ao) {
 
 StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo) {
   if (!svo.has_normal || svo.brick_side == 0) {
-    return Status::BadInput("the octree's voxels have no normals to bake along (voxelize with "
-                            "--attributes normal or color,normal)");
+    return Status::BadInput(
+        "the octree's voxels have no normals to bake along (voxelize with "
+        "--attributes normal or color,normal)");
   }
   const std::vector<std::uint64_t> keys = svo.LevelKeys(svo.depth);
   std::vector<AoPoint> points(keys.size());
   ParallelChunks(keys.size(), 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const MortonCoord c = MortonDecode(keys[i]);
-      points[i] = {svo.grid.VoxelCenter({static_cast<int>(c.x), static_cast<int>(c.y),
-                                         static_cast<int>(c.z)}),
+      points[i] = {svo.grid.VoxelCenter(
+                       {static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)}),
                    VoxelNormal(svo, i)};
     }
   });
@@ -132,7 +133,8 @@ std::vector<AoPoint> SurfacePoints(const Mesh& mesh, std::size_t count, std::uin
   if (total <= 0) return points;
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint64_t h = HashIndex(seed, k);
-    const double at = (static_cast<double>(k) + UnitInterval(h)) / static_cast<double>(count) * total;
+    const double at =
+        (static_cast<double>(k) + UnitInterval(h)) / static_cast<double>(count) * total;
     const std::size_t t = std::min<std::size_t>(
         static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), at) -
                                  cumulative.begin()),
@@ -188,7 +190,8 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
           w[c] = ((x[b] - x[a]) * (cy - y[a]) - (cx - x[a]) * (y[b] - y[a])) / area;
         }
         if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
-        const std::size_t texel = static_cast<std::size_t>(py) * side + static_cast<std::size_t>(px);
+        const std::size_t texel =
+            static_cast<std::size_t>(py) * side + static_cast<std::size_t>(px);
         if (owner[texel] >= 0) continue;
         owner[texel] = static_cast<std::int64_t>(t);
         weights[texel] = w;
@@ -315,16 +318,18 @@ Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::strin
     return Status::BadInput("{}: the mesh lies outside the octree's grid: not its mesh", mesh_name);
   }
   const StatusOr<GridTransform> fitted =
-      resolution ? GridTransform::FitResolution(bounds, static_cast<std::uint32_t>(*resolution),
-                                                static_cast<std::uint32_t>(pad))
-                 : GridTransform::FitVoxelSize(bounds, *voxel_size, static_cast<std::uint32_t>(pad));
+      resolution
+          ? GridTransform::FitResolution(bounds, static_cast<std::uint32_t>(*resolution),
+                                         static_cast<std::uint32_t>(pad))
+          : GridTransform::FitVoxelSize(bounds, *voxel_size, static_cast<std::uint32_t>(pad));
   const GridTransform& g = svo.grid;
   const double tolerance = 1e-6 * g.voxel_size();
   if (!fitted.ok() || fitted->dims() != g.dims() ||
       std::abs(fitted->voxel_size() - g.voxel_size()) > 1e-9 * g.voxel_size() ||
       Length(fitted->origin() - g.origin()) > tolerance) {
     return Status::BadInput(
-        "{}: the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] do not give the "
+        "{}: the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] do not give "
+        "the "
         "octree's grid: not the mesh it was voxelized from",
         mesh_name, bounds.lo.x, bounds.lo.y, bounds.lo.z, bounds.hi.x, bounds.hi.y, bounds.hi.z);
   }

@@ -20,7 +20,7 @@ constexpr double kConservativeShell = 1.5, kThinShell = 0.8;
 // Coverage of a sample = gain × opacity × node size / shell thickness: the tent cascade spreads a
 // wall over about two node sizes, so its peak reaches about half of what the wall covers.
 constexpr double kCoverageGain = 2.0;
-// Step along the cone, in cone diameters (each step's opacity corrected for it).
+// Step along the cone, in footprints (each step's opacity corrected for it: a square root).
 constexpr double kStep = 0.5;
 // A cone that lets less than this through is fully occluded.
 constexpr float kClear = 0.002f;
@@ -64,12 +64,13 @@ std::vector<Cone> ConeConstellation(std::uint32_t count, double aperture) {
     const double cos0 = std::sqrt(1 - ring.u0), cos1 = std::sqrt(1 - ring.u1);
     const double share = (cos0 - cos1) / ring.count;
     const double half = std::min(std::acos(1 - share) * aperture, kPi / 2);
-    const double theta = ring.u0 == 0 && ring.count == 1 ? 0 : std::asin(std::sqrt((ring.u0 + ring.u1) / 2));
+    const double theta =
+        ring.u0 == 0 && ring.count == 1 ? 0 : std::asin(std::sqrt((ring.u0 + ring.u1) / 2));
     for (std::uint32_t j = 0; j < ring.count; ++j) {
       const double phi = 2 * kPi * (j + ring.phase) / ring.count;
-      cones.push_back({{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                        std::cos(theta)},
-                       half});
+      cones.push_back(
+          {{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)},
+           half});
     }
   }
   return cones;
@@ -86,8 +87,9 @@ void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b) {
 
 StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options) {
   if (svo.brick_side == 0) {
-    return Status::BadInput("the octree has no bricks to trace cones through (build it with "
-                            "--bricks 3 or 2)");
+    return Status::BadInput(
+        "the octree has no bricks to trace cones through (build it with "
+        "--bricks 3 or 2)");
   }
   if (Rings(options.cones).empty()) {
     return Status::BadInput("--cones {}: constellations have 3, 5, 8 or 16 cones", options.cones);
@@ -114,8 +116,8 @@ ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
     : svo_(&svo), options_(options), cones_(ConeConstellation(options.cones, options.aperture)) {
   const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
-    level_gain_.push_back(
-        static_cast<float>(kCoverageGain * std::ldexp(1.0, static_cast<int>(svo.depth - l)) / shell));
+    level_gain_.push_back(static_cast<float>(
+        kCoverageGain * std::ldexp(1.0, static_cast<int>(svo.depth - l)) / shell));
   }
   distance_voxels_ = options.distance / svo.grid.voxel_size();
   offset_voxels_ = options.offset * std::sqrt(3.0);
@@ -177,8 +179,25 @@ float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t in
   return std::min(1.f, opacity * level_gain_[level]);
 }
 
+double ConeTracer::EmptyNodeSize(int level) const {
+  return std::ldexp(1.0, static_cast<int>(svo_->depth) - level);
+}
+
+double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& axis, int level) const {
+  // The distance along `axis` from p to where it leaves p's node of `level`, a hair beyond.
+  const double size = EmptyNodeSize(level);
+  double exit = INFINITY;
+  const double ps[3] = {p.x, p.y, p.z}, ds[3] = {axis.x, axis.y, axis.z};
+  for (int i = 0; i < 3; ++i) {
+    const double lo = std::floor(ps[i] / size) * size;
+    if (ds[i] > 0) exit = std::min(exit, (lo + size - ps[i]) / ds[i]);
+    if (ds[i] < 0) exit = std::min(exit, (lo - ps[i]) / ds[i]);
+  }
+  return exit + 1e-6 * size;
+}
+
 float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta,
-                           double tan_half) const {
+                            double tan_half) const {
   const std::uint32_t depth = svo_->depth;
   const double lambda = options_.falloff / distance_voxels_;
   const double o = offset_voxels_;
@@ -203,20 +222,25 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
     // One descent serves both levels: to the finer one, the coarser on its way.
     const bool fine = fine_weight > 0 && coarse < depth;
     const std::uint32_t deepest = fine ? coarse + 1 : coarse;
-    float coverage = 0;
     const int reached = Descend(p, deepest, cursor);
-    if (reached >= static_cast<int>(coarse)) {
-      coverage = Coverage(p, coarse, cursor.index[coarse]);
-      if (fine) {
-        // An absent finer node covers nothing.
-        const float finer =
-            reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor.index[deepest]) : 0;
-        coverage += fine_weight * (finer - coverage);
-      }
+    if (reached < 0) break;  // out of the octree's cube, which the axis does not enter again
+    if (reached < static_cast<int>(coarse)) {
+      // Inside an empty node: nothing to read there until the cone leaves it or grows to its
+      // size (then a coarser level's brick may hold its neighbours' surface).
+      t = std::max(t + kStep * footprint, std::min(ExitDistance(p, axis, reached + 1) + t,
+                                                   EmptyNodeSize(reached + 1) / (2 * tan_half)));
+      continue;
+    }
+    float coverage = Coverage(p, coarse, cursor.index[coarse]);
+    if (fine) {
+      // An absent finer node covers nothing.
+      const float finer =
+          reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor.index[deepest]) : 0;
+      coverage += fine_weight * (finer - coverage);
     }
     if (coverage > 0) {
-      // Corrected for the step: a wall is seen by diameter/step samples.
-      const float alpha = 1.f - std::pow(1.f - coverage, static_cast<float>(kStep));
+      // Corrected for the step: a wall is seen by 1/kStep samples, (1 − α)^(1/kStep) = 1 − coverage.
+      const float alpha = 1.f - std::sqrt(1.f - coverage);
       occlusion += transmittance * alpha * static_cast<float>(1 / (1 + lambda * r));
       transmittance *= 1 - alpha;
       if (transmittance <= kClear) break;

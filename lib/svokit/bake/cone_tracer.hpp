@@ -80,6 +80,8 @@ class ConeTracer {
   int Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   // Coverage at `v` in node `index` of `level` (trilinear in its brick).
   float Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const;
+  double EmptyNodeSize(int level) const;
+  double ExitDistance(const Vec3d& p, const Vec3d& axis, int level) const;
   float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half) const;
 
   const Svo* svo_;

@@ -52,9 +52,9 @@ StatusOr<RayAoReference> RayAoReference::Make(const Mesh& mesh) {
   rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_ROBUST);
   RTCGeometry geometry = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vertices = static_cast<float*>(
-      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                              3 * sizeof(float), mesh.positions.size()));
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                               mesh.positions.size()));
   auto* indices = static_cast<std::uint32_t*>(
       rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                               3 * sizeof(std::uint32_t), mesh.triangles.size()));

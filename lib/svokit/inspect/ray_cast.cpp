@@ -403,7 +403,8 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
     return Status::BadInput("--level {} is beyond the octree's levels 0..{}", level, loaded);
   }
   if (options.shade == Shade::kAo && !svo.has_ao) {
-    return Status::BadInput("--shade ao: the octree has no baked ambient occlusion (svo-bake --ao)");
+    return Status::BadInput(
+        "--shade ao: the octree has no baked ambient occlusion (svo-bake --ao)");
   }
   RenderResult result;
   result.level = level;

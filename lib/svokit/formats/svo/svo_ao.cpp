@@ -72,7 +72,8 @@ bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink,
   }
   // Levels past `last` were not decoded: their bytes follow the decoded levels' and are dropped.
   std::uint64_t nodes = 0;
-  for (std::uint32_t l = 0; l <= last && l < svo.levels.size(); ++l) nodes += svo.levels[l].node_count;
+  for (std::uint32_t l = 0; l <= last && l < svo.levels.size(); ++l)
+    nodes += svo.levels[l].node_count;
   // A whole octree needs every byte; one read down to `last` the first `nodes` (levels in order).
   if (last >= svo.depth ? raw != nodes : raw < nodes) {
     sink.Add("ao", name, "the AOCC section holds {} bytes for {} nodes", raw, nodes);
