@@ -50,8 +50,8 @@ TEST(SvoBakeCli, BakesIntoTheOctreeTheSameBytesForAnyThreadCount) {
   ExpectValidSvo(one, kTorus);
   // svo-inspect shows the term: the inner ring darker than the outer.
   const std::string png = (dir / "ao.png").string();
-  const ToolResult render = RunTool(
-      "svo-inspect", {one, "--render", png, "--shade", "ao", "--view", "top", "--size", "64x64", "-q"});
+  const ToolResult render = RunTool("svo-inspect", {one, "--render", png, "--shade", "ao", "--view",
+                                                    "top", "--size", "64x64", "-q"});
   ASSERT_EQ(render.exit_code, 0) << render.err;
   const std::vector<std::uint8_t> bytes = ReadBytes(png);
   ImageHeader header;
@@ -69,10 +69,9 @@ TEST(SvoBakeCli, BakesIntoTheOctreeTheSameBytesForAnyThreadCount) {
 TEST(SvoBakeCli, BakesOntoTheVerticesAndTheUvs) {
   TempDir dir;
   const std::string ply = (dir / "ao.ply").string(), png = (dir / "ao.png").string();
-  const ToolResult r =
-      RunTool("svo-bake", {TorusSvo(), "--ao", "--mesh", kTorus, "--vertex-out", ply,
-                           "--texture-out", png, "--size", "128", "--distance", "2.5",
-                           "--reference", "256", "-q"});
+  const ToolResult r = RunTool(
+      "svo-bake", {TorusSvo(), "--ao", "--mesh", kTorus, "--vertex-out", ply, "--texture-out", png,
+                   "--size", "128", "--distance", "2.5", "--reference", "256", "-q"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("reference   256 rays per vertex"), std::string::npos) << r.out;
   StatusOr<Mesh> torus = ImportMesh(kTorus);
@@ -101,9 +100,14 @@ TEST(SvoBakeCli, BadInputIsOneLineExitTwoAndNoOutput) {
   const std::string tetra_svo = (dir / "tetra.svo").string();
   ASSERT_EQ(RunTool("mesh2svo", {sphere, "-r", "16", "-o", tetra_svo, "-q"}).exit_code, 0);
   const std::string no_bricks = (dir / "nobricks.svo").string();
-  ASSERT_EQ(RunTool("mesh2svo", {kTorus, "-r", "16", "--bricks", "none", "-o", no_bricks, "-q"}).exit_code, 0);
+  ASSERT_EQ(RunTool("mesh2svo", {kTorus, "-r", "16", "--bricks", "none", "-o", no_bricks, "-q"})
+                .exit_code,
+            0);
   const std::string no_normals = (dir / "nonormals.svo").string();
-  ASSERT_EQ(RunTool("mesh2svo", {kTorus, "-r", "16", "--attributes", "color", "-o", no_normals, "-q"}).exit_code, 0);
+  ASSERT_EQ(
+      RunTool("mesh2svo", {kTorus, "-r", "16", "--attributes", "color", "-o", no_normals, "-q"})
+          .exit_code,
+      0);
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{tetra_svo, "--ao", "--mesh", sphere, "--texture-out", png}, "no texture coordinates"},
       {{TorusSvo(), "--ao", "--mesh", sphere, "--vertex-out", ply}, "not the mesh"},

@@ -51,6 +51,17 @@ std::vector<Ring> Rings(std::uint32_t cones) {
   }
 }
 
+// log2 of x ≥ 1 to about 1e-4: the exponent plus a quartic for ln of the mantissa (a level of
+// detail needs no more, and libm's log2f was a sixth of the tracer's time).
+float FastLog2(float x) {
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
+  const float exponent = static_cast<float>(static_cast<int>(bits >> 23) - 127);
+  const float m = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u);  // [1, 2)
+  const float ln_m =
+      -1.7417939f + (2.8212026f + (-1.4699568f + (0.44717955f - 0.056570851f * m) * m) * m) * m;
+  return exponent + 1.44269504f * ln_m;
+}
+
 bool Finite(double v) {
   return std::isfinite(v);
 }
@@ -116,6 +127,7 @@ ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
     : svo_(&svo), options_(options), cones_(ConeConstellation(options.cones, options.aperture)) {
   const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
+    node_size_.push_back(std::ldexp(1.0, static_cast<int>(svo.depth - l)));
     level_gain_.push_back(static_cast<float>(
         kCoverageGain * std::ldexp(1.0, static_cast<int>(svo.depth - l)) / shell));
   }
@@ -156,7 +168,7 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
 float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const {
   // Trilinear over the brick's lattice (side 3: spacing half the node; side 2: the corners).
   const std::uint32_t side = svo_->brick_side;
-  const double scale = std::ldexp(1.0, -static_cast<int>(svo_->depth - level));
+  const double scale = 1 / node_size_[level];
   const double cells = side - 1;
   const double nx = v.x * scale, ny = v.y * scale, nz = v.z * scale;
   const double gx = (nx - std::floor(nx)) * cells, gy = (ny - std::floor(ny)) * cells,
@@ -179,19 +191,16 @@ float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t in
   return std::min(1.f, opacity * level_gain_[level]);
 }
 
-double ConeTracer::EmptyNodeSize(int level) const {
-  return std::ldexp(1.0, static_cast<int>(svo_->depth) - level);
-}
-
-double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& axis, int level) const {
-  // The distance along `axis` from p to where it leaves p's node of `level`, a hair beyond.
-  const double size = EmptyNodeSize(level);
+double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const {
+  // The distance along the axis from p to where it leaves p's node of `level`, a hair beyond.
+  const std::uint32_t shift = svo_->depth - static_cast<std::uint32_t>(level);
+  const double size = node_size_[static_cast<std::size_t>(level)];
   double exit = INFINITY;
-  const double ps[3] = {p.x, p.y, p.z}, ds[3] = {axis.x, axis.y, axis.z};
+  const double ps[3] = {p.x, p.y, p.z}, inv[3] = {inverse_axis.x, inverse_axis.y, inverse_axis.z};
   for (int i = 0; i < 3; ++i) {
-    const double lo = std::floor(ps[i] / size) * size;
-    if (ds[i] > 0) exit = std::min(exit, (lo + size - ps[i]) / ds[i]);
-    if (ds[i] < 0) exit = std::min(exit, (lo - ps[i]) / ds[i]);
+    const double lo = static_cast<double>((static_cast<std::uint32_t>(ps[i]) >> shift) << shift);
+    if (inv[i] > 0) exit = std::min(exit, (lo + size - ps[i]) * inv[i]);
+    if (inv[i] < 0) exit = std::min(exit, (lo - ps[i]) * inv[i]);
   }
   return exit + 1e-6 * size;
 }
@@ -205,6 +214,7 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
   // occludes its share of what the samples before it let through (the transmittance).
   float occlusion = 0, transmittance = 1;
   Cursor cursor;
+  const Vec3d inverse_axis{1 / axis.x, 1 / axis.y, 1 / axis.z};
   for (double t = 1;;) {
     // Distance from the surface point (the origin sits `o` above it along the normal).
     const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
@@ -214,10 +224,11 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
     // off the point's own tangent plane: near it, the cone reads finer levels than its diameter.
     const double height = o + t * cos_theta;
     const double footprint = std::clamp((height - kShellReach) / kFootprint, 1.0, diameter);
-    const double lod = std::clamp(static_cast<double>(depth) - std::log2(footprint), 0.0,
-                                  static_cast<double>(depth));
+    const float lod =
+        std::clamp(static_cast<float>(depth) - FastLog2(static_cast<float>(footprint)), 0.f,
+                   static_cast<float>(depth));
     const auto coarse = static_cast<std::uint32_t>(lod);
-    const float fine_weight = static_cast<float>(lod - coarse);
+    const float fine_weight = lod - static_cast<float>(coarse);
     const Vec3d p = origin + axis * t;
     // One descent serves both levels: to the finer one, the coarser on its way.
     const bool fine = fine_weight > 0 && coarse < depth;
@@ -227,8 +238,10 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
     if (reached < static_cast<int>(coarse)) {
       // Inside an empty node: nothing to read there until the cone leaves it or grows to its
       // size (then a coarser level's brick may hold its neighbours' surface).
-      t = std::max(t + kStep * footprint, std::min(ExitDistance(p, axis, reached + 1) + t,
-                                                   EmptyNodeSize(reached + 1) / (2 * tan_half)));
+      const int empty = reached + 1;
+      t = std::max(t + kStep * footprint,
+                   std::min(t + ExitDistance(p, inverse_axis, empty),
+                            node_size_[static_cast<std::size_t>(empty)] / (2 * tan_half)));
       continue;
     }
     float coverage = Coverage(p, coarse, cursor.index[coarse]);
@@ -239,7 +252,8 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
       coverage += fine_weight * (finer - coverage);
     }
     if (coverage > 0) {
-      // Corrected for the step: a wall is seen by 1/kStep samples, (1 − α)^(1/kStep) = 1 − coverage.
+      // Corrected for the step: a wall is seen by 1/kStep samples, (1 − α)^(1/kStep) = 1 −
+      // coverage.
       const float alpha = 1.f - std::sqrt(1.f - coverage);
       occlusion += transmittance * alpha * static_cast<float>(1 / (1 + lambda * r));
       transmittance *= 1 - alpha;

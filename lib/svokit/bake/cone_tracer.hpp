@@ -80,14 +80,14 @@ class ConeTracer {
   int Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   // Coverage at `v` in node `index` of `level` (trilinear in its brick).
   float Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const;
-  double EmptyNodeSize(int level) const;
-  double ExitDistance(const Vec3d& p, const Vec3d& axis, int level) const;
+  double ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const;
   float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half) const;
 
   const Svo* svo_;
   ConeOptions options_;
   std::vector<Cone> cones_;
-  std::vector<float> level_gain_;  // per level: node size over the shell's thickness
+  std::vector<double> node_size_;  // per level, in voxels
+  std::vector<float> level_gain_;  // per level: coverage per unit of opacity
   double distance_voxels_ = 0;
   double offset_voxels_ = 0;
   double root_side_ = 0;
