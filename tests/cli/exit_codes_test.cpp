@@ -107,6 +107,10 @@ class ExitCodes : public ::testing::Test {
         {"svo-inspect",
          {svo, "--slice", "z=8", (out / "s.png").string()},
          (out / "s.png").string()},
+        {"svo-bake", {svo, "--ao", "-o", (out / "ao.svo").string()}, (out / "ao.svo").string()},
+        {"svo-bake",
+         {svo, "--ao", "--mesh", mesh, "--vertex-out", (out / "ao.ply").string()},
+         (out / "ao.ply").string()},
     };
     for (const char* ext : {"vdb", "vox", "binvox", "ply", "xyz"}) {
       const std::string o = (out / (std::string("e.") + ext)).string();

@@ -8,8 +8,9 @@
 namespace svokit::test {
 namespace {
 
-const char* const kTools[] = {"svo-import", "mesh2svo",   "svo-voxelize", "svo-build",
-                              "svo-merge",  "svo-export", "svo-validate", "svo-inspect"};
+const char* const kTools[] = {"svo-import",   "mesh2svo",    "svo-voxelize",
+                              "svo-build",    "svo-merge",   "svo-export",
+                              "svo-validate", "svo-inspect", "svo-bake"};
 
 std::string Help(const std::string& tool) {
   const ToolResult r = RunTool(tool, {"--help"});
