@@ -56,8 +56,8 @@ int main(int argc, char** argv) {
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
     StatusOr<GridTransform> grid = voxelize.Grid(mesh->Bounds());
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
-    const std::string meta =
-        SvoMetadataJson({input.filename().string(), voxelize.Recorded(), build.Recorded()});
+    const std::string meta = SvoMetadataJson(
+        {input.filename().string(), voxelize.Recorded(), build.Recorded(), mesh->triangle_count()});
     // Without a limit, a build goes by pages when the whole grid would not fit in half the
     // machine's memory (held whole, ~48 B a voxel, ~100 with bricks): the same file either way.
     const bool may_go_by_pages = memory_limit.empty() && pages.empty();

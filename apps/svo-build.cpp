@@ -81,7 +81,8 @@ int main(int argc, char** argv) {
       if (!m.ok()) return app::Fail(tool, m.status());
       mesh = std::move(*m);
     }
-    const std::string meta = SvoMetadataJson({source.source, source.options, build.Recorded()});
+    const std::string meta =
+        SvoMetadataJson({source.source, source.options, build.Recorded(), source.triangles});
     if (cubes) {
       const VfragCubes& vfrag = *cubes;
       const BoxVoxels paged{vfrag.grid(),

@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
     const std::string ext = LowerExtension(output);
     std::size_t voxel_count = 0;
     Status written;
-    const VfragMetadata meta{input.filename().string(), voxelize.Recorded()};
+    const VfragMetadata meta{input.filename().string(), voxelize.Recorded(),
+                             mesh->triangle_count()};
     // Without a limit, a .vfrag whose voxels would not fit in half the machine's memory (~8 B a
     // voxel, ~16 with attributes) is written cube by cube within that half.
     StatusOr<std::uint64_t> limit = std::uint64_t{0};

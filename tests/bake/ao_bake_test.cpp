@@ -188,6 +188,16 @@ TEST(CheckMeshMatchesOctree, OnlyTheOctreesOwnMeshPasses) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("moved.obj"), std::string::npos);
   EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), svo, "sphere").ok());
+  // Same bounds, another triangle count (one triangle dropped, its corners still used).
+  svo.metadata = R"({"triangles":2304,"voxelize":"--resolution 48 --pad 0"})";
+  EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+  Mesh fewer = *torus;
+  fewer.triangles.pop_back();
+  fewer.material_ids.pop_back();
+  const Status count = CheckMeshMatchesOctree(fewer, svo, "fewer.obj");
+  ASSERT_FALSE(count.ok());
+  EXPECT_NE(count.message().find("has 2303 triangles, the octree's 2304"), std::string::npos)
+      << count.message();
 }
 
 }  // namespace

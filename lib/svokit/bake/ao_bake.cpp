@@ -42,11 +42,13 @@ Vec3d VoxelNormal(const Svo& svo, std::uint64_t voxel) {
   return Normalized(sum);
 }
 
-// A number after `flag` in the recorded options ("--resolution 512"), if there is one.
-std::optional<double> RecordedNumber(const std::string& metadata, std::string_view flag) {
-  const std::size_t at = metadata.find(std::string(flag) + " ");
+// The number after `key` in the metadata (`--resolution 512` in the recorded options, or the
+// JSON member `"triangles":2304`), if there is one.
+std::optional<double> RecordedNumber(const std::string& metadata, std::string_view key) {
+  const bool member = key.back() == ':';
+  const std::size_t at = metadata.find(member ? std::string(key) : std::string(key) + " ");
   if (at == std::string::npos) return std::nullopt;
-  const char* begin = metadata.c_str() + at + flag.size() + 1;
+  const char* begin = metadata.c_str() + at + key.size() + (member ? 0 : 1);
   char* end = nullptr;
   const double value = std::strtod(begin, &end);
   if (end == begin || !std::isfinite(value)) return std::nullopt;
@@ -308,6 +310,12 @@ Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<c
 }
 
 Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name) {
+  if (const std::optional<double> triangles = RecordedNumber(svo.metadata, "\"triangles\":");
+      triangles && *triangles != static_cast<double>(mesh.triangle_count())) {
+    return Status::BadInput(
+        "{}: the mesh has {} triangles, the octree's {}: not the mesh it was voxelized from",
+        mesh_name, mesh.triangle_count(), static_cast<std::uint64_t>(*triangles));
+  }
   const std::optional<double> resolution = RecordedNumber(svo.metadata, "--resolution");
   const std::optional<double> voxel_size = RecordedNumber(svo.metadata, "--voxel-size");
   const double pad = RecordedNumber(svo.metadata, "--pad").value_or(0);

@@ -56,9 +56,10 @@ std::vector<std::uint8_t> AoTexture(const TexelPoints& texels, std::span<const f
 Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<const float> ao,
                   const std::filesystem::path& path);
 
-/// Whether `mesh` is the mesh the octree was voxelized from: the grid that the octree's recorded
-/// voxelization options fit around the mesh's bounds must be the octree's grid. Bad input names
-/// `mesh_name` and what differs.
+/// Whether `mesh` is the mesh the octree was voxelized from: its triangle count must be the one
+/// the octree's metadata records (when it does), and the grid that the recorded voxelization
+/// options fit around its bounds must be the octree's grid. Bad input names `mesh_name` and what
+/// differs.
 Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name);
 
 }  // namespace svokit

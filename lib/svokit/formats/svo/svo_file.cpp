@@ -90,10 +90,11 @@ StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {
 
 std::string SvoMetadataJson(const SvoMetadata& meta) {
   // nlohmann::json orders the keys alphabetically; the files depend on that order.
-  const nlohmann::json json = {{"source", EscapeInvalidUtf8(meta.source)},
-                               {"voxelize", meta.voxelize},
-                               {"build", meta.build},
-                               {"generator", "svokit " SVOKIT_VERSION}};
+  nlohmann::json json = {{"source", EscapeInvalidUtf8(meta.source)},
+                         {"voxelize", meta.voxelize},
+                         {"build", meta.build},
+                         {"generator", "svokit " SVOKIT_VERSION}};
+  if (meta.triangles > 0) json["triangles"] = meta.triangles;
   return json.dump();
 }
 

@@ -33,6 +33,7 @@ struct SvoMetadata {
   std::string source;    ///< the mesh's file name, without directories
   std::string voxelize;  ///< the voxelization options, as the command line spells them
   std::string build;     ///< the build options, likewise
+  std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded); svo-bake checks it
 };
 /// The `META` section's JSON text (Svo::metadata; BuildSvo's `metadata`).
 std::string SvoMetadataJson(const SvoMetadata& meta);

@@ -22,9 +22,10 @@ namespace svokit {
 namespace vfrag_detail {
 
 std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
-  const nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
-                            {"options", EscapeInvalidUtf8(meta.options)},
-                            {"generator", "svokit " SVOKIT_VERSION}};
+  nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
+                      {"options", EscapeInvalidUtf8(meta.options)},
+                      {"generator", "svokit " SVOKIT_VERSION}};
+  if (meta.triangles > 0) j["triangles"] = meta.triangles;
   const std::string text = j.dump();
   return {text.begin(), text.end()};
 }
@@ -40,6 +41,10 @@ VfragMetadata ParseMetadata(std::span<const std::uint8_t> text) {
     };
     meta.source = text_of("source");
     meta.options = text_of("options");
+    const auto triangles = j.find("triangles");
+    if (triangles != j.end() && triangles->is_number_unsigned()) {
+      meta.triangles = triangles->get<std::uint64_t>();
+    }
   }
   return meta;
 }

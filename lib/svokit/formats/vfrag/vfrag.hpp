@@ -25,6 +25,7 @@ inline constexpr container::FormatId kVfragFormat{
 struct VfragMetadata {
   std::string source;   ///< input file name, without directories
   std::string options;  ///< the voxelization options, as the tool's command line spells them
+  std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded)
 };
 
 std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta);
