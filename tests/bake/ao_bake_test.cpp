@@ -7,6 +7,8 @@
 #include <map>
 
 #include "svokit/bake/ao_bake.hpp"
+#include "svokit/core/bytes.hpp"
+#include "svokit/formats/container/container.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/compact_svo.hpp"
@@ -106,6 +108,43 @@ TEST(AoSection, ReadsBackWholeAndDownToALevel) {
   const StatusOr<Svo> damaged = DecodeSvo(bytes, "damaged.svo");
   ASSERT_FALSE(damaged.ok());
   EXPECT_NE(damaged.status().message().find("damaged.svo"), std::string::npos);
+}
+
+// AOCC sections whose checksums hold but whose header does not fit the octree: refused by the
+// strict reader naming the section, reported as kind "ao" by the lenient one (svo-validate).
+TEST(AoSection, AnInconsistentSectionIsRefused) {
+  const Svo& svo = Torus48().svo;
+  std::uint64_t nodes = 0;
+  for (const SvoLevel& level : svo.levels) nodes += level.node_count;
+  const std::uint32_t levels = svo.depth + 1;
+  struct Case {
+    std::uint32_t levels, codec;
+    std::uint64_t raw;
+  };
+  for (const Case& c : {Case{levels - 1, 0, nodes}, Case{levels, 0, nodes - 1},
+                        Case{levels, 7, nodes}, Case{levels, 1, nodes}}) {
+    StatusOr<container::Frame> frame = container::Frame::Open(Torus48().plain, kSvoFormat);
+    ASSERT_TRUE(frame.ok());
+    container::Writer writer(kSvoFormat, frame->flags());
+    for (const container::Frame::Section& s : frame->sections()) {
+      writer.AddSectionView(s.tag, s.bytes);
+    }
+    ByteWriter aocc;
+    aocc.Put(c.levels);
+    aocc.Put(c.codec);
+    aocc.Put(c.raw);
+    aocc.Put(c.raw);  // stored = raw: a zstd "stream" of zeros does not decode
+    aocc.PutArray(std::span<const std::uint8_t>(std::vector<std::uint8_t>(c.raw, 0)));
+    writer.AddSection(container::MakeTag("AOCC"), std::move(aocc.bytes()));
+    const std::vector<std::uint8_t> bytes = writer.Serialize();
+    const StatusOr<Svo> strict = DecodeSvo(bytes, "bad-ao.svo");
+    ASSERT_FALSE(strict.ok()) << c.levels << " " << c.codec << " " << c.raw;
+    EXPECT_NE(strict.status().message().find("bad-ao.svo: the AOCC"), std::string::npos)
+        << strict.status().message();
+    const StatusOr<LenientSvo> lenient = DecodeSvoLenient(bytes, "bad-ao.svo");
+    ASSERT_TRUE(lenient.ok());
+    EXPECT_EQ(lenient->issue_counts.count("ao"), 1u);
+  }
 }
 
 TEST(RasterizeUvs, TexelsOfTheUvTrianglesAndDilatedGutters) {
