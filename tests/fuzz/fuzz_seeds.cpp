@@ -21,6 +21,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/formats/svm/svm.hpp"
+#include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/mesh/mesh.hpp"
@@ -201,6 +202,23 @@ void MeshDraco() {
   }
 }
 
+// The file again with an AOCC section (svo-bake's; a byte per node, here a pattern), so that its
+// reader is fuzzed too.
+std::vector<std::uint8_t> BakedSvo(const std::vector<std::uint8_t>& bytes) {
+  auto svo = svokit::DecodeSvo(bytes, "seed");
+  auto frame = svokit::container::Frame::FromBytes(bytes, "seed", svokit::kSvoFormat);
+  if (!svo.ok() || !frame.ok()) return bytes;
+  for (svokit::SvoLevel& level : svo->levels) {
+    level.ao.resize(level.node_count);
+    for (std::size_t i = 0; i < level.ao.size(); ++i)
+      level.ao[i] = static_cast<std::uint8_t>(37 * i);
+  }
+  svokit::container::Writer writer(svokit::kSvoFormat, frame->flags());
+  for (const auto& section : frame->sections()) writer.AddSectionView(section.tag, section.bytes);
+  writer.AddSection(svokit::container::MakeTag("AOCC"), svokit::svo_detail::EncodeAoSection(*svo));
+  return writer.Serialize();
+}
+
 // The chain's own files, from the tetrahedron with colours and normals.
 void ChainFiles() {
   svokit::Mesh mesh;
@@ -232,6 +250,8 @@ void ChainFiles() {
     Put("svo", fmt::format("tetra-{}.svo", resolution), Bytes(bytes.data(), bytes.size()));
     const auto v1 = svokit::test::EncodeSvoV1(svokit::AssembleSvo(*svo));
     Put("svo", fmt::format("tetra-{}-version1.svo", resolution), Bytes(v1.data(), v1.size()));
+    const auto baked = BakedSvo(bytes);
+    Put("svo", fmt::format("tetra-{}-ao.svo", resolution), Bytes(baked.data(), baked.size()));
   }
 }
 
