@@ -163,18 +163,36 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
   }
   const std::vector<AoPoint> vertices = VertexPoints(mesh);
   const std::size_t side = static_cast<std::size_t>(size);
-  // Owner triangle and barycentrics per texel; the first triangle to cover a texel keeps it.
-  std::vector<std::int64_t> owner(side * side, -1);
-  std::vector<std::array<double, 3>> weights(side * side);
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+  // Triangle t in texel coordinates (texel centres at integers).
+  struct UvTriangle {
     std::array<double, 3> x, y;
-    for (int c = 0; c < 3; ++c) {
-      const Vec2f uv = mesh.uvs[3 * t + static_cast<std::size_t>(c)];
-      x[c] = static_cast<double>(uv.u) * size - 0.5;
-      y[c] = (1 - static_cast<double>(uv.v)) * size - 0.5;
+    double area;
+    std::array<double, 3> Weights(long px, long py) const {
+      const double cx = static_cast<double>(px), cy = static_cast<double>(py);
+      std::array<double, 3> w;
+      for (int c = 0; c < 3; ++c) {
+        const int a = (c + 1) % 3, b = (c + 2) % 3;
+        w[c] = ((x[b] - x[a]) * (cy - y[a]) - (cx - x[a]) * (y[b] - y[a])) / area;
+      }
+      return w;
     }
-    const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-    if (area == 0 || !std::isfinite(area)) continue;
+  };
+  auto uv_triangle = [&](std::size_t t) {
+    UvTriangle uv;
+    for (int c = 0; c < 3; ++c) {
+      const Vec2f corner = mesh.uvs[3 * t + static_cast<std::size_t>(c)];
+      uv.x[c] = static_cast<double>(corner.u) * size - 0.5;
+      uv.y[c] = (1 - static_cast<double>(corner.v)) * size - 0.5;
+    }
+    uv.area = (uv.x[1] - uv.x[0]) * (uv.y[2] - uv.y[0]) - (uv.x[2] - uv.x[0]) * (uv.y[1] - uv.y[0]);
+    return uv;
+  };
+  // The triangle that owns each texel (the first to cover it), 4 bytes a texel.
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> owner(side * side, kNone);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const UvTriangle uv = uv_triangle(t);
+    if (uv.area == 0 || !std::isfinite(uv.area)) continue;
     const auto lo = [&](const std::array<double, 3>& v) {
       return std::clamp(static_cast<long>(std::ceil(std::min({v[0], v[1], v[2]}))), 0L,
                         static_cast<long>(size));
@@ -183,32 +201,28 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
       return std::clamp(static_cast<long>(std::floor(std::max({v[0], v[1], v[2]}))), -1L,
                         static_cast<long>(size) - 1);
     };
-    for (long py = lo(y); py <= hi(y); ++py) {
-      for (long px = lo(x); px <= hi(x); ++px) {
-        const double cx = static_cast<double>(px), cy = static_cast<double>(py);
-        std::array<double, 3> w;
-        for (int c = 0; c < 3; ++c) {
-          const int a = (c + 1) % 3, b = (c + 2) % 3;
-          w[c] = ((x[b] - x[a]) * (cy - y[a]) - (cx - x[a]) * (y[b] - y[a])) / area;
-        }
+    for (long py = lo(uv.y); py <= hi(uv.y); ++py) {
+      for (long px = lo(uv.x); px <= hi(uv.x); ++px) {
+        const std::array<double, 3> w = uv.Weights(px, py);
         if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
         const std::size_t texel =
             static_cast<std::size_t>(py) * side + static_cast<std::size_t>(px);
-        if (owner[texel] >= 0) continue;
-        owner[texel] = static_cast<std::int64_t>(t);
-        weights[texel] = w;
+        if (owner[texel] == kNone) owner[texel] = static_cast<std::uint32_t>(t);
       }
     }
   }
   TexelPoints out;
   out.size = size;
   for (std::size_t texel = 0; texel < owner.size(); ++texel) {
-    if (owner[texel] < 0) continue;
-    const Triangle& tri = mesh.triangles[static_cast<std::size_t>(owner[texel])];
+    if (owner[texel] == kNone) continue;
+    const Triangle& tri = mesh.triangles[owner[texel]];
+    const std::array<double, 3> w =
+        uv_triangle(owner[texel])
+            .Weights(static_cast<long>(texel % side), static_cast<long>(texel / side));
     Vec3d p{0, 0, 0}, n{0, 0, 0};
     for (int c = 0; c < 3; ++c) {
-      p = p + mesh.positions[tri[c]] * weights[texel][c];
-      n = n + vertices[tri[c]].normal * weights[texel][c];
+      p = p + mesh.positions[tri[c]] * w[c];
+      n = n + vertices[tri[c]].normal * w[c];
     }
     if (Length(n) == 0) {
       n = Cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
