@@ -94,6 +94,8 @@ TEST(ConeTracer, InsideAClosedSphereIsFullyOccluded) {
         << cones << " cones";
   }
   EXPECT_NEAR(Rays(Icosphere(5), 2.5, 0, {{0, 0, -1}, {0, 0, 1}}), 1.0, 1e-6);
+  // Without a normal there is no hemisphere: 0, not an arbitrary frame's value.
+  EXPECT_EQ(Cones(Sphere256(), Options(8, 1.5, 0), {{0, 0, 0}, {0, 0, 0}}), 0.f);
 }
 
 TEST(ConeTracer, TheFalloffWeighsTheFirstHit) {

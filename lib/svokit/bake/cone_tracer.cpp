@@ -128,8 +128,7 @@ ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
   const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
     node_size_.push_back(std::ldexp(1.0, static_cast<int>(svo.depth - l)));
-    level_gain_.push_back(static_cast<float>(
-        kCoverageGain * std::ldexp(1.0, static_cast<int>(svo.depth - l)) / shell));
+    level_gain_.push_back(static_cast<float>(kCoverageGain * node_size_.back() / shell));
   }
   distance_voxels_ = options.distance / svo.grid.voxel_size();
   offset_voxels_ = options.offset * std::sqrt(3.0);
@@ -265,6 +264,8 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
 }
 
 float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
+  // A point without a normal (a voxel whose brick holds none) has no hemisphere to trace.
+  if (!(Dot(point.normal, point.normal) > 0.25)) return 0;
   const Vec3d n = point.normal;
   Vec3d t, b;
   TangentFrame(n, t, b);

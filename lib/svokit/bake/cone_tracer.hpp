@@ -58,8 +58,8 @@ class ConeTracer {
   /// or distance ≤ 0, falloff or offset < 0, non-finite values).
   static StatusOr<ConeTracer> Make(const Svo& svo, const ConeOptions& options);
 
-  /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded); `index` numbers the point
-  /// for the jitter. Thread-safe.
+  /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal);
+  /// `index` numbers the point for the jitter. Thread-safe.
   float Occlusion(const AoPoint& point, std::uint64_t index) const;
   /// Occlusion of every point, in parallel; the result does not depend on the thread count.
   std::vector<float> Occlusion(std::span<const AoPoint> points) const;
