@@ -5,6 +5,7 @@ svokit_test(test_voxelize_fidelity
   SOURCES
     voxelize/exact_reference.cpp
     voxelize/voxelize_fidelity_test.cpp
+    voxelize/winding_number_test.cpp
   LIBS CGAL::CGAL)
 
 # gtest_discover_tests defines the tests when ctest runs, from an include file that also sets

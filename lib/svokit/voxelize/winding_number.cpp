@@ -1,0 +1,128 @@
+#include "svokit/voxelize/winding_number.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace svokit {
+
+namespace {
+
+constexpr double kFourPi = 4 * std::numbers::pi;
+constexpr std::uint32_t kLeafSize = 8;
+
+Vec3d Centroid(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  return (a + b + c) * (1.0 / 3);
+}
+
+}  // namespace
+
+double TriangleSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
+  const Vec3d u = a - p, v = b - p, w = c - p;
+  const double lu = Length(u), lv = Length(v), lw = Length(w);
+  const double numerator = Dot(u, Cross(v, w));
+  const double denominator = lu * lv * lw + Dot(u, v) * lw + Dot(v, w) * lu + Dot(w, u) * lv;
+  return 2 * std::atan2(numerator, denominator);
+}
+
+double WindingNumber(std::span<const Vec3d> positions, std::span<const Triangle> triangles,
+                     const Vec3d& p) {
+  double sum = 0;
+  for (const Triangle& t : triangles) {
+    sum += TriangleSolidAngle(positions[t[0]], positions[t[1]], positions[t[2]], p);
+  }
+  return sum / kFourPi;
+}
+
+FastWindingNumber::FastWindingNumber(std::span<const Vec3d> positions,
+                                     std::span<const Triangle> triangles, double accuracy)
+    : positions_(positions.begin(), positions.end()),
+      triangles_(triangles.begin(), triangles.end()),
+      accuracy_(accuracy) {
+  order_.resize(triangles_.size());
+  for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+  if (!triangles_.empty()) Build(0, static_cast<std::uint32_t>(triangles_.size()));
+}
+
+std::uint32_t FastWindingNumber::Build(std::uint32_t first, std::uint32_t count) {
+  const auto index = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  Node node;
+  node.first = first;
+  double area = 0;
+  Vec3d weighted{0, 0, 0}, lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    const Triangle& t = triangles_[order_[i]];
+    const Vec3d &a = positions_[t[0]], &b = positions_[t[1]], &c = positions_[t[2]];
+    const Vec3d n = Cross(b - a, c - a) * 0.5;
+    const double triangle_area = Length(n);
+    const Vec3d centroid = Centroid(a, b, c);
+    node.normal_area = node.normal_area + n;
+    weighted = weighted + centroid * triangle_area;
+    area += triangle_area;
+    lo = {std::min(lo.x, centroid.x), std::min(lo.y, centroid.y), std::min(lo.z, centroid.z)};
+    hi = {std::max(hi.x, centroid.x), std::max(hi.y, centroid.y), std::max(hi.z, centroid.z)};
+  }
+  // Degenerate clusters (no area) are centred on their centroids' box.
+  node.centre = area > 0 ? weighted / area : (lo + hi) * 0.5;
+  for (std::uint32_t i = first; i < first + count; ++i) {
+    for (const std::uint32_t v : triangles_[order_[i]]) {
+      node.radius = std::max(node.radius, Length(positions_[v] - node.centre));
+    }
+  }
+  if (count <= kLeafSize) {
+    node.count = count;
+    nodes_[index] = node;
+    return index;
+  }
+  // Median split of the centroids along the box's longest axis; ties broken by index, so the
+  // tree depends on the mesh alone.
+  const Vec3d extent = hi - lo;
+  const int axis =
+      extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+  auto key = [&](std::uint32_t t) {
+    const Triangle& tri = triangles_[t];
+    const Vec3d c = Centroid(positions_[tri[0]], positions_[tri[1]], positions_[tri[2]]);
+    return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+  };
+  const auto begin = order_.begin() + first;
+  const std::uint32_t half = count / 2;
+  std::nth_element(begin, begin + half, begin + count, [&](std::uint32_t a, std::uint32_t b) {
+    const double ka = key(a), kb = key(b);
+    return ka < kb || (ka == kb && a < b);
+  });
+  node.children[0] = Build(first, half);
+  node.children[1] = Build(first + half, count - half);
+  nodes_[index] = node;
+  return index;
+}
+
+double FastWindingNumber::operator()(const Vec3d& p) const {
+  if (nodes_.empty()) return 0;
+  double sum = 0;
+  std::uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    const Vec3d d = node.centre - p;
+    const double distance2 = Dot(d, d);
+    const double reach = accuracy_ * node.radius;
+    if (distance2 > reach * reach) {
+      // Far: the cluster as one dipole, Σ a·n·(c − p)/|c − p|³ over 4π.
+      sum += Dot(node.normal_area, d) / (kFourPi * distance2 * std::sqrt(distance2));
+    } else if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const Triangle& t = triangles_[order_[i]];
+        sum +=
+            TriangleSolidAngle(positions_[t[0]], positions_[t[1]], positions_[t[2]], p) / kFourPi;
+      }
+    } else {
+      stack[top++] = node.children[1];
+      stack[top++] = node.children[0];
+    }
+  }
+  return sum;
+}
+
+}  // namespace svokit
