@@ -18,28 +18,6 @@ namespace {
 // --distance's default: this fraction of the diagonal of the octree's grid.
 constexpr double kDefaultDistance = 0.25;
 
-struct Errors {
-  double mean = 0, p95 = 0, max = 0;
-};
-Errors CompareAo(std::span<const float> a, std::span<const float> b) {
-  std::vector<double> d(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) d[i] = std::abs(double{a[i]} - double{b[i]});
-  Errors e;
-  if (d.empty()) return e;
-  for (const double v : d) e.mean += v;
-  e.mean /= static_cast<double>(d.size());
-  std::sort(d.begin(), d.end());
-  e.p95 = d[std::min(d.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(d.size())))];
-  e.max = d.back();
-  return e;
-}
-
-double Mean(std::span<const float> v) {
-  double sum = 0;
-  for (const float x : v) sum += x;
-  return v.empty() ? 0 : sum / static_cast<double>(v.size());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -207,7 +185,7 @@ int main(int argc, char** argv) {
       const Status written = app::RunStage(
           progress, "write", [&] { return WriteBakedSvo(input, *svo, options, output); });
       if (!written.ok()) return fail(written);
-      fmt::print("voxels      {} traced, mean AO {:.4f}\n", voxel_ao.size(), Mean(voxel_ao));
+      fmt::print("voxels      {} traced, mean AO {:.4f}\n", voxel_ao.size(), MeanAo(voxel_ao));
       fmt::print("output      {} ({} bytes)\n", output.string(),
                  std::filesystem::file_size(output));
     }
@@ -216,16 +194,16 @@ int main(int argc, char** argv) {
       const std::vector<float> vertex_ao =
           app::RunStage(progress, "vertices", [&] { return bake_points(points); });
       fmt::print("vertices    {} traced ({}), mean AO {:.4f}\n", points.size(), method,
-                 Mean(vertex_ao));
+                 MeanAo(vertex_ao));
       if (reference) {
         const std::vector<float> truth = app::RunStage(progress, "reference", [&] {
           return rays_scene->Occlusion(points, {*reference, cones.distance, cones.falloff, 0});
         });
-        const Errors e = CompareAo(vertex_ao, truth);
+        const AoErrors e = CompareAo(vertex_ao, truth);
         fmt::print(
             "reference   {} rays per vertex, mean AO {:.4f}; error: mean {:.4f}, 95th "
             "percentile {:.4f}, max {:.4f}\n",
-            *reference, Mean(truth), e.mean, e.p95, e.max);
+            *reference, MeanAo(truth), e.mean, e.p95, e.max);
       }
       if (!vertex_out.empty()) {
         const Status written = app::RunStage(progress, "write ply", [&] {
@@ -248,7 +226,7 @@ int main(int argc, char** argv) {
       });
       if (!written.ok()) return fail(written);
       fmt::print("texture-out {} ({}x{}, {} texels covered, mean AO {:.4f})\n",
-                 texture_out.string(), size, size, texels->texels.size(), Mean(texel_ao));
+                 texture_out.string(), size, size, texels->texels.size(), MeanAo(texel_ao));
     }
     app::PrintTimes(progress);
     return 0;

@@ -147,6 +147,20 @@ TEST(AoSection, AnInconsistentSectionIsRefused) {
   }
 }
 
+TEST(CompareAo, MeanPercentileAndLargestDifference) {
+  // Differences 0.00, 0.01, ..., 0.99 in shuffled order.
+  std::vector<float> a(100), b(100, 0.5f);
+  for (int i = 0; i < 100; ++i)
+    a[static_cast<std::size_t>((i * 37) % 100)] = 0.5f + 0.01f * static_cast<float>(i);
+  const AoErrors e = CompareAo(a, b);
+  EXPECT_NEAR(e.mean, 0.495, 1e-5);
+  EXPECT_NEAR(e.p95, 0.95, 1e-5);
+  EXPECT_NEAR(e.max, 0.99, 1e-5);
+  EXPECT_NEAR(MeanAo(b), 0.5, 1e-12);
+  EXPECT_EQ(CompareAo({}, {}).max, 0);
+  EXPECT_EQ(MeanAo({}), 0);
+}
+
 TEST(RasterizeUvs, TexelsOfTheUvTrianglesAndDilatedGutters) {
   // One triangle over the lower-left half of UV space: texel centres with u + v ≤ 1.
   Mesh mesh;

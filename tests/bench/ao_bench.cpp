@@ -68,29 +68,6 @@ struct Loaded {
   std::vector<AoPoint> points;
 };
 
-struct Errors {
-  double mean = 0, p95 = 0, max = 0;
-};
-
-Errors Compare(std::span<const float> a, std::span<const float> b) {
-  std::vector<double> d(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) d[i] = std::abs(double{a[i]} - double{b[i]});
-  Errors e;
-  if (d.empty()) return e;
-  for (const double v : d) e.mean += v;
-  e.mean /= static_cast<double>(d.size());
-  std::sort(d.begin(), d.end());
-  e.p95 = d[std::min(d.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(d.size())))];
-  e.max = d.back();
-  return e;
-}
-
-double Mean(std::span<const float> v) {
-  double sum = 0;
-  for (const float x : v) sum += x;
-  return v.empty() ? 0 : sum / static_cast<double>(v.size());
-}
-
 double Seconds(const std::chrono::steady_clock::time_point& t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -374,12 +351,12 @@ int main(int argc, char** argv) {
       for (const std::uint32_t count : kConeCounts) {
         const ConeTracer tracer = MakeTracer(svo, DefaultCones(svo, count));
         auto [ao, t] = Timed(3, [&] { return tracer.Occlusion(points); });
-        const Errors e = Compare(ao, truth);
+        const AoErrors e = CompareAo(ao, truth);
         fmt::print(
             "{:<18} {:>5} {:>5} {:>5} {:>9} {:>8.4f} {:>8.4f} {:>8.4f} {:>7.4f} {:>7.4f} "
             "{:>13.0f}\n",
             l.spec.name, depth, count, 1u << depth, svo.voxel_count(), e.mean, e.p95, e.max,
-            Mean(ao), Mean(truth), static_cast<double>(points.size()) / t);
+            MeanAo(ao), MeanAo(truth), static_cast<double>(points.size()) / t);
         std::fflush(stdout);
         if (count == 8) cones8 = std::move(ao);
       }
@@ -388,13 +365,13 @@ int main(int argc, char** argv) {
         const ConeTracer tracer = MakeTracer(svo, base);
         const auto [ao, t] = Timed(3, [&] { return tracer.Occlusion(points); });
         const double n = static_cast<double>(points.size());
-        const Errors ce = Compare(ao, truth);
+        const AoErrors ce = CompareAo(ao, truth);
         const double cone_rate = n / t;
         std::vector<double> errs, rates;
         for (const std::uint32_t rays : kRayCounts) {
           const RayAoOptions o{rays, base.distance, kFalloff, 1};
           const auto [ray_ao, rt] = Timed(3, [&] { return embree->Occlusion(points, o); });
-          const Errors e = Compare(ray_ao, truth);
+          const AoErrors e = CompareAo(ray_ao, truth);
           errs.push_back(e.mean);
           rates.push_back(n / rt);
           speed_rows.push_back(fmt::format("{:<18} {:>5} {:>5} {:>8.4f} {:>8.4f} {:>12.0f}",

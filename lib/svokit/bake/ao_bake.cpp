@@ -61,6 +61,25 @@ std::uint8_t EncodeAo(float ao) {
   return static_cast<std::uint8_t>(std::lround(255.f * std::clamp(ao, 0.f, 1.f)));
 }
 
+AoErrors CompareAo(std::span<const float> a, std::span<const float> b) {
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = std::abs(double{a[i]} - double{b[i]});
+  AoErrors e;
+  if (d.empty()) return e;
+  for (const double v : d) e.mean += v;
+  e.mean /= static_cast<double>(d.size());
+  std::sort(d.begin(), d.end());
+  e.p95 = d[std::min(d.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(d.size())))];
+  e.max = d.back();
+  return e;
+}
+
+double MeanAo(std::span<const float> ao) {
+  double sum = 0;
+  for (const float x : ao) sum += x;
+  return ao.empty() ? 0 : sum / static_cast<double>(ao.size());
+}
+
 StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo) {
   if (!svo.has_normal || svo.brick_side == 0) {
     return Status::BadInput(

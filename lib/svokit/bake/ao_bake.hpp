@@ -19,6 +19,14 @@ namespace svokit {
 /// AO 0..1 → the byte stored (0 open, 255 fully occluded).
 std::uint8_t EncodeAo(float ao);
 
+/// |a − b| per point (cones against a reference): mean, 95th percentile, largest.
+struct AoErrors {
+  double mean = 0, p95 = 0, max = 0;
+};
+AoErrors CompareAo(std::span<const float> a, std::span<const float> b);
+/// The mean of per-point AO (0 for none).
+double MeanAo(std::span<const float> ao);
+
 /// The voxels of `svo` as bake points: centre and the voxel brick's normal (zero where a voxel has
 /// none). Bad input: an octree without normals.
 StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo);

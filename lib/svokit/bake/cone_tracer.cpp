@@ -62,10 +62,6 @@ float FastLog2(float x) {
   return exponent + 1.44269504f * ln_m;
 }
 
-bool Finite(double v) {
-  return std::isfinite(v);
-}
-
 }  // namespace
 
 std::vector<Cone> ConeConstellation(std::uint32_t count, double aperture) {
@@ -105,16 +101,16 @@ StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options
   if (Rings(options.cones).empty()) {
     return Status::BadInput("--cones {}: constellations have 3, 5, 8 or 16 cones", options.cones);
   }
-  if (!Finite(options.aperture) || options.aperture <= 0 || options.aperture > 4) {
+  if (!std::isfinite(options.aperture) || options.aperture <= 0 || options.aperture > 4) {
     return Status::BadInput("--aperture {}: must be in (0, 4]", options.aperture);
   }
-  if (!Finite(options.distance) || options.distance <= 0) {
+  if (!std::isfinite(options.distance) || options.distance <= 0) {
     return Status::BadInput("--distance {}: must be > 0", options.distance);
   }
-  if (!Finite(options.falloff) || options.falloff < 0) {
+  if (!std::isfinite(options.falloff) || options.falloff < 0) {
     return Status::BadInput("--falloff {}: must be ≥ 0", options.falloff);
   }
-  if (!Finite(options.offset) || options.offset < 0) {
+  if (!std::isfinite(options.offset) || options.offset < 0) {
     return Status::BadInput("--offset {}: must be ≥ 0", options.offset);
   }
   if (svo.levels.size() != svo.depth + 1) {
@@ -125,6 +121,7 @@ StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options
 
 ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
     : svo_(&svo), options_(options), cones_(ConeConstellation(options.cones, options.aperture)) {
+  for (const Cone& cone : cones_) tan_half_.push_back(std::tan(cone.half_angle));
   const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
   for (std::uint32_t l = 0; l <= svo.depth; ++l) {
     node_size_.push_back(std::ldexp(1.0, static_cast<int>(svo.depth - l)));
@@ -277,9 +274,10 @@ float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
   }
   const Vec3d origin = svo_->grid.WorldToVoxel(point.position) + n * offset_voxels_;
   float sum = 0;
-  for (const Cone& cone : cones_) {
-    const Vec3d axis = t * cone.axis.x + b * cone.axis.y + n * cone.axis.z;
-    sum += TraceCone(origin, axis, cone.axis.z, std::tan(cone.half_angle));
+  for (std::size_t i = 0; i < cones_.size(); ++i) {
+    const Vec3d& local = cones_[i].axis;
+    const Vec3d axis = t * local.x + b * local.y + n * local.z;
+    sum += TraceCone(origin, axis, local.z, tan_half_[i]);
   }
   return sum / static_cast<float>(cones_.size());
 }

@@ -86,6 +86,7 @@ class ConeTracer {
   const Svo* svo_;
   ConeOptions options_;
   std::vector<Cone> cones_;
+  std::vector<double> tan_half_;   // per cone: tan of its half-angle
   std::vector<double> node_size_;  // per level, in voxels
   std::vector<float> level_gain_;  // per level: coverage per unit of opacity
   double distance_voxels_ = 0;

@@ -30,9 +30,9 @@ inline constexpr container::FormatId kSvoFormat{
 /// Provenance stored with the octree (the `META` section): what svo-voxelize + svo-build and
 /// mesh2svo record alike, so both routes write the same file.
 struct SvoMetadata {
-  std::string source;    ///< the mesh's file name, without directories
-  std::string voxelize;  ///< the voxelization options, as the command line spells them
-  std::string build;     ///< the build options, likewise
+  std::string source;           ///< the mesh's file name, without directories
+  std::string voxelize;         ///< the voxelization options, as the command line spells them
+  std::string build;            ///< the build options, likewise
   std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded); svo-bake checks it
 };
 /// The `META` section's JSON text (Svo::metadata; BuildSvo's `metadata`).
