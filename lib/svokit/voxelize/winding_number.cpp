@@ -41,6 +41,10 @@ FastWindingNumber::FastWindingNumber(std::span<const Vec3d> positions,
       accuracy_(accuracy) {
   order_.resize(triangles_.size());
   for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+  centroids_.reserve(triangles_.size());
+  for (const Triangle& t : triangles_) {
+    centroids_.push_back(Centroid(positions_[t[0]], positions_[t[1]], positions_[t[2]]));
+  }
   if (!triangles_.empty()) Build(0, static_cast<std::uint32_t>(triangles_.size()));
 }
 
@@ -56,7 +60,7 @@ std::uint32_t FastWindingNumber::Build(std::uint32_t first, std::uint32_t count)
     const Vec3d &a = positions_[t[0]], &b = positions_[t[1]], &c = positions_[t[2]];
     const Vec3d n = Cross(b - a, c - a) * 0.5;
     const double triangle_area = Length(n);
-    const Vec3d centroid = Centroid(a, b, c);
+    const Vec3d& centroid = centroids_[order_[i]];
     node.normal_area = node.normal_area + n;
     weighted = weighted + centroid * triangle_area;
     area += triangle_area;
@@ -81,8 +85,7 @@ std::uint32_t FastWindingNumber::Build(std::uint32_t first, std::uint32_t count)
   const int axis =
       extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
   auto key = [&](std::uint32_t t) {
-    const Triangle& tri = triangles_[t];
-    const Vec3d c = Centroid(positions_[tri[0]], positions_[tri[1]], positions_[tri[2]]);
+    const Vec3d& c = centroids_[t];
     return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
   };
   const auto begin = order_.begin() + first;

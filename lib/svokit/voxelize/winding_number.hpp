@@ -51,6 +51,7 @@ class FastWindingNumber {
 
   std::vector<Vec3d> positions_;
   std::vector<Triangle> triangles_;
+  std::vector<Vec3d> centroids_;  // per triangle, for the splits and the clusters' centres
   std::vector<std::uint32_t> order_;
   std::vector<Node> nodes_;
   double accuracy_ = 2;
