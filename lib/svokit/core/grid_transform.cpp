@@ -1,6 +1,7 @@
 #include "svokit/core/grid_transform.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "svokit/core/morton.hpp"
@@ -94,6 +95,10 @@ Box3d GridTransform::GridBounds() const {
 
 IBox3 GridTransform::IndexBox() const {
   return {{0, 0, 0}, {dims_[0], dims_[1], dims_[2]}};
+}
+
+std::uint32_t OctreeDepth(const GridTransform& grid) {
+  return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
 }
 
 }  // namespace svokit

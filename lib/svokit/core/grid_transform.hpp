@@ -67,4 +67,8 @@ class GridTransform {
   std::array<std::uint32_t, 3> dims_{1, 1, 1};
 };
 
+/// The octree depth whose 2^depth cube encloses the grid (at least 1, so the root is always an
+/// inner node).
+std::uint32_t OctreeDepth(const GridTransform& grid);
+
 }  // namespace svokit

@@ -61,9 +61,4 @@ std::string LevelTable(const Svo& svo) {
   return out;
 }
 
-std::uint32_t OctreeDepth(const GridTransform& grid) {
-  // At least one level above the voxels, so the root is always an inner node.
-  return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
-}
-
 }  // namespace svokit

@@ -116,7 +116,4 @@ struct Contour {
 std::uint32_t EncodeContour(const Contour& c);
 Contour DecodeContour(std::uint32_t word);
 
-/// The depth whose 2^depth cube encloses the grid (at least 1).
-std::uint32_t OctreeDepth(const GridTransform& grid);
-
 }  // namespace svokit

@@ -15,6 +15,32 @@ Vec3d Centroid(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return (a + b + c) * (1.0 / 3);
 }
 
+// Squared distance from p to triangle (a, b, c): the closest point by Voronoi regions (Ericson,
+// "Real-Time Collision Detection", 5.1.5).
+double SquaredDistanceToTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = Dot(ab, ap), d2 = Dot(ac, ap);
+  const auto squared = [&](const Vec3d& q) { return Dot(p - q, p - q); };
+  if (d1 <= 0 && d2 <= 0) return squared(a);
+  const Vec3d bp = p - b;
+  const double d3 = Dot(ab, bp), d4 = Dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return squared(b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return squared(a + ab * (d1 / (d1 - d3)));
+  const Vec3d cp = p - c;
+  const double d5 = Dot(ab, cp), d6 = Dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return squared(c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return squared(a + ac * (d2 / (d2 - d6)));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    return squared(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  }
+  const double sum = va + vb + vc;
+  if (!(sum > 0)) return std::min({squared(a), squared(b), squared(c)});  // degenerate
+  return squared(a + ab * (vb / sum) + ac * (vc / sum));
+}
+
 }  // namespace
 
 double TriangleSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
@@ -126,6 +152,32 @@ double FastWindingNumber::operator()(const Vec3d& p) const {
     }
   }
   return sum;
+}
+
+bool FastWindingNumber::NoTriangleWithin(const Vec3d& p, double r) const {
+  if (nodes_.empty()) return true;
+  std::uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    const double reach = r + node.radius;
+    const Vec3d d = node.centre - p;
+    if (Dot(d, d) > reach * reach) continue;
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const Triangle& t = triangles_[order_[i]];
+        if (SquaredDistanceToTriangle(p, positions_[t[0]], positions_[t[1]], positions_[t[2]]) <=
+            r * r) {
+          return false;
+        }
+      }
+    } else {
+      stack[top++] = node.children[1];
+      stack[top++] = node.children[0];
+    }
+  }
+  return true;
 }
 
 }  // namespace svokit

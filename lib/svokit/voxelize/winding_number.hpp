@@ -37,6 +37,9 @@ class FastWindingNumber {
   FastWindingNumber(std::span<const Vec3d> positions, std::span<const Triangle> triangles,
                     double accuracy = kDefaultAccuracy);
   double operator()(const Vec3d& p) const;
+  /// Whether every triangle is farther than `r` from p (exact point–triangle distances at the
+  /// leaves, the nodes' balls above them).
+  bool NoTriangleWithin(const Vec3d& p, double r) const;
 
  private:
   struct Node {
