@@ -32,6 +32,7 @@
 #include "svokit/core/status.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 
 namespace svokit::app {
 
@@ -224,6 +225,18 @@ inline void PrintFileSummary(const SvoFileStats& stats) {
              static_cast<double>(stats.file_bytes) / voxels);
   fmt::print("pages       {} below level {} ({} to {} bytes)\n", stats.pages, stats.page_level,
              stats.smallest_page, stats.largest_page);
+}
+
+/// The summary's line of a solid's interior.
+inline void PrintInterior(const InteriorCubes& interior) {
+  fmt::print("interior    {} voxels in {} cubes, by {}\n", interior.voxel_count(),
+             interior.cube_count(),
+             interior.method == FillMethod::kColumns
+                 ? "exact crossings (closed surface)"
+                 : fmt::format("winding numbers ({} open edges)", interior.open_edges));
+  if (interior.cube_count() == 0) {
+    fmt::print("            the surface encloses no voxel centre: the solid is its surface\n");
+  }
 }
 
 inline void PrintOctreeSummary(const CompactSvo& svo, const SvoFileStats& stats) {

@@ -49,6 +49,7 @@ struct VoxelizeCli {
   std::uint32_t resolution = 0, pad = 0;
   double voxel_size = 0;
   std::string attributes = "color,normal";
+  std::string fill = "surface";
   /// Mode, method and cutoff as given; Options() adds the attributes.
   VoxelizeOptions parsed;
 
@@ -76,6 +77,13 @@ struct VoxelizeCli {
         ->check(CLI::IsMember({"color,normal", "normal,color", "color", "normal", "none"})
                     .description(""))
         ->option_text("color,normal|color|normal|none")
+        ->capture_default_str();
+    cli.add_option("--fill", fill,
+                   "surface: the voxels the surface touches; solid: also every voxel whose centre "
+                   "is inside (exact crossings on closed meshes, winding numbers on open ones), "
+                   "stored as whole cubes")
+        ->check(CLI::IsMember({"surface", "solid"}).description(""))
+        ->option_text("surface|solid")
         ->capture_default_str();
     cli.add_option("--hybrid-cutoff", parsed.hybrid_cutoff,
                    "Hybrid: projected area (voxel²) above which a triangle takes the fragment path")
@@ -106,12 +114,14 @@ struct VoxelizeCli {
   }
 
   std::string ModeName() const { return NameOf(kVoxelModes, parsed.mode); }
+  bool solid() const { return fill == "solid"; }
 
   /// What shapes the voxels, as the command line spells it (methods and threads do not).
   std::string Recorded() const {
     const std::string grid = resolution > 0 ? fmt::format("--resolution {}", resolution)
                                             : fmt::format("--voxel-size {}", voxel_size);
-    return fmt::format("{} --pad {} --mode {} --attributes {}", grid, pad, ModeName(), attributes);
+    return fmt::format("{} --pad {} --mode {} --attributes {}{}", grid, pad, ModeName(), attributes,
+                       solid() ? " --fill solid" : "");
   }
 };
 

@@ -73,6 +73,10 @@ int main(int argc, char** argv) {
                  grid->voxel_size(), OctreeDepth(*grid));
     };
     if (!memory_limit.empty() || !pages.empty() || by_pages_by_default) {
+      if (voxelize.solid()) {
+        return app::Fail(tool, Status::BadInput("--fill solid is built whole: a build by pages "
+                                                "(--memory-limit, --pages) does not fill yet"));
+      }
       const StatusOr<std::uint64_t> limit =
           by_pages_by_default    ? half_machine
           : memory_limit.empty() ? std::uint64_t{0}
@@ -115,8 +119,14 @@ int main(int argc, char** argv) {
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
     app::Warn(tool, voxels->warnings);
 
-    StatusOr<CompactSvo> svo =
-        BuildCompactSvo(std::move(*voxels), &*mesh, build.Options(), meta, progress);
+    StatusOr<InteriorCubes> interior = InteriorCubes{};
+    BuildOptions options = build.Options();
+    if (voxelize.solid()) {
+      interior = FillInterior(*mesh, *grid, voxels->keys, {}, progress);
+      if (!interior.ok()) return app::Fail(tool, interior.status().WithContext(input.string()));
+      options.interior = &*interior;
+    }
+    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), &*mesh, options, meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
     StatusOr<SvoFileStats> written =
         app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
@@ -124,6 +134,7 @@ int main(int argc, char** argv) {
 
     print_mesh_and_grid();
     fmt::print("voxels      {} ({})\n", svo->voxel_count(), voxelize.ModeName());
+    if (voxelize.solid()) app::PrintInterior(*interior);
     app::PrintOctreeSummary(*svo, *written);
     app::PrintTimes(progress);
     fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);

@@ -59,6 +59,14 @@ int main(int argc, char** argv) {
       if (by_default) limit = half_machine;
     }
     VfragMetadata source;
+    StatusOr<std::optional<InteriorCubes>> interior = ReadVfragInterior(input);
+    if (!interior.ok()) return app::Fail(tool, interior.status());
+    if (*interior && !memory_limit.empty()) {
+      return app::Fail(tool, Status::BadInput("{}: a solid is built whole: a build by pages "
+                                              "(--memory-limit) does not fill yet",
+                                              input.string()));
+    }
+    if (*interior) limit = std::uint64_t{0};  // built whole, as above
     std::unique_ptr<VfragCubes> cubes;
     if (*limit > 0) {
       StatusOr<std::unique_ptr<VfragCubes>> opened = app::RunStage(
@@ -106,13 +114,16 @@ int main(int argc, char** argv) {
       fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
       return 0;
     }
-    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), mesh ? &*mesh : nullptr,
-                                               build.Options(), meta, progress);
+    BuildOptions options = build.Options();
+    if (*interior) options.interior = &**interior;
+    StatusOr<CompactSvo> svo =
+        BuildCompactSvo(std::move(*voxels), mesh ? &*mesh : nullptr, options, meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
     StatusOr<SvoFileStats> written =
         app::RunStage(progress, "write", [&] { return WriteSvo(*svo, output, *compression); });
     if (!written.ok()) return app::Fail(tool, written.status());
     fmt::print("input       {} ({} voxels)\n", input.string(), svo->voxel_count());
+    if (*interior) app::PrintInterior(**interior);
     fmt::print("octree      depth {}, bricks {}, contours {}\n", svo->depth, build.bricks,
                build.contours ? "on" : "off");
     app::PrintOctreeSummary(*svo, *written);

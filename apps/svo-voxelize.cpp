@@ -5,6 +5,7 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/voxel_writers.hpp"
 #include "svokit/formats/mesh_import.hpp"
@@ -48,6 +49,10 @@ int main(int argc, char** argv) {
     if (!grid.ok()) return app::Fail(tool, grid.status().WithContext(input.string()));
 
     const std::string ext = LowerExtension(output);
+    if (voxelize.solid() && ext != "vfrag") {
+      return app::Fail(
+          tool, Status::BadInput("--fill solid writes .vfrag files only, not {}", output.string()));
+    }
     std::size_t voxel_count = 0;
     Status written;
     const VfragMetadata meta{input.filename().string(), voxelize.Recorded(),
@@ -72,6 +77,11 @@ int main(int argc, char** argv) {
         limit = half_machine;
       }
     }
+    std::optional<InteriorCubes> interior;
+    if (*limit > 0 && voxelize.solid()) {
+      return app::Fail(tool, Status::BadInput("--fill solid is voxelized whole: writing cube by "
+                                              "cube (--memory-limit) does not fill yet"));
+    }
     if (*limit > 0) {
       StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
           RegionVoxelizer::Create(*mesh, *grid, voxelize.Options());
@@ -86,13 +96,25 @@ int main(int argc, char** argv) {
       // Keys packed as they are found, everything written in place into the file's mapped
       // sections. Methods and thread counts give the same file, byte for byte: they are not
       // recorded.
-      VfragFileWriter file(output, meta);
+      VfragFileWriter file(output, meta, voxelize.solid());
       StatusOr<PackedVoxelization> voxels =
           VoxelizePacked(*mesh, *grid, voxelize.Options(), file, progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
       app::Warn(tool, voxels->attributes.warnings);
       voxel_count = voxels->count;
-      written = app::RunStage(progress, "write", [&] { return file.Commit(*voxels); });
+      if (voxelize.solid()) {
+        // The interior is found around the surface's keys, read back from the file's own bytes.
+        std::vector<std::uint64_t> keys;
+        const std::span<const std::uint8_t> gaps = file.KeyGaps(*voxels);
+        const std::uint8_t* p = gaps.data();
+        bool not_increasing = false;
+        ReadKeyGaps(p, p + gaps.size(), voxels->count, kNoPreviousKey, keys, &not_increasing);
+        StatusOr<InteriorCubes> cubes = FillInterior(*mesh, *grid, keys, {}, progress);
+        if (!cubes.ok()) return app::Fail(tool, cubes.status().WithContext(input.string()));
+        interior = std::move(*cubes);
+      }
+      written = app::RunStage(
+          progress, "write", [&] { return file.Commit(*voxels, interior ? &*interior : nullptr); });
     } else {
       StatusOr<VoxelSet> voxels = Voxelize(*mesh, *grid, voxelize.Options(), progress);
       if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
@@ -109,6 +131,7 @@ int main(int argc, char** argv) {
     fmt::print("grid        {} x {} x {} voxels of {:.9g}\n", d[0], d[1], d[2], grid->voxel_size());
     fmt::print("{}", by_cubes);
     fmt::print("voxels      {} ({})\n", voxel_count, voxelize.ModeName());
+    if (interior) app::PrintInterior(*interior);
     fmt::print("output      {}\n", output.string());
     return 0;
   });

@@ -339,7 +339,7 @@ TEST(SvoFile, RejectsIndicesOutOfSequence) {
   svo.levels[1].nodes[2].first_contour = 0;
   ExpectRejected(svo, "first contour index out of sequence");
   svo = HandSvo();
-  svo.levels[1].nodes[1].reserved = 1;
+  svo.levels[1].nodes[1].full_mask = 1;
   ExpectRejected(svo, "reserved");
 }
 

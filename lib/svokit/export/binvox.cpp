@@ -42,19 +42,39 @@ class StreamedFile {
 
 }  // namespace
 
-Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path) {
+Status WriteVoxelsBinvox(const VoxelSet& voxels, const InteriorCubes* interior,
+                         const std::filesystem::path& path) {
   const std::uint64_t d = voxels.grid.max_dim();
   // The cube is stored whole (runs of at most 255): beyond 4096³ the empty runs alone pass 0.5 GB.
   if (d > 4096) {
     return Status::BadInput("{}: a {}³ binvox cube is too large; export a coarser --level",
                             path.string(), d);
   }
-  std::vector<std::uint64_t> order(voxels.keys.size());
-  std::transform(voxels.keys.begin(), voxels.keys.end(), order.begin(), [d](std::uint64_t key) {
+  // Filled runs (first index, length) in file order: y fastest, then z, then x. A cube of side s
+  // is s² runs along y.
+  const auto index = [d](std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+    return (x * d + z) * d + y;
+  };
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> runs(voxels.keys.size());
+  std::transform(voxels.keys.begin(), voxels.keys.end(), runs.begin(), [&](std::uint64_t key) {
     const MortonCoord c = MortonDecode(key);
-    return (std::uint64_t{c.x} * d + c.z) * d + c.y;  // y fastest, then z, then x
+    return std::pair<std::uint64_t, std::uint64_t>{index(c.x, c.y, c.z), 1};
   });
-  std::sort(order.begin(), order.end());
+  if (interior != nullptr) {
+    for (std::uint32_t l = 0; l < interior->levels.size(); ++l) {
+      const std::uint64_t side = std::uint64_t{1} << (interior->depth - l);
+      for (const std::uint64_t key : interior->levels[l]) {
+        const MortonCoord c = MortonDecode(key);
+        const std::uint64_t x0 = c.x * side, y0 = c.y * side, z0 = c.z * side;
+        for (std::uint64_t x = x0; x < std::min(x0 + side, d); ++x) {
+          for (std::uint64_t z = z0; z < std::min(z0 + side, d); ++z) {
+            runs.push_back({index(x, y0, z), std::min(side, d - y0)});
+          }
+        }
+      }
+    }
+  }
+  std::sort(runs.begin(), runs.end());
 
   StreamedFile out(path);
   if (!out.status().ok()) return out.status();
@@ -69,12 +89,13 @@ Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& pa
     }
   };
   std::uint64_t next = 0;  // first index not yet written
-  for (std::size_t i = 0; i < order.size();) {
+  for (std::size_t i = 0; i < runs.size();) {
+    std::uint64_t end = runs[i].first + runs[i].second;
     std::size_t j = i + 1;
-    while (j < order.size() && order[j] == order[j - 1] + 1) ++j;
-    run(0, order[i] - next);
-    run(1, j - i);
-    next = order[j - 1] + 1;
+    for (; j < runs.size() && runs[j].first == end; ++j) end += runs[j].second;
+    run(0, runs[i].first - next);
+    run(1, end - runs[i].first);
+    next = end;
     i = j;
   }
   run(0, d * d * d - next);

@@ -72,6 +72,72 @@ VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
   return set;
 }
 
+InteriorCubes LevelInterior(const Svo& svo, std::uint32_t level) {
+  InteriorCubes interior;
+  interior.depth = level;
+  interior.levels.resize(level + 1);
+  if (!svo.solid) return interior;
+  // Full leaves of levels ≤ `level` are its cubes; deeper ones lie inside nodes of `level`.
+  for (std::uint32_t l = 0; l < level; ++l) {
+    const std::vector<std::uint64_t> keys = svo.LevelKeys(l);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const std::uint8_t full = svo.levels[l].nodes[i].full_mask;
+      for (unsigned c = 0; c < 8; ++c) {
+        if (full >> c & 1u) interior.levels[l + 1].push_back(keys[i] << 3 | c);
+      }
+    }
+  }
+  return interior;
+}
+
+namespace {
+
+// The voxels with the interior's as voxels of their own, in the surface's mean colour (white
+// without colours): for formats that list every voxel.
+StatusOr<VoxelSet> WithInteriorVoxels(VoxelSet voxels, const InteriorCubes& interior,
+                                      const std::filesystem::path& path) {
+  constexpr std::uint64_t kMostVoxels = std::uint64_t{1} << 28;
+  if (interior.voxel_count() + voxels.size() > kMostVoxels) {
+    return Status::BadInput(
+        "{}: {} voxels with the interior are too many to list one by one; "
+        "export a coarser --level or a .vdb",
+        path.string(), interior.voxel_count() + voxels.size());
+  }
+  std::vector<std::uint64_t> inside;
+  inside.reserve(interior.voxel_count());
+  for (std::uint32_t l = 0; l < interior.levels.size(); ++l) {
+    const std::uint64_t count = std::uint64_t{1} << (3 * (interior.depth - l));
+    for (const std::uint64_t key : interior.levels[l]) {
+      for (std::uint64_t v = 0; v < count; ++v) inside.push_back(key * count + v);
+    }
+  }
+  std::sort(inside.begin(), inside.end());
+  VoxelSet all;
+  all.grid = voxels.grid;
+  all.mode = voxels.mode;
+  all.keys.resize(voxels.size() + inside.size());
+  std::merge(voxels.keys.begin(), voxels.keys.end(), inside.begin(), inside.end(),
+             all.keys.begin());
+  if (voxels.has_colors()) {
+    Rgba mean{0, 0, 0, 0};
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      const Rgba c = voxels.color(i);
+      mean = {mean.r + c.r, mean.g + c.g, mean.b + c.b, mean.a + c.a};
+    }
+    const float n = static_cast<float>(std::max<std::size_t>(voxels.size(), 1));
+    const HalfRgba interior_color(mean.r / n, mean.g / n, mean.b / n, mean.a / n);
+    all.colors.resize(all.keys.size());
+    std::size_t i = 0;
+    for (std::size_t k = 0; k < all.keys.size(); ++k) {
+      const bool surface = i < voxels.size() && voxels.keys[i] == all.keys[k];
+      all.colors[k] = surface ? voxels.color(i++) : interior_color;
+    }
+  }
+  return all;
+}
+
+}  // namespace
+
 Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options) {
   const std::string ext = LowerExtension(path);
   const auto& known = ExportExtensions();
@@ -91,10 +157,16 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
   }
-  const VoxelSet voxels = LevelVoxels(svo, level);
-  if (ext == "vdb") return WriteVoxelsVdb(voxels, path);
-  if (ext == "binvox") return WriteVoxelsBinvox(voxels, path);
-  if (ext == "vox") return WriteVoxelsVox(voxels, path);
+  VoxelSet voxels = LevelVoxels(svo, level);
+  const InteriorCubes interior = LevelInterior(svo, level);
+  const InteriorCubes* solid = svo.solid ? &interior : nullptr;
+  if (ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
+  if (ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
+  if (ext == "vox") {
+    if (solid == nullptr) return WriteVoxelsVox(voxels, path);
+    StatusOr<VoxelSet> all = WithInteriorVoxels(std::move(voxels), interior, path);
+    return all.ok() ? WriteVoxelsVox(*all, path) : all.status();
+  }
   if (ext == "ply") return WriteVoxelsPly(voxels, path);
   return WriteVoxelsXyz(voxels, path);
 }

@@ -13,6 +13,7 @@
 
 #include "svokit/core/status.hpp"
 #include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -34,5 +35,9 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
 /// A node's colour and normal are its brick's centre sample (side 3) or the opacity-weighted mean
 /// of its 8 corners (side 2); without bricks only occupancy.
 VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level);
+
+/// A solid's full leaves seen from `level`: cubes of levels ≤ `level` at that resolution (depth =
+/// `level`; deeper full leaves lie inside nodes of `level`). No cubes unless svo.solid.
+InteriorCubes LevelInterior(const Svo& svo, std::uint32_t level);
 
 }  // namespace svokit

@@ -64,7 +64,8 @@ Status ReplaceUuid(const AtomicFileWriter& file) {
 
 }  // namespace
 
-Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path) {
+Status WriteVoxelsVdb(const VoxelSet& voxels, const InteriorCubes* interior,
+                      const std::filesystem::path& path) {
   InitializeOpenVdb();
   const double h = voxels.grid.voxel_size();
   const Vec3d& o = voxels.grid.origin();
@@ -97,6 +98,20 @@ Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path)
     if (voxels.has_normals()) {
       const Vec3f& n = voxels.normals[i];
       oriented.setValueOn(ijk, openvdb::Vec3f(n.x, n.y, n.z));
+    }
+  }
+
+  if (interior != nullptr) {
+    for (std::uint32_t l = 0; l < interior->levels.size(); ++l) {
+      const auto side = static_cast<openvdb::Int32>(1u << (interior->depth - l));
+      for (const std::uint64_t key : interior->levels[l]) {
+        const MortonCoord c = MortonDecode(key);
+        const openvdb::Coord lo(static_cast<openvdb::Int32>(c.x) * side,
+                                static_cast<openvdb::Int32>(c.y) * side,
+                                static_cast<openvdb::Int32>(c.z) * side);
+        // sparseFill makes a tile of every whole, aligned node: a cube costs its surface's nodes.
+        occupancy->tree().sparseFill(openvdb::CoordBBox(lo, lo.offsetBy(side - 1)), true, true);
+      }
     }
   }
 

@@ -6,19 +6,25 @@
 #include <filesystem>
 
 #include "svokit/core/status.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
 
 /// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
 /// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).
-Status WriteVoxelsBinvox(const VoxelSet& voxels, const std::filesystem::path& path);
+/// A solid's `interior` cubes (at the voxels' resolution; null for none) are filled.
+Status WriteVoxelsBinvox(const VoxelSet& voxels, const InteriorCubes* interior,
+                         const std::filesystem::path& path);
 /// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
 /// scene graph at its grid position; colours median-cut into at most 255 palette entries.
 Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
 /// OpenVDB: BoolGrid "occupancy", Vec3f grids "color" (linear RGB) and "normal" when present, all
 /// sharing a transform whose voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp).
-Status WriteVoxelsVdb(const VoxelSet& voxels, const std::filesystem::path& path);
+/// A solid's `interior` cubes are active in the occupancy grid, as tiles where they are whole
+/// nodes of the tree (8³ voxels and up); colour and normal grids leave them inactive.
+Status WriteVoxelsVdb(const VoxelSet& voxels, const InteriorCubes* interior,
+                      const std::filesystem::path& path);
 
 /// Text: "# origin X Y Z", "# voxel_size H", "# dims NX NY NZ" (round-trip precision), then
 /// "i j k" per voxel in Morton order.

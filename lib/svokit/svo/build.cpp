@@ -91,6 +91,9 @@ Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
 StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
                        std::string metadata, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckBuildInput(voxels, mesh, options));
+  if (options.interior != nullptr) {
+    return Status::BadInput("a solid's full leaves need a version-2 octree (BuildCompactSvo)");
+  }
   Svo svo;
   svo.grid = voxels.grid;
   svo.mode = voxels.mode;

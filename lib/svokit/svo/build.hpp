@@ -10,6 +10,7 @@
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/svo/contour.hpp"
 #include "svokit/svo/svo.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -18,6 +19,8 @@ struct BuildOptions {
   std::uint32_t brick_side = 3;  ///< 3, 2 or 0 (no bricks)
   bool contours = true;          ///< needs the mesh
   ContourOptions contour;
+  /// A solid's interior (FillInterior, same grid): its cubes become full leaves. Null: a surface.
+  const InteriorCubes* interior = nullptr;
 };
 
 /// The octree of `voxels`; `mesh` (the surface the voxels came from, in the same world space) is

@@ -11,6 +11,32 @@
 
 namespace svokit {
 
+StatusOr<std::vector<std::vector<std::uint8_t>>> FullMasks(
+    std::span<const std::vector<std::uint64_t>> keys, const MaskTree& tree,
+    const InteriorCubes& interior) {
+  if (interior.levels.size() != keys.size() || interior.levels.front().size() > 0) {
+    return Status::BadInput("the interior's cubes are not of this octree's {} levels", keys.size());
+  }
+  std::vector<std::vector<std::uint8_t>> full(keys.size() - 1);
+  for (std::size_t l = 0; l + 1 < keys.size(); ++l) {
+    full[l].assign(keys[l].size(), 0);
+    // Every cube is a free child of a node of the level above: walk both in order.
+    std::size_t node = 0;
+    for (const std::uint64_t cube : interior.levels[l + 1]) {
+      while (node < keys[l].size() && keys[l][node] < cube >> 3) ++node;
+      const auto bit = static_cast<std::uint8_t>(1u << (cube & 7));
+      if (node == keys[l].size() || keys[l][node] != cube >> 3 ||
+          ((tree.masks[l][node] | full[l][node]) & bit)) {
+        return Status::BadInput(
+            "interior cube {} of level {} is not a free child of a node of the surface", cube,
+            l + 1);
+      }
+      full[l][node] |= bit;
+    }
+  }
+  return full;
+}
+
 VoxelSamplesSource CompactSvo::VoxelSource() const {
   VoxelSamplesSource source;
   if (has_color) source.colors = colors;
@@ -37,6 +63,12 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
     Progress::Stage stage(progress, "octree", 1);
     keys = LevelKeysFromVoxels(std::move(voxels.keys), svo.depth);
     svo.tree = MaskTreeFromKeys(keys);
+    if (options.interior != nullptr) {
+      auto full = FullMasks(keys, svo.tree, *options.interior);
+      if (!full.ok()) return full.status();
+      svo.solid = true;
+      svo.tree.full = std::move(*full);
+    }
     if (!options.contours) keys = {};  // only contours read keys (8 B per voxel) after the masks
     stage.Advance();
   }
@@ -67,6 +99,7 @@ SvoShape Shape(const CompactSvo& svo) {
   shape.has_color = svo.has_color;
   shape.has_normal = svo.has_normal;
   shape.has_contours = svo.has_contours;
+  shape.solid = svo.solid;
   if (svo.has_color && svo.colors.size() == 1) shape.shared_color = {svo.colors[0]};
   return shape;
 }

@@ -27,6 +27,7 @@ struct CompactSvo {
   std::uint32_t depth = 0;       ///< level `depth` holds the voxels
   std::uint32_t brick_side = 0;  ///< 0 (no bricks), 2 or 3
   bool has_color = false, has_normal = false, has_contours = false;
+  bool solid = false;  ///< tree.full holds the interior's cubes
   std::string metadata;
   /// Levels 0 .. depth: the child masks of levels 0 .. depth − 1.
   MaskTree tree;
@@ -55,6 +56,13 @@ struct CompactSvo {
 StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const BuildOptions& options,
                                      std::string metadata = "{}",
                                      Progress& progress = Progress::Silent());
+
+/// The full-leaf masks of `tree`, whose level keys are `keys` (LevelKeysFromVoxels), for the
+/// cubes of `interior`; fails unless each cube is a free child of a node of the tree (as
+/// FillInterior's are) and the levels match.
+StatusOr<std::vector<std::vector<std::uint8_t>>> FullMasks(
+    std::span<const std::vector<std::uint64_t>> keys, const MaskTree& tree,
+    const InteriorCubes& interior);
 
 /// Every node's brick and the node records: the Svo the octree stands for.
 Svo AssembleSvo(const CompactSvo& svo);

@@ -32,6 +32,9 @@ struct MaskTree {
   /// level holds exactly one node.
   std::uint32_t first_level = 0;
   std::vector<std::vector<std::uint8_t>> masks;
+  /// A solid's full leaves: per level of `masks`, per node, the children that are cubes wholly
+  /// inside (disjoint from its mask; they are not nodes of the next level). Empty for a surface.
+  std::vector<std::vector<std::uint8_t>> full;
   /// Prefix sums of the masks' popcounts: the index of each node's first child.
   std::vector<std::vector<std::uint64_t>> first_child;
 

@@ -8,6 +8,16 @@
 
 namespace svokit {
 
+std::uint64_t Svo::InteriorVoxelCount() const {
+  std::uint64_t count = 0;
+  for (std::uint32_t l = 0; l < depth && l < levels.size(); ++l) {
+    for (const SvoNode& n : levels[l].nodes) {
+      count += static_cast<std::uint64_t>(CountBits8(n.full_mask)) << (3 * (depth - l - 1));
+    }
+  }
+  return count;
+}
+
 std::vector<std::uint64_t> Svo::LevelKeys(std::uint32_t level) const {
   std::vector<std::uint64_t> keys{0};  // the root
   for (std::uint32_t l = 0; l < level; ++l) {

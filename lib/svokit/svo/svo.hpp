@@ -27,7 +27,9 @@ struct SvoNode {
   std::uint8_t child_mask = 0;      ///< bit c: child c exists
   std::uint8_t leaf_mask = 0;       ///< bit c: child c exists and has no children
   std::uint8_t contour_mask = 0;    ///< bit c: child c has a contour
-  std::uint8_t reserved = 0;
+  /// bit c: child c is a full leaf, a cube wholly inside a solid (`--fill solid`): no record, brick
+  /// or contour of its own; a renderer reads it as opacity 1. Disjoint from child_mask.
+  std::uint8_t full_mask = 0;
 
   std::uint32_t Child(unsigned c) const {
     return first_child + static_cast<std::uint32_t>(RankInByte(child_mask, c));
@@ -74,11 +76,14 @@ struct Svo {
   bool has_normal = false;  ///< bricks carry normals
   bool has_contours = false;
   bool has_ao = false;           ///< every level holds `ao`
+  bool solid = false;            ///< nodes may have full leaves (SvoNode::full_mask)
   std::string metadata;          ///< JSON: source, options, tool version
   std::vector<SvoLevel> levels;  ///< depth + 1 levels
 
   std::uint32_t brick_samples() const { return brick_side * brick_side * brick_side; }
   std::uint64_t voxel_count() const { return levels.empty() ? 0 : levels.back().node_count; }
+  /// Voxels inside the full leaves (0 unless solid).
+  std::uint64_t InteriorVoxelCount() const;
   /// World-space edge length of a node at `level`.
   double NodeSize(std::uint32_t level) const {
     return grid.voxel_size() * static_cast<double>(std::uint64_t{1} << (depth - level));

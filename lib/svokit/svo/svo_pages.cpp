@@ -51,6 +51,7 @@ SvoChunk TopChunk(const CompactSvo& svo, std::uint32_t page_level) {
   SvoChunk top;
   if (page_level == 0) return top;
   top.tree.masks.assign(svo.tree.masks.begin(), svo.tree.masks.begin() + page_level);
+  if (svo.solid) top.tree.full.assign(svo.tree.full.begin(), svo.tree.full.begin() + page_level);
   top.tree.LinkChildren();
   top.contours.assign(svo.contours.begin(), svo.contours.begin() + page_level);
   if (svo.brick_side != 0) {
@@ -72,6 +73,10 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
     const std::vector<std::uint8_t>& masks = svo.tree.masks[l];
     chunk.tree.masks.emplace_back(masks.begin() + static_cast<std::ptrdiff_t>(begin),
                                   masks.begin() + static_cast<std::ptrdiff_t>(end));
+    if (svo.solid) {
+      chunk.tree.full.emplace_back(svo.tree.full[l].begin() + static_cast<std::ptrdiff_t>(begin),
+                                   svo.tree.full[l].begin() + static_cast<std::ptrdiff_t>(end));
+    }
   }
   chunk.tree.LinkChildren();
   for (std::uint32_t l = page_level; l <= svo.depth; ++l) {
@@ -249,6 +254,7 @@ SvoAssembler::SvoAssembler(const SvoShape& shape, std::uint32_t max_level)
     : shape_(shape),
       max_level_(std::min(max_level, shape.depth)),
       masks_(shape.depth),
+      full_(shape.solid ? shape.depth : 0),
       words_(shape.depth + 1),
       levels_(shape.depth + 1) {}
 
@@ -278,7 +284,10 @@ void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
       words_[l].resize(words_[l].size() + chunk.tree.NodeCount(l), 0);
     }
     if (l > max_level_) continue;
-    if (l < shape_.depth) AppendTo(masks_[l], chunk.tree.masks[k]);
+    if (l < shape_.depth) {
+      AppendTo(masks_[l], chunk.tree.masks[k]);
+      if (shape_.solid) AppendTo(full_[l], chunk.tree.full[k]);
+    }
     if (shape_.brick_side == 0) continue;
     AppendTo(levels_[l].opacity, std::move(bricks[k].opacity));
     AppendTo(levels_[l].color, std::move(bricks[k].color));
@@ -296,6 +305,7 @@ Svo SvoAssembler::Finish(const GridTransform& grid, VoxelMode mode, std::string 
   svo.has_color = shape_.brick_side != 0 && shape_.has_color;
   svo.has_normal = shape_.brick_side != 0 && shape_.has_normal;
   svo.has_contours = shape_.has_contours;
+  svo.solid = shape_.solid;
   svo.metadata = std::move(metadata);
   svo.levels = std::move(levels_);
   svo.levels.resize(max_level_ + 1);
@@ -313,6 +323,7 @@ Svo SvoAssembler::Finish(const GridTransform& grid, VoxelMode mode, std::string 
     for (std::size_t i = 0; i < masks.size(); ++i) {
       SvoNode& n = lv.nodes[i];
       n.child_mask = masks[i];
+      if (shape_.solid) n.full_mask = full_[l][i];
       n.leaf_mask = l + 1 == shape_.depth ? masks[i] : 0;
       n.first_child = child;
       n.first_contour = contour;

@@ -71,6 +71,7 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
 struct SvoShape {
   std::uint32_t depth = 0, brick_side = 0;
   bool has_color = false, has_normal = false, has_contours = false;
+  bool solid = false;                  ///< nodes may have full leaves (MaskTree::full)
   std::vector<HalfRgba> shared_color;  ///< one entry, or empty
 };
 
@@ -93,7 +94,7 @@ class SvoAssembler {
  private:
   SvoShape shape_;
   std::uint32_t max_level_;
-  std::vector<std::vector<std::uint8_t>> masks_;
+  std::vector<std::vector<std::uint8_t>> masks_, full_;
   std::vector<std::vector<std::uint32_t>> words_;
   std::vector<SvoLevel> levels_;
 };

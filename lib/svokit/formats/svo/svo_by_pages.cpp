@@ -489,7 +489,8 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   head.Put(frame.shape.brick_side);
   head.Put(std::uint32_t{(frame.shape.has_color ? svo_detail::kHasColor : 0u) |
                          (frame.shape.has_normal ? svo_detail::kHasNormal : 0u) |
-                         (frame.shape.has_contours ? svo_detail::kHasContours : 0u)});
+                         (frame.shape.has_contours ? svo_detail::kHasContours : 0u) |
+                         (frame.shape.solid ? svo_detail::kSolid : 0u)});
   head.Put(frame.shape.shared_color.empty() ? HalfRgba(0, 0, 0, 0) : frame.shape.shared_color[0]);
   head.Put(std::uint32_t{frame.shape.shared_color.empty() ? 0u : 1u});
   head.Put(std::uint32_t{compression.zstd ? 1u : 0u});
@@ -595,6 +596,7 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
   shape.has_color = flags & svo_detail::kHasColor;
   shape.has_normal = flags & svo_detail::kHasNormal;
   shape.has_contours = flags & svo_detail::kHasContours;
+  shape.solid = flags & svo_detail::kSolid;
   if (shared) shape.shared_color = {color};
   part.compression.zstd = zstd != 0;
   part.compression.level = static_cast<int>(level);
@@ -602,7 +604,8 @@ StatusOr<Part> ReadPart(const std::filesystem::path& path) {
   if (part.parts == 0 || part.part >= part.parts || part.first > part.end ||
       part.end > part.cells || part.frame.depth != OctreeDepth(part.frame.grid) ||
       (shape.brick_side != 0 && shape.brick_side != 2 && shape.brick_side != 3) ||
-      (flags & ~(svo_detail::kHasColor | svo_detail::kHasNormal | svo_detail::kHasContours)) != 0) {
+      (flags & ~(svo_detail::kHasColor | svo_detail::kHasNormal | svo_detail::kHasContours |
+                 svo_detail::kSolid)) != 0) {
     return Status::BadInput("{}: the part's header is inconsistent", name);
   }
   const std::uint32_t page_level = PageLevel(part.frame.depth);

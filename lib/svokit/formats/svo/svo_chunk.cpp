@@ -33,6 +33,7 @@ enum Stream : std::uint8_t {
   kHaloKeys,
   kHaloColors,
   kHaloNormals,
+  kFullMasks,
   kStreamKinds
 };
 constexpr std::uint8_t kStored = 0, kZstd = 1;
@@ -171,6 +172,8 @@ std::string SectionOf(Stream kind) {
       return "voxel colours";
     case kVoxelNormals:
       return "voxel normals";
+    case kFullMasks:
+      return "full leaves";
     default:
       return "halo";
   }
@@ -266,6 +269,10 @@ std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& sha
   for (const std::vector<std::uint8_t>& level : chunk.tree.masks) {
     masks.insert(masks.end(), level.begin(), level.end());
   }
+  Bytes full;
+  for (const std::vector<std::uint8_t>& level : chunk.tree.full) {
+    full.insert(full.end(), level.begin(), level.end());
+  }
   const Contours contours = SplitContours(chunk);
   const SampleStreams samples = SplitSamples(chunk);
   // Halo keys: their count, then AppendKeyGaps' gaps.
@@ -293,6 +300,7 @@ std::vector<std::uint8_t> EncodeChunk(const SvoChunk& chunk, const SvoShape& sha
       {kHaloKeys, halo_keys},
       {kHaloColors, DeltaLanes(std::span<const HalfRgba>(chunk.halo_colors))},
       {kHaloNormals, DeltaLanes(std::span<const OctNormal>(chunk.halo_normals))},
+      {kFullMasks, shape.solid ? full : Bytes{}},
   };
   Bytes directory = {0}, data;
   for (const auto& [kind, raw] : streams) {
@@ -396,7 +404,8 @@ std::string_view StreamName(Stream kind) {
                                                 "voxel normals",
                                                 "halo keys",
                                                 "halo colours",
-                                                "halo normals"};
+                                                "halo normals",
+                                                "full masks"};
   return kNames[kind];
 }
 
@@ -453,6 +462,7 @@ std::vector<std::array<std::uint64_t, kStreamKinds>> LevelValues(const SvoChunk&
   for (std::uint32_t k = 0; k < held; ++k) {
     std::array<std::uint64_t, kStreamKinds>& v = values[k];
     if (k < chunk.tree.masks.size()) v[kMasks] = chunk.tree.masks[k].size();
+    if (k < chunk.tree.full.size()) v[kFullMasks] = chunk.tree.full[k].size();
     if (k < chunk.contours.size()) {
       const std::vector<std::uint32_t>& words = chunk.contours[k];
       if (shape.has_contours) v[kContourBits] = (words.size() + 7) / 8;
@@ -555,6 +565,25 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
                             masks.size() - at);
   }
   chunk.tree.LinkChildren();
+  // A solid's full leaves: one mask per node above the voxels, disjoint from its children.
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kFullMasks, shape.solid ? masks.size() : 0, name));
+  if (shape.solid) {
+    const Bytes& full = set[kFullMasks];
+    std::uint64_t from = 0;
+    for (std::size_t k = 0; k < chunk.tree.masks.size(); ++k) {
+      const std::vector<std::uint8_t>& level = chunk.tree.masks[k];
+      std::vector<std::uint8_t>& f = chunk.tree.full.emplace_back(
+          full.begin() + static_cast<std::ptrdiff_t>(from),
+          full.begin() + static_cast<std::ptrdiff_t>(from + level.size()));
+      for (std::size_t i = 0; i < level.size(); ++i) {
+        if (f[i] & level[i]) {
+          return Status::BadInput("{}: a node of level {} has a child that is both full and not",
+                                  name, frame.root_level + k);
+        }
+      }
+      from += level.size();
+    }
+  }
 
   // Contours.
   std::uint64_t contour_count = 0, bit_bytes = 0;

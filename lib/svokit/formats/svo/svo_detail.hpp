@@ -24,6 +24,8 @@ inline constexpr Tag kMetadata = MakeTag("META");
 inline constexpr Tag kAo = MakeTag("AOCC");
 inline constexpr std::uint32_t kMaxDepth = 20;
 inline constexpr std::uint32_t kHasColor = 1, kHasNormal = 2, kHasContours = 4;  // HEAD flags
+/// HEAD flag (version 2): the chunks carry full-leaf masks (a solid).
+inline constexpr std::uint32_t kSolid = 16;
 
 // Collects the issues of one decode. The strict readers stop at the first (Add returns false);
 // the lenient one records every issue (the first kMaxExamples messages of each kind) and goes on.

@@ -72,7 +72,7 @@ bool CheckLinks(const Svo& svo, std::uint32_t l, const std::string& name, std::u
     if (l + 1 < svo.depth && n.leaf_mask != 0 && !bad("mask", i, "leaf above the voxel level")) {
       return false;
     }
-    if (n.reserved != 0 && !bad("reserved", i, "reserved byte is not zero")) return false;
+    if (n.full_mask != 0 && !bad("reserved", i, "reserved byte is not zero")) return false;
     children += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(n.child_mask)));
     contours += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(n.contour_mask)));
     if (children > std::uint64_t{0xffffffff}) return bad("child_index", i, "too many children");

@@ -46,6 +46,7 @@ using svo_detail::kMetadata;
 using svo_detail::kPages;
 using svo_detail::kPageTable;
 using svo_detail::kSharedColor;
+using svo_detail::kSolid;
 using svo_detail::kTop;
 
 namespace {
@@ -128,7 +129,8 @@ Status PagedSvoWriter::Finish() {
   head.Put(frame_.depth);
   head.Put(shape.brick_side);
   head.Put((shape.has_color ? kHasColor : 0) | (shape.has_normal ? kHasNormal : 0) |
-           (shape.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0));
+           (shape.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0) |
+           (shape.solid ? kSolid : 0));
   head.Put(page_level_);
   head.Put(static_cast<std::uint64_t>(keys_.size()));
   head.Put(shared ? shape.shared_color[0] : HalfRgba(0, 0, 0, 0));
@@ -260,7 +262,7 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   }
   const std::uint32_t side = v.shape.brick_side;
   if ((side != 0 && side != 2 && side != 3) ||
-      (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor)) ||
+      (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor | kSolid)) ||
       ((flags & kSharedColor) && !(flags & kHasColor)) || codec > 1) {
     return bad_head(
         fmt::format("brick side {}, flags {:#x} or codec {} are invalid", side, flags, codec));
@@ -268,6 +270,7 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   v.shape.has_color = flags & kHasColor;
   v.shape.has_normal = flags & kHasNormal;
   v.shape.has_contours = flags & kHasContours;
+  v.shape.solid = flags & kSolid;
   if (flags & kSharedColor) v.shape.shared_color = {shared};
   if (v.page_level >= depth && !(v.page_level == 0 && depth == 0)) {
     return bad_head(

@@ -11,6 +11,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
 #include "svokit/core/key_gaps.hpp"
+#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
 #include "svokit/core/utf8.hpp"
@@ -343,12 +344,14 @@ Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesyst
   return status;
 }
 
-VfragFileWriter::VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta)
+VfragFileWriter::VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta, bool solid)
     : path_(std::move(path)),
       metadata_(MetadataSection(meta)),
       grid_(kGridSectionSize, 0),          // its value comes with Commit()
       shared_color_(sizeof(HalfRgba), 0),  // likewise
-      file_(kVfragFormat, 0) {}
+      file_(kVfragFormat, 0) {
+  solid_ = solid;
+}
 
 std::vector<container::MappedWriter::Section> VfragFileWriter::Sections(
     const PackedVoxelContents& contents, std::uint64_t voxels, std::uint64_t key_bytes) const {
@@ -363,7 +366,12 @@ std::vector<container::MappedWriter::Section> VfragFileWriter::Sections(
   if (contents.normals) sections.push_back({kNormals, {}, region++, voxels * sizeof(OctNormal)});
   if (contents.coverage) sections.push_back({kCoverage, {}, region++, voxels * sizeof(Half)});
   sections.push_back({kMetadata, metadata_});
+  if (solid_) sections.push_back({kInterior, interior_});
   return sections;
+}
+
+std::span<const std::uint8_t> VfragFileWriter::KeyGaps(const PackedVoxelization& voxels) const {
+  return file_.region(0).subspan(sizeof(std::uint64_t), voxels.key_bytes);
 }
 
 StatusOr<PackedVoxelArrays> VfragFileWriter::Reserve(const PackedVoxelContents& contents,
@@ -396,9 +404,14 @@ StatusOr<PackedVoxelArrays> VfragFileWriter::Reserve(const PackedVoxelContents& 
   return arrays;
 }
 
-Status VfragFileWriter::Commit(const PackedVoxelization& voxels) {
+Status VfragFileWriter::Commit(const PackedVoxelization& voxels, const InteriorCubes* interior) {
   const VoxelAttributes& a = voxels.attributes;
   const PackedVoxelContents& c = voxels.contents;
+  if (solid_ != (interior != nullptr)) {
+    return Status::Internal("{}: a solid's file needs its interior, a surface's has none",
+                            path_.string());
+  }
+  if (interior != nullptr) interior_ = EncodeInteriorSection(*interior);
   if (!open_ || c.colors != contents_.colors || c.normals != contents_.normals ||
       c.coverage != contents_.coverage || c.shared_color != contents_.shared_color ||
       c.shared_color != (a.colors.size() == 1)) {
@@ -430,6 +443,83 @@ Status VfragFileWriter::Commit(const PackedVoxelization& voxels) {
   }
   open_ = false;
   return file_.Commit(std::move(sections));
+}
+
+constexpr std::size_t kInteriorHeader = 16;
+
+std::vector<std::uint8_t> EncodeInteriorSection(const InteriorCubes& interior) {
+  // Header: u32 depth, u32 method, u64 open edges.
+  std::vector<std::uint8_t> out(kInteriorHeader);
+  const auto method = static_cast<std::uint32_t>(interior.method);
+  std::memcpy(out.data(), &interior.depth, 4);
+  std::memcpy(out.data() + 4, &method, 4);
+  std::memcpy(out.data() + 8, &interior.open_edges, 8);
+  std::uint8_t varint[kMaxVarintBytes];
+  for (const std::vector<std::uint64_t>& level : interior.levels) {
+    out.insert(out.end(), varint, varint + PutVarint(level.size(), varint));
+    AppendKeyGaps(std::span<const std::uint64_t>(level), kNoPreviousKey, out);
+  }
+  return out;
+}
+
+StatusOr<InteriorCubes> DecodeInteriorSection(std::span<const std::uint8_t> bytes,
+                                              const GridTransform& grid, const std::string& name) {
+  InteriorCubes interior;
+  const std::uint32_t depth = OctreeDepth(grid);
+  if (bytes.size() < kInteriorHeader) return Status::BadInput("{}: FILL is truncated", name);
+  std::uint32_t method = 0;
+  std::memcpy(&interior.depth, bytes.data(), 4);
+  std::memcpy(&method, bytes.data() + 4, 4);
+  std::memcpy(&interior.open_edges, bytes.data() + 8, 8);
+  if (method > 1 || (method == 0) != (interior.open_edges == 0)) {
+    return Status::BadInput("{}: FILL names an unknown method", name);
+  }
+  interior.method = static_cast<FillMethod>(method);
+  if (interior.depth != depth) {
+    return Status::BadInput("{}: FILL has depth {}, the grid's octree {}", name, interior.depth,
+                            depth);
+  }
+  const std::uint8_t* p = bytes.data() + kInteriorHeader;
+  const std::uint8_t* end = bytes.data() + bytes.size();
+  interior.levels.resize(depth + 1);
+  const auto& dims = grid.dims();
+  for (std::uint32_t l = 0; l <= depth; ++l) {
+    std::uint64_t count = 0;
+    // Each cube takes at least one byte: a count beyond the bytes left is damage, not a size.
+    if (!GetVarint(p, end, count) || count > static_cast<std::uint64_t>(end - p)) {
+      return Status::BadInput("{}: FILL level {} is damaged", name, l);
+    }
+    bool not_increasing = false;
+    std::vector<std::uint64_t>& keys = interior.levels[l];
+    if (ReadKeyGaps(p, end, count, kNoPreviousKey, keys, &not_increasing) != count) {
+      return Status::BadInput("{}: FILL level {} is damaged", name, l);
+    }
+    for (const std::uint64_t key : keys) {
+      const std::uint32_t shift = depth - l;
+      const MortonCoord c = MortonDecode(key);
+      if ((l < 21 && key >> (3 * l) != 0) || (std::uint64_t{c.x} << shift) >= dims[0] ||
+          (std::uint64_t{c.y} << shift) >= dims[1] || (std::uint64_t{c.z} << shift) >= dims[2]) {
+        return Status::BadInput("{}: FILL cube {} of level {} is outside the grid", name, key, l);
+      }
+    }
+  }
+  if (p != end) return Status::BadInput("{}: FILL has bytes after its last level", name);
+  return interior;
+}
+
+StatusOr<std::optional<InteriorCubes>> ReadVfragInterior(const std::filesystem::path& path) {
+  const auto file = container::Reader::Open(path, kVfragFormat);
+  if (!file.ok()) return file.status();
+  const auto fill = file->Find(kInterior);
+  if (!fill) return std::optional<InteriorCubes>{};
+  const auto grid_bytes = file->Find(kGrid);
+  if (!grid_bytes) return Status::BadInput("{}: required section 'GRID' is missing", path.string());
+  GridTransform grid;
+  VoxelMode mode;
+  SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid_bytes, path.string(), grid, mode));
+  auto interior = DecodeInteriorSection(*fill, grid, path.string());
+  if (!interior.ok()) return interior.status();
+  return std::optional<InteriorCubes>(std::move(*interior));
 }
 
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,

@@ -14,6 +14,7 @@
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -43,11 +44,14 @@ std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMeta
 /// armadillo with attributes: 290 MB). Destroyed uncommitted, it leaves nothing behind.
 class VfragFileWriter final : public PackedVoxelStorage {
  public:
-  VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta);
+  /// `solid`: the file will hold a solid's interior (Commit()'s `interior`).
+  VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta, bool solid = false);
   StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
                                       std::size_t key_bytes) override;
-  /// `voxels`: what VoxelizePacked() returned for this storage.
-  Status Commit(const PackedVoxelization& voxels);
+  /// The keys written so far, as varint gaps (`voxels`: what VoxelizePacked() returned).
+  std::span<const std::uint8_t> KeyGaps(const PackedVoxelization& voxels) const;
+  /// `voxels`: what VoxelizePacked() returned for this storage; `interior` for a solid writer.
+  Status Commit(const PackedVoxelization& voxels, const InteriorCubes* interior = nullptr);
 
  private:
   // The file's sections for these contents and sizes (regions: their rooms, or used sizes).
@@ -58,7 +62,8 @@ class VfragFileWriter final : public PackedVoxelStorage {
   std::filesystem::path path_;
   std::vector<std::uint8_t> metadata_, grid_, shared_color_;
   container::MappedWriter file_;
-  bool open_ = false;
+  bool open_ = false, solid_ = false;
+  std::vector<std::uint8_t> interior_;
   PackedVoxelContents contents_;
 };
 
@@ -129,6 +134,14 @@ class VfragCubes {
   Array colors_, normals_, coverage_;
   HalfRgba shared_color_value_{};
 };
+
+/// A solid's interior as the FILL section stores it (README.md), and back: every level's keys
+/// ascending and below 8^level, the depth the grid's, every cube's first voxel inside it.
+std::vector<std::uint8_t> EncodeInteriorSection(const InteriorCubes& interior);
+StatusOr<InteriorCubes> DecodeInteriorSection(std::span<const std::uint8_t> bytes,
+                                              const GridTransform& grid, const std::string& name);
+/// The interior of a solid's .vfrag (`--fill solid`); none for a surface's.
+StatusOr<std::optional<InteriorCubes>> ReadVfragInterior(const std::filesystem::path& path);
 
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,

@@ -22,6 +22,7 @@ inline constexpr container::Tag kColors = MakeTag("COLR");
 inline constexpr container::Tag kNormals = MakeTag("NORM");
 inline constexpr container::Tag kCoverage = MakeTag("COVR");
 inline constexpr container::Tag kMetadata = MakeTag("META");
+inline constexpr container::Tag kInterior = MakeTag("FILL");
 
 /// The META section of `meta`, and back (metadata that is not such JSON reads as empty).
 std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta);
