@@ -1,5 +1,6 @@
 #include "svokit/svo/compact_svo.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <iterator>
 #include <utility>
@@ -10,6 +11,34 @@
 #include "svokit/svo/svo_pages.hpp"
 
 namespace svokit {
+
+void AddSplitNodes(const InteriorCubes& interior, std::vector<std::vector<std::uint64_t>>& keys) {
+  // Bottom up: a level's missing parents are those of its cubes and of the split nodes added to
+  // it from below; every list is sorted, so each level is one merge walk.
+  std::vector<std::uint64_t> added;
+  for (std::size_t l = std::min(interior.levels.size(), keys.size()) - 1; l >= 1; --l) {
+    std::vector<std::uint64_t> parents(interior.levels[l].size() + added.size());
+    const auto parent = [](std::uint64_t key) { return key >> 3; };
+    std::transform(interior.levels[l].begin(), interior.levels[l].end(), parents.begin(), parent);
+    const auto middle = std::transform(
+        added.begin(), added.end(),
+        parents.begin() + static_cast<std::ptrdiff_t>(interior.levels[l].size()), parent);
+    std::inplace_merge(parents.begin(),
+                       parents.begin() + static_cast<std::ptrdiff_t>(interior.levels[l].size()),
+                       middle);
+    parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
+    const std::vector<std::uint64_t>& above = keys[l - 1];
+    std::vector<std::uint64_t> missing;
+    std::set_difference(parents.begin(), parents.end(), above.begin(), above.end(),
+                        std::back_inserter(missing));
+    if (!missing.empty()) {
+      std::vector<std::uint64_t> merged(above.size() + missing.size());
+      std::merge(above.begin(), above.end(), missing.begin(), missing.end(), merged.begin());
+      keys[l - 1] = std::move(merged);
+    }
+    added = std::move(missing);
+  }
+}
 
 StatusOr<std::vector<std::vector<std::uint8_t>>> FullMasks(
     std::span<const std::vector<std::uint64_t>> keys, const MaskTree& tree,
@@ -62,6 +91,7 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
   {
     Progress::Stage stage(progress, "octree", 1);
     keys = LevelKeysFromVoxels(std::move(voxels.keys), svo.depth);
+    if (options.interior != nullptr) AddSplitNodes(*options.interior, keys);
     svo.tree = MaskTreeFromKeys(keys);
     if (options.interior != nullptr) {
       auto full = FullMasks(keys, svo.tree, *options.interior);

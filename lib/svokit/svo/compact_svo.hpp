@@ -57,6 +57,10 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
                                      std::string metadata = "{}",
                                      Progress& progress = Progress::Silent());
 
+/// Adds to `keys` (LevelKeysFromVoxels) the nodes that hold interior cubes but no surface voxel:
+/// cubes the winding numbers split (their parents), and those nodes' ancestors.
+void AddSplitNodes(const InteriorCubes& interior, std::vector<std::vector<std::uint64_t>>& keys);
+
 /// The full-leaf masks of `tree`, whose level keys are `keys` (LevelKeysFromVoxels), for the
 /// cubes of `interior`; fails unless each cube is a free child of a node of the tree (as
 /// FillInterior's are) and the levels match.

@@ -28,8 +28,10 @@ Report Validate(const LenientSvo& file, const std::string& name, const ValidateO
                   svo.voxel_count(), svo.mode == VoxelMode::kThin ? "thin" : "conservative",
                   svo.brick_side, svo.has_color ? " colour" : "", svo.has_normal ? " normal" : "",
                   svo.has_contours ? "yes" : "no");
-  const std::vector<std::vector<std::uint64_t>> keys =
-      LevelKeysFromVoxels(svo.LevelKeys(svo.depth), svo.depth);
+  // Walked from the masks, not derived from the voxels: a solid has nodes that hold only full
+  // leaves.
+  std::vector<std::vector<std::uint64_t>> keys(svo.depth + 1);
+  for (std::uint32_t l = 0; l <= svo.depth; ++l) keys[l] = svo.LevelKeys(l);
   {
     Progress::Stage stage(progress, "bricks", 1);
     report.checks.push_back(CheckBricks(svo, keys));

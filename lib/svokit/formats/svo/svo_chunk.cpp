@@ -550,8 +550,9 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
                                       masks.begin() + static_cast<std::ptrdiff_t>(at + nodes));
     at += nodes;
     std::uint64_t next = 0;
+    // A node without children is a solid's, holding full leaves (checked with the full masks).
     for (const std::uint8_t m : level) {
-      if (m == 0) {
+      if (m == 0 && !shape.solid) {
         return Status::BadInput("{}: a node of level {} has no children", name,
                                 frame.root_level + k);
       }
@@ -579,6 +580,10 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
         if (f[i] & level[i]) {
           return Status::BadInput("{}: a node of level {} has a child that is both full and not",
                                   name, frame.root_level + k);
+        }
+        if ((f[i] | level[i]) == 0) {
+          return Status::BadInput("{}: a node of level {} has no children", name,
+                                  frame.root_level + k);
         }
       }
       from += level.size();
