@@ -64,8 +64,16 @@ int main(int argc, char** argv) {
     const double per_voxel = build.Options().brick_side == 0 ? 48.0 : 100.0;
     const double whole_bytes = may_go_by_pages ? per_voxel * EstimateVoxelCount(*mesh, *grid) : 0.0;
     const std::uint64_t half_machine = app::MachineMemory() / 2;
-    const bool by_pages_by_default =
-        may_go_by_pages && half_machine > 0 && whole_bytes > static_cast<double>(half_machine);
+    // A solid's interior is decided by what the mesh is: exact crossings build by pages too, the
+    // winding numbers of a surface with open edges only whole.
+    StatusOr<std::unique_ptr<InteriorFinder>> finder = std::unique_ptr<InteriorFinder>();
+    if (voxelize.solid()) {
+      finder = InteriorFinder::Create(*mesh, *grid, {}, progress);
+      if (!finder.ok()) return app::Fail(tool, finder.status().WithContext(input.string()));
+    }
+    const bool fills_by_pages = !*finder || (*finder)->method() == FillMethod::kColumns;
+    const bool by_pages_by_default = may_go_by_pages && fills_by_pages && half_machine > 0 &&
+                                     whole_bytes > static_cast<double>(half_machine);
     const auto print_mesh_and_grid = [&] {
       const auto& d = grid->dims();
       fmt::print("mesh        {} ({} triangles)\n", input.string(), mesh->triangle_count());
@@ -73,9 +81,9 @@ int main(int argc, char** argv) {
                  grid->voxel_size(), OctreeDepth(*grid));
     };
     if (!memory_limit.empty() || !pages.empty() || by_pages_by_default) {
-      if (voxelize.solid()) {
-        return app::Fail(tool, Status::BadInput("--fill solid is built whole: a build by pages "
-                                                "(--memory-limit, --pages) does not fill yet"));
+      if (voxelize.solid() && !pages.empty()) {
+        return app::Fail(tool, Status::BadInput("--fill solid is built in one job: parts "
+                                                "(--pages) do not fill"));
       }
       const StatusOr<std::uint64_t> limit =
           by_pages_by_default    ? half_machine
@@ -101,8 +109,10 @@ int main(int argc, char** argv) {
         fmt::print("output      {}\n", output.string());
         return 0;
       }
+      BuildOptions options = build.Options();
+      options.interior_finder = finder->get();
       StatusOr<SvoFileStats> written =
-          BuildSvoByPages(**regions, build.Options(), meta, output, *compression, *limit, progress);
+          BuildSvoByPages(**regions, options, meta, output, *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
       print_mesh_and_grid();
       if (*limit > 0) {
@@ -119,12 +129,15 @@ int main(int argc, char** argv) {
     if (!voxels.ok()) return app::Fail(tool, voxels.status().WithContext(input.string()));
     app::Warn(tool, voxels->warnings);
 
-    StatusOr<InteriorCubes> interior = InteriorCubes{};
+    InteriorCubes interior;
     BuildOptions options = build.Options();
-    if (voxelize.solid()) {
-      interior = FillInterior(*mesh, *grid, voxels->keys, {}, progress);
-      if (!interior.ok()) return app::Fail(tool, interior.status().WithContext(input.string()));
-      options.interior = &*interior;
+    if (*finder) {
+      if (voxels->keys.empty()) {
+        return app::Fail(tool, Status::BadInput("{}: no voxels to fill between", input.string()));
+      }
+      interior =
+          app::RunStage(progress, "solid: interior", [&] { return (*finder)->Fill(voxels->keys); });
+      options.interior = &interior;
     }
     StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), &*mesh, options, meta, progress);
     if (!svo.ok()) return app::Fail(tool, svo.status().WithContext(input.string()));
@@ -134,7 +147,7 @@ int main(int argc, char** argv) {
 
     print_mesh_and_grid();
     fmt::print("voxels      {} ({})\n", svo->voxel_count(), voxelize.ModeName());
-    if (voxelize.solid()) app::PrintInterior(*interior);
+    if (voxelize.solid()) app::PrintInterior(interior);
     app::PrintOctreeSummary(*svo, *written);
     app::PrintTimes(progress);
     fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);

@@ -61,12 +61,6 @@ int main(int argc, char** argv) {
     VfragMetadata source;
     StatusOr<std::optional<InteriorCubes>> interior = ReadVfragInterior(input);
     if (!interior.ok()) return app::Fail(tool, interior.status());
-    if (*interior && !memory_limit.empty()) {
-      return app::Fail(tool, Status::BadInput("{}: a solid is built whole: a build by pages "
-                                              "(--memory-limit) does not fill yet",
-                                              input.string()));
-    }
-    if (*interior) limit = std::uint64_t{0};  // built whole, as above
     std::unique_ptr<VfragCubes> cubes;
     if (*limit > 0) {
       StatusOr<std::unique_ptr<VfragCubes>> opened = app::RunStage(
@@ -101,9 +95,10 @@ int main(int argc, char** argv) {
                             vfrag.cubes(),
                             [&vfrag](const IBox3& box) { return vfrag.Read(box); },
                             vfrag.bytes()};
-      StatusOr<SvoFileStats> written =
-          BuildSvoByPages(paged, mesh ? &*mesh : nullptr, build.Options(), meta, output,
-                          *compression, *limit, progress);
+      BuildOptions options = build.Options();
+      if (*interior) options.interior = &**interior;
+      StatusOr<SvoFileStats> written = BuildSvoByPages(
+          paged, mesh ? &*mesh : nullptr, options, meta, output, *compression, *limit, progress);
       if (!written.ok()) return app::Fail(tool, written.status().WithContext(input.string()));
       fmt::print("input       {} ({} voxels)\n", input.string(), vfrag.voxel_count());
       fmt::print("octree      depth {}, bricks {}, contours {}, by pages {}\n",

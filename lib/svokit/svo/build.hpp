@@ -21,6 +21,9 @@ struct BuildOptions {
   ContourOptions contour;
   /// A solid's interior (FillInterior, same grid): its cubes become full leaves. Null: a surface.
   const InteriorCubes* interior = nullptr;
+  /// A solid built by pages from the mesh: what decides each page's interior (by exact crossings;
+  /// InteriorFinder::method() kColumns). Null: a surface, or `interior` holds it.
+  const InteriorFinder* interior_finder = nullptr;
 };
 
 /// The octree of `voxels`; `mesh` (the surface the voxels came from, in the same world space) is

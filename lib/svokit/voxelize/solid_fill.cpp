@@ -514,6 +514,15 @@ void InteriorFinder::AddCubes(std::span<const std::uint64_t> keys, std::uint32_t
   }
 }
 
+InteriorCubes InteriorFinder::Fill(std::span<const std::uint64_t> surface_keys) const {
+  InteriorCubes interior;
+  interior.depth = depth();
+  interior.method = method();
+  interior.open_edges = open_edges();
+  AddCubes(surface_keys, interior.depth, 0, interior.levels);
+  return interior;
+}
+
 StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid,
                                      std::span<const std::uint64_t> surface_keys,
                                      const FillOptions& options, Progress& progress) {
@@ -522,13 +531,8 @@ StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid
   }
   auto finder = InteriorFinder::Create(mesh, grid, options, progress);
   if (!finder.ok()) return finder.status();
-  InteriorCubes interior;
-  interior.depth = (*finder)->depth();
-  interior.method = (*finder)->method();
-  interior.open_edges = (*finder)->open_edges();
   Progress::Stage stage(progress, "solid: interior", 1);
-  (*finder)->AddCubes(surface_keys, interior.depth, 0, interior.levels);
-  return interior;
+  return (*finder)->Fill(surface_keys);
 }
 
 }  // namespace svokit

@@ -81,6 +81,8 @@ class InteriorFinder {
   /// ascending order. The result for a subtree does not depend on the rest of the tree.
   void AddCubes(std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top,
                 std::vector<std::vector<std::uint64_t>>& cubes) const;
+  /// The whole interior around the surface voxels `surface_keys` (sorted, not empty).
+  InteriorCubes Fill(std::span<const std::uint64_t> surface_keys) const;
 
  private:
   struct Impl;

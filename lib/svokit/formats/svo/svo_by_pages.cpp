@@ -39,13 +39,73 @@ IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
 // on its own pieces alone.
 using TopContours = std::vector<std::map<std::uint64_t, std::uint32_t>>;
 
+// A solid's interior cubes among the free children of the surface nodes `keys` at `level`, at
+// levels `level` down to `top` + 1 (InteriorFinder::AddCubes); empty for a surface.
+using CubesOf = std::function<std::vector<std::vector<std::uint64_t>>(
+    std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top)>;
+
+// A solid's cubes as a build by pages needs them: from the mesh (exact crossings only: the
+// winding numbers may split cubes below the page level outside every page), or cut out of a
+// whole interior read before (a .vfrag's).
+StatusOr<CubesOf> SolidCubes(const BuildOptions& options) {
+  if (options.interior_finder != nullptr) {
+    const InteriorFinder* finder = options.interior_finder;
+    if (finder->method() != FillMethod::kColumns) {
+      return Status::BadInput(
+          "a solid of a surface with open edges is built whole: a build by pages fills closed "
+          "surfaces only");
+    }
+    return CubesOf(
+        [finder](std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top) {
+          std::vector<std::vector<std::uint64_t>> cubes;
+          finder->AddCubes(keys, level, top, cubes);
+          return cubes;
+        });
+  }
+  if (options.interior != nullptr) {
+    const InteriorCubes* interior = options.interior;
+    if (interior->method != FillMethod::kColumns) {
+      return Status::BadInput(
+          "a solid of a surface with open edges is built whole: a build by pages fills closed "
+          "surfaces only");
+    }
+    return CubesOf(
+        [interior](std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top) {
+          // Levels top + 1 .. level of the subtree of keys' ancestor at `top` (all of them at top
+          // 0).
+          std::vector<std::vector<std::uint64_t>> cubes(interior->levels.size());
+          const std::uint64_t root = keys.empty() ? 0 : keys.front() >> (3 * (level - top));
+          for (std::uint32_t l = top + 1; l <= level && l < interior->levels.size(); ++l) {
+            const std::vector<std::uint64_t>& all = interior->levels[l];
+            const std::uint32_t shift = 3 * (l - top);
+            const auto first = std::lower_bound(all.begin(), all.end(), root << shift);
+            const auto last =
+                top == 0 ? all.end() : std::lower_bound(first, all.end(), (root + 1) << shift);
+            cubes[l].assign(first, last);
+          }
+          return cubes;
+        });
+  }
+  return CubesOf{};
+}
+
 // The top chunk of the pages with these root keys: masks, the contours `words` gives, and with
 // bricks (side ≠ 0) the samples filtered from the bricks of the pages' roots.
-SvoChunk TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
-                    const TopContours* words, std::uint32_t side, const LevelSamples& roots) {
+StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
+                              const TopContours* words, std::uint32_t side,
+                              const LevelSamples& roots, const CubesOf& cubes) {
   const std::vector<std::vector<std::uint64_t>> level_keys = LevelKeysFromVoxels(keys, page_level);
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
+  if (cubes && page_level > 0) {
+    InteriorCubes interior;
+    interior.depth = page_level;
+    interior.levels = cubes(keys, page_level, 0);
+    interior.levels.resize(page_level + 1);
+    auto full = FullMasks(level_keys, top.tree, interior);
+    if (!full.ok()) return full.status();
+    top.tree.full = std::move(*full);
+  }
   top.contours.assign(page_level, {});
   if (words != nullptr) {
     for (std::uint32_t l = 0; l < page_level; ++l) {
@@ -149,6 +209,7 @@ class PagePlan {
         voxelizer.shared_color() ? std::optional<HalfRgba>(HalfRgba(*voxelizer.shared_color()))
                                  : std::nullopt));
     plan->mesh_ = &voxelizer.mesh();
+    SVOKIT_RETURN_IF_ERROR(plan->SetSolid(options));
     if (options.contours) {
       plan->contours_.emplace(voxelizer.mesh(), plan->frame_.grid, plan->frame_.depth,
                               options.contour);
@@ -177,6 +238,7 @@ class PagePlan {
                                                 voxels.colors, voxels.normals,
                                                 voxels.shared_color));
     plan->mesh_ = mesh;
+    SVOKIT_RETURN_IF_ERROR(plan->SetSolid(options));
     std::uint64_t fixed = voxels.bytes;
     if (options.contours) {
       if (mesh == nullptr) return Status::BadInput("contours need the mesh");
@@ -206,6 +268,7 @@ class PagePlan {
   }
 
   const SvoFrame& frame() const { return frame_; }
+  const CubesOf& cubes() const { return cubes_; }
   std::uint32_t page_level() const { return page_level_; }
   const RegionVoxelizer::Bins& bins() const { return bins_; }
   std::span<const std::uint64_t> cells() const { return cells_; }
@@ -284,7 +347,17 @@ class PagePlan {
     // The halo: the voxels a page's voxel bricks read, one around it; with bricks of side 2 the
     // samples of its faces above the voxels read one more.
     grow_ = options.brick_side == 2 ? 2 : 1;
-    page_options_.contours = false;  // fitted from each page's triangles instead
+    page_options_.contours = false;    // fitted from each page's triangles instead
+    page_options_.interior = nullptr;  // each page's own, from cubes_
+    page_options_.interior_finder = nullptr;
+  }
+
+  Status SetSolid(const BuildOptions& options) {
+    StatusOr<CubesOf> cubes = SolidCubes(options);
+    if (!cubes.ok()) return cubes.status();
+    cubes_ = std::move(*cubes);
+    frame_.shape.solid = static_cast<bool>(cubes_);
+    return Status::Ok();
   }
 
   // How many pages may be in flight: held whatever the page, `fixed` bytes (the snapped mesh
@@ -319,7 +392,18 @@ class PagePlan {
     const std::uint64_t first = cell << (3 * bits_), last = (cell + 1) << (3 * bits_);
     const auto begin = std::lower_bound(voxels->keys.begin(), voxels->keys.end(), first);
     if (begin == voxels->keys.end() || *begin >= last) return Status::Ok();
-    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), nullptr, page_options_);
+    // A solid page's interior: the free children of its own nodes, below its root.
+    InteriorCubes interior;
+    BuildOptions options = page_options_;
+    if (cubes_) {
+      const auto end = std::lower_bound(begin, voxels->keys.end(), last);
+      interior.depth = frame_.depth;
+      interior.levels =
+          cubes_(std::span<const std::uint64_t>(&*begin, end - begin), frame_.depth, page_level_);
+      interior.levels.resize(frame_.depth + 1);
+      options.interior = &interior;
+    }
+    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), nullptr, options);
     if (!svo.ok()) return svo.status();
     const std::vector<std::uint64_t> keys = svo_detail::KeysOfLevel(svo->tree, page_level_);
     const std::size_t at =
@@ -345,6 +429,7 @@ class PagePlan {
   std::span<const std::uint64_t> cells_;
   std::function<StatusOr<VoxelSet>(std::size_t cell, const IBox3& box)> read_;
   std::function<std::span<const std::uint32_t>(std::size_t cell)> triangles_;
+  CubesOf cubes_;
   std::size_t in_flight_ = 1;
 };
 
@@ -385,7 +470,7 @@ StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options
               progress);
         },
         [&](std::span<const std::uint64_t> keys) {
-          return TopOfPages(keys, p.page_level(), top_words, 0, {});
+          return TopOfPages(keys, p.page_level(), top_words, 0, {}, p.cubes());
         });
   }
   // With bricks, two passes: the pages built alone and their shells go to a scratch file; then
@@ -421,7 +506,7 @@ StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options
         return p.Finish(writer, built, take, roots, progress);
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, p.page_level(), top_words, options.brick_side, roots);
+        return TopOfPages(keys, p.page_level(), top_words, options.brick_side, roots, p.cubes());
       });
 }
 
@@ -458,6 +543,10 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
   if (part.parts == 0 || part.part >= part.parts) {
     return Status::BadInput("part {} of {} does not exist (parts are 0 .. N − 1)", part.part,
                             part.parts);
+  }
+  if (options.interior != nullptr || options.interior_finder != nullptr) {
+    // The top levels' full leaves depend on the pages of every part, which merging cannot see.
+    return Status::BadInput("a solid is built in one job: parts (--pages) do not fill");
   }
   StatusOr<std::unique_ptr<PagePlan>> plan =
       PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
@@ -730,7 +819,7 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
           return FinishPages(head.frame, writer, built, MostInFlight(), take, roots, progress);
         },
         [&](std::span<const std::uint64_t> keys) {
-          return TopOfPages(keys, PageLevel(head.frame.depth), top_words, side, roots);
+          return TopOfPages(keys, PageLevel(head.frame.depth), top_words, side, roots, {});
         });
   }
   Progress::Stage stage(progress, "merge", parts.size());
@@ -755,7 +844,7 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
         return Status::Ok();
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, PageLevel(head.frame.depth), top_words, 0, roots);
+        return TopOfPages(keys, PageLevel(head.frame.depth), top_words, 0, roots, {});
       });
 }
 

@@ -93,7 +93,7 @@ class PagedSvoWriter {
   using Take = std::function<Status(EncodedPage)>;
   using PageSource = std::function<Status(const Take& take)>;
   /// The top chunk (levels 0 .. page level − 1) of the pages with these root keys.
-  using TopMaker = std::function<SvoChunk(std::span<const std::uint64_t> page_keys)>;
+  using TopMaker = std::function<StatusOr<SvoChunk>(std::span<const std::uint64_t> page_keys)>;
 
   StatusOr<SvoFileStats> Write(const std::filesystem::path& path, PageSource pages, TopMaker top);
   std::vector<std::uint8_t> Serialize(PageSource pages, TopMaker top, SvoFileStats* stats);

@@ -119,9 +119,10 @@ Status PagedSvoWriter::ProducePages(const container::Writer::Emit& emit) {
 Status PagedSvoWriter::Finish() {
   if (keys_.empty()) return Status::BadInput("the octree has no voxels");
   if (page_level_ > 0) {
-    const SvoChunk top = top_maker_(keys_);
-    top_ = EncodeChunk(top, frame_.shape, compression_, &top_stats_);
-    for (std::uint32_t l = 0; l < page_level_; ++l) levels_[l] = ChunkLevelCounts(top, l);
+    const StatusOr<SvoChunk> top = top_maker_(keys_);
+    if (!top.ok()) return top.status();
+    top_ = EncodeChunk(*top, frame_.shape, compression_, &top_stats_);
+    for (std::uint32_t l = 0; l < page_level_; ++l) levels_[l] = ChunkLevelCounts(*top, l);
   }
   ByteWriter head;
   const SvoShape& shape = frame_.shape;
@@ -486,15 +487,19 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
   PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
   return writer.Serialize(
       svo_detail::PagesOf(svo, writer),
-      [&](std::span<const std::uint64_t>) { return TopChunk(svo, writer.page_level()); }, stats);
+      [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
+        return TopChunk(svo, writer.page_level());
+      },
+      stats);
 }
 
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
                                 const SvoCompression& compression) {
   PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
-  return writer.Write(path, svo_detail::PagesOf(svo, writer), [&](std::span<const std::uint64_t>) {
-    return TopChunk(svo, writer.page_level());
-  });
+  return writer.Write(path, svo_detail::PagesOf(svo, writer),
+                      [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
+                        return TopChunk(svo, writer.page_level());
+                      });
 }
 
 }  // namespace svokit
