@@ -5,7 +5,6 @@
 
 #include "apps/app.hpp"
 #include "apps/chain_options.hpp"
-#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/voxel_writers.hpp"
 #include "svokit/formats/mesh_import.hpp"
@@ -103,15 +102,13 @@ int main(int argc, char** argv) {
       app::Warn(tool, voxels->attributes.warnings);
       voxel_count = voxels->count;
       if (voxelize.solid()) {
-        // The interior is found around the surface's keys, read back from the file's own bytes.
-        std::vector<std::uint64_t> keys;
-        const std::span<const std::uint8_t> gaps = file.KeyGaps(*voxels);
-        const std::uint8_t* p = gaps.data();
-        bool not_increasing = false;
-        ReadKeyGaps(p, p + gaps.size(), voxels->count, kNoPreviousKey, keys, &not_increasing);
-        StatusOr<InteriorCubes> cubes = FillInterior(*mesh, *grid, keys, {}, progress);
-        if (!cubes.ok()) return app::Fail(tool, cubes.status().WithContext(input.string()));
-        interior = std::move(*cubes);
+        // The interior is found around the surface's keys, read once from the file's own bytes.
+        StatusOr<std::unique_ptr<InteriorFinder>> finder =
+            InteriorFinder::Create(*mesh, *grid, {}, progress);
+        if (!finder.ok()) return app::Fail(tool, finder.status().WithContext(input.string()));
+        interior = app::RunStage(progress, "solid: interior", [&] {
+          return (*finder)->Fill(file.KeyGaps(*voxels), voxels->count);
+        });
       }
       written = app::RunStage(
           progress, "write", [&] { return file.Commit(*voxels, interior ? &*interior : nullptr); });

@@ -93,6 +93,9 @@ Status WriteVoxelsBinvox(const VoxelSet& voxels, const InteriorCubes* interior,
     std::uint64_t end = runs[i].first + runs[i].second;
     std::size_t j = i + 1;
     for (; j < runs.size() && runs[j].first == end; ++j) end += runs[j].second;
+    if (runs[i].first < next) {
+      return Status::Internal("{}: interior cubes overlap other voxels", path.string());
+    }
     run(0, runs[i].first - next);
     run(1, end - runs[i].first);
     next = end;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -10,6 +11,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/voxelize/triangle_voxelizer.hpp"
@@ -143,6 +145,8 @@ void RasterizeColumns(const FixedPoint3& a, const FixedPoint3& b, const FixedPoi
   }
 }
 
+constexpr auto kRelaxed = std::memory_order_relaxed;
+
 // Every column's crossings, sorted: the integer winding number at any voxel centre of a cycle.
 class ColumnCrossings {
  public:
@@ -167,19 +171,25 @@ class ColumnCrossings {
     std::uint64_t total = 0;
     for (const auto& part : parts) total += part.size();
     if (total > std::numeric_limits<std::uint32_t>::max()) return;  // too_many()
+    // Counts, their running sums (each column's end), then each crossing placed below its
+    // column's end: the ends become the starts, with no second array. In parallel: a column's
+    // crossings land in any order, and are sorted after.
     offsets_.assign(columns + 1, 0);
-    for (const auto& part : parts) {
-      for (const std::uint64_t entry : part) ++offsets_[(entry >> 32) + 1];
-    }
+    const auto at = [this](std::uint64_t column) {
+      return std::atomic_ref<std::uint32_t>(offsets_[column]);
+    };
+    tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t k) {
+      for (const std::uint64_t entry : parts[k]) at(entry >> 32).fetch_add(1, kRelaxed);
+    });
     std::partial_sum(offsets_.begin(), offsets_.end(), offsets_.begin());
     crossings_.resize(offsets_.back());
-    std::vector<std::uint32_t> cursor(offsets_.begin(), offsets_.end() - 1);
-    for (auto& part : parts) {
-      for (const std::uint64_t entry : part) {
-        crossings_[cursor[entry >> 32]++] = static_cast<Crossing>(entry & 0xffffffffu);
+    tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t k) {
+      for (const std::uint64_t entry : parts[k]) {
+        crossings_[at(entry >> 32).fetch_sub(1, kRelaxed) - 1] =
+            static_cast<Crossing>(entry & 0xffffffffu);
       }
-      std::vector<std::uint64_t>().swap(part);
-    }
+      std::vector<std::uint64_t>().swap(parts[k]);
+    });
     ParallelChunks(columns, 1 << 14, [&](std::size_t begin, std::size_t end) {
       for (std::size_t c = begin; c < end; ++c) {
         std::sort(crossings_.begin() + static_cast<std::ptrdiff_t>(offsets_[c]),
@@ -291,43 +301,78 @@ struct CubeAt {
   std::uint64_t key;
 };
 
-// Calls decide(level, parent, free, out) for every node whose children at `level` are `keys`, with
-// the mask of its free children, in parallel chunks (out: per level, in order); returns the
-// parents' keys.
-template <class Decide>
-std::vector<std::uint64_t> FreeChildren(std::span<const std::uint64_t> keys, std::uint32_t level,
-                                        std::vector<std::vector<std::vector<std::uint64_t>>>& out,
-                                        const Decide& decide) {
+// The nodes one level up from sorted keys, each with the mask of its children among them.
+struct Groups {
+  std::vector<std::uint64_t> parents;
+  std::vector<std::uint8_t> masks;
+};
+
+Groups GroupByParent(std::span<const std::uint64_t> keys) {
   constexpr std::size_t kChunk = 1 << 16;
   const std::size_t chunks = (keys.size() + kChunk - 1) / kChunk;
-  std::vector<std::vector<std::uint64_t>> parents(chunks);
-  std::vector<std::vector<std::vector<std::uint64_t>>> found(chunks);
   // A chunk starts at the first key of a parent at or after its nominal start.
   const auto group_start = [&](std::size_t i) {
     while (i > 0 && i < keys.size() && keys[i] >> 3 == keys[i - 1] >> 3) ++i;
     return std::min(i, keys.size());
   };
+  std::vector<Groups> parts(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
     std::size_t i = group_start(chunk * kChunk);
     const std::size_t end = group_start(std::min(keys.size(), (chunk + 1) * kChunk));
-    auto& levels = found[chunk];
-    levels.resize(out.size());
+    Groups& g = parts[chunk];
     while (i < end) {
       const std::uint64_t parent = keys[i] >> 3;
       unsigned mask = 0;
       for (; i < keys.size() && keys[i] >> 3 == parent; ++i) mask |= 1u << (keys[i] & 7);
-      parents[chunk].push_back(parent);
-      decide(level, parent, ~mask & 0xffu, levels);
+      g.parents.push_back(parent);
+      g.masks.push_back(static_cast<std::uint8_t>(mask));
     }
   });
-  std::vector<std::uint64_t> above;
-  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-    above.insert(above.end(), parents[chunk].begin(), parents[chunk].end());
-    for (std::size_t l = 0; l < out.size(); ++l) {
-      if (!found[chunk].empty()) out[l].push_back(std::move(found[chunk][l]));
-    }
+  Groups all;
+  for (Groups& g : parts) {
+    all.parents.insert(all.parents.end(), g.parents.begin(), g.parents.end());
+    all.masks.insert(all.masks.end(), g.masks.begin(), g.masks.end());
   }
-  return above;
+  return all;
+}
+
+// The same from keys stored as varint gaps (a .vfrag's), read once: the voxels' keys are never
+// held, only their parents.
+Groups GroupByParent(std::span<const std::uint8_t> gaps, std::uint64_t count) {
+  Groups g;
+  const std::uint8_t* p = gaps.data();
+  const std::uint8_t* end = p + gaps.size();
+  std::uint64_t key = kNoPreviousKey, gap = 0;
+  for (std::uint64_t i = 0; i < count && GetVarint(p, end, gap); ++i) {
+    key += gap + 1;
+    if (g.parents.empty() || g.parents.back() != key >> 3) {
+      g.parents.push_back(key >> 3);
+      g.masks.push_back(0);
+    }
+    g.masks.back() = static_cast<std::uint8_t>(g.masks.back() | 1u << (key & 7));
+  }
+  return g;
+}
+
+// Calls decide(level, parent, free, out) for every group, with the mask of its free children at
+// `level`, in parallel chunks (out: per level, in order).
+template <class Decide>
+void DecideFreeChildren(const Groups& groups, std::uint32_t level,
+                        std::vector<std::vector<std::vector<std::uint64_t>>>& out,
+                        const Decide& decide) {
+  constexpr std::size_t kChunk = 1 << 14;
+  const std::size_t chunks = (groups.parents.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<std::vector<std::uint64_t>>> found(chunks);
+  ParallelChunks(groups.parents.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    auto& levels = found[begin / kChunk];
+    levels.resize(out.size());
+    for (std::size_t i = begin; i < end; ++i) {
+      decide(level, groups.parents[i], ~unsigned{groups.masks[i]} & 0xffu, levels);
+    }
+  });
+  for (auto& levels : found) {
+    for (std::size_t l = 0; l < out.size(); ++l) out[l].push_back(std::move(levels[l]));
+  }
 }
 
 }  // namespace
@@ -414,6 +459,10 @@ struct InteriorFinder::Impl {
     }
   }
 
+  // The cubes among the free children of `groups` (nodes of level − 1) down to level top + 1.
+  void AddCubes(Groups groups, std::uint32_t level, std::uint32_t top,
+                std::vector<std::vector<std::uint64_t>>& cubes) const;
+
   // Elsewhere a free cube is told from its centre when it can be, else split.
   void DecideByWinding(std::uint32_t level, std::uint64_t key,
                        std::vector<std::vector<std::uint64_t>>& out) const {
@@ -478,25 +527,35 @@ std::uint32_t InteriorFinder::depth() const {
 void InteriorFinder::AddCubes(std::span<const std::uint64_t> keys, std::uint32_t level,
                               std::uint32_t top,
                               std::vector<std::vector<std::uint64_t>>& cubes) const {
-  const Impl& impl = *impl_;
+  if (level > top) impl_->AddCubes(GroupByParent(keys), level, top, cubes);
+}
+
+void InteriorFinder::AddCubes(std::span<const std::uint8_t> key_gaps, std::uint64_t count,
+                              std::uint32_t level, std::uint32_t top,
+                              std::vector<std::vector<std::uint64_t>>& cubes) const {
+  if (level > top) impl_->AddCubes(GroupByParent(key_gaps, count), level, top, cubes);
+}
+
+void InteriorFinder::Impl::AddCubes(Groups groups, std::uint32_t level, std::uint32_t top,
+                                    std::vector<std::vector<std::uint64_t>>& cubes) const {
+  const Impl& impl = *this;
   cubes.resize(impl.depth + 1);
   std::vector<std::vector<std::vector<std::uint64_t>>> parts(impl.depth + 1);
-  std::vector<std::uint64_t> above;
   for (; level > top; --level) {
-    std::vector<std::uint64_t> parents =
-        impl.method == FillMethod::kColumns
-            ? FreeChildren(keys, level, parts,
-                           [&](std::uint32_t l, std::uint64_t parent, unsigned free, auto& out) {
-                             impl.DecideByColumns(l, parent, free, out);
-                           })
-            : FreeChildren(keys, level, parts,
-                           [&](std::uint32_t l, std::uint64_t parent, unsigned free, auto& out) {
-                             for (unsigned c = 0; c < 8; ++c) {
-                               if (free >> c & 1u) impl.DecideByWinding(l, parent << 3 | c, out);
-                             }
-                           });
-    above = std::move(parents);
-    keys = above;
+    if (impl.method == FillMethod::kColumns) {
+      DecideFreeChildren(groups, level, parts,
+                         [&](std::uint32_t l, std::uint64_t parent, unsigned free, auto& out) {
+                           impl.DecideByColumns(l, parent, free, out);
+                         });
+    } else {
+      DecideFreeChildren(groups, level, parts,
+                         [&](std::uint32_t l, std::uint64_t parent, unsigned free, auto& out) {
+                           for (unsigned c = 0; c < 8; ++c) {
+                             if (free >> c & 1u) impl.DecideByWinding(l, parent << 3 | c, out);
+                           }
+                         });
+    }
+    if (level - 1 > top) groups = GroupByParent(groups.parents);
   }
   for (std::uint32_t l = 0; l <= impl.depth; ++l) {
     std::vector<std::uint64_t>& level_cubes = cubes[l];
@@ -515,11 +574,24 @@ void InteriorFinder::AddCubes(std::span<const std::uint64_t> keys, std::uint32_t
 }
 
 InteriorCubes InteriorFinder::Fill(std::span<const std::uint64_t> surface_keys) const {
+  InteriorCubes interior = Empty();
+  AddCubes(surface_keys, interior.depth, 0, interior.levels);
+  return interior;
+}
+
+InteriorCubes InteriorFinder::Fill(std::span<const std::uint8_t> key_gaps,
+                                   std::uint64_t count) const {
+  InteriorCubes interior = Empty();
+  AddCubes(key_gaps, count, interior.depth, 0, interior.levels);
+  return interior;
+}
+
+InteriorCubes InteriorFinder::Empty() const {
   InteriorCubes interior;
   interior.depth = depth();
   interior.method = method();
   interior.open_edges = open_edges();
-  AddCubes(surface_keys, interior.depth, 0, interior.levels);
+  interior.levels.resize(depth() + 1);
   return interior;
 }
 

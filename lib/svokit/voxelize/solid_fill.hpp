@@ -81,12 +81,18 @@ class InteriorFinder {
   /// ascending order. The result for a subtree does not depend on the rest of the tree.
   void AddCubes(std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top,
                 std::vector<std::vector<std::uint64_t>>& cubes) const;
-  /// The whole interior around the surface voxels `surface_keys` (sorted, not empty).
+  /// The same with the keys as varint gaps (core/key_gaps.hpp, a .vfrag's `KEYS`), read once.
+  void AddCubes(std::span<const std::uint8_t> key_gaps, std::uint64_t count, std::uint32_t level,
+                std::uint32_t top, std::vector<std::vector<std::uint64_t>>& cubes) const;
+  /// The whole interior around the surface voxels `surface_keys` (sorted, not empty), or around
+  /// `count` keys stored as varint gaps.
   InteriorCubes Fill(std::span<const std::uint64_t> surface_keys) const;
+  InteriorCubes Fill(std::span<const std::uint8_t> key_gaps, std::uint64_t count) const;
 
  private:
   struct Impl;
   explicit InteriorFinder(std::unique_ptr<Impl> impl);
+  InteriorCubes Empty() const;
   std::unique_ptr<Impl> impl_;
 };
 
