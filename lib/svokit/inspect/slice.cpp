@@ -99,8 +99,8 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
                             scale);
   }
   RgbaImage image(static_cast<int>(cols) * scale, static_cast<int>(rows) * scale);
-  const auto put = [&](const std::array<std::uint32_t, 3>& ijk, std::uint64_t node) {
-    const std::array<std::uint8_t, 3> rgb = NodeColor(svo, level, node);
+  const auto paint = [&](const std::array<std::uint32_t, 3>& ijk, const std::uint8_t* rgb) {
+    if (ijk[col_axis] >= cols || ijk[row_axis] >= rows) return;
     const std::uint32_t col = ijk[col_axis];
     const std::uint32_t row = flip_rows ? rows - 1 - ijk[row_axis] : ijk[row_axis];
     for (int dy = 0; dy < scale; ++dy) {
@@ -111,6 +111,24 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
         px[1] = rgb[1];
         px[2] = rgb[2];
         px[3] = 255;
+      }
+    }
+  };
+  const auto put = [&](const std::array<std::uint32_t, 3>& ijk, std::uint64_t node) {
+    const std::array<std::uint8_t, 3> rgb = NodeColor(svo, level, node);
+    paint(ijk, rgb.data());
+  };
+  // A full leaf of level l crossing the slice: its square of cells at the slice level.
+  const auto put_full = [&](std::uint32_t l, const std::array<std::uint32_t, 3>& ijk) {
+    const std::uint32_t side = 1u << (level - l);
+    std::array<std::uint32_t, 3> cell{ijk[0] * side, ijk[1] * side, ijk[2] * side};
+    cell[slice.axis] = slice.index;
+    const std::uint32_t col0 = cell[col_axis], row0 = cell[row_axis];
+    for (std::uint32_t r = 0; r < side && row0 + r < rows; ++r) {
+      for (std::uint32_t c = 0; c < side && col0 + c < cols; ++c) {
+        cell[col_axis] = col0 + c;
+        cell[row_axis] = row0 + r;
+        paint(cell, kSliceInterior);
       }
     }
   };
@@ -131,7 +149,12 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
     const SvoNode& n = svo.levels[f.level].nodes[f.node];
     const unsigned bit = slice.index >> (level - f.level - 1) & 1;
     for (unsigned c = 0; c < 8; ++c) {
-      if (!(n.child_mask >> c & 1) || (c >> slice.axis & 1) != bit) continue;
+      if ((c >> slice.axis & 1) != bit) continue;
+      if (n.full_mask >> c & 1) {
+        put_full(f.level + 1, {f.ijk[0] * 2 + (c & 1), f.ijk[1] * 2 + (c >> 1 & 1),
+                               f.ijk[2] * 2 + (c >> 2 & 1)});
+      }
+      if (!(n.child_mask >> c & 1)) continue;
       stack.push_back(
           {f.level + 1,
            n.Child(c),

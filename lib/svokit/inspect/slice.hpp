@@ -2,7 +2,7 @@
 // One axis-aligned slice of the octree's grid as a picture: a cell per node of the chosen level
 // (the voxels by default) whose index along the axis is K; occupied cells show the node's colour
 // (its brick's centre sample, or the opacity-weighted mean of the corners of a 2³ brick; a fixed
-// orange without colour), empty cells are transparent.
+// orange without colour), a solid's interior a fixed blue, empty cells are transparent.
 //
 // Orientation, as the views of ray_cast.hpp see the grid: z=K as from the front (x right, y up),
 // x=K as from the left (z right, y up), y=K as from the top (x right, z down).
@@ -34,6 +34,8 @@ struct SliceOptions {
 
 /// The cell colour used for occupied nodes of an octree without colour (sRGB).
 inline constexpr std::uint8_t kSliceOccupied[3] = {230, 150, 40};
+/// The cell colour of a solid's interior (full leaves, `--fill solid`): they have no colour.
+inline constexpr std::uint8_t kSliceInterior[3] = {70, 110, 170};
 
 /// Bad input: an index outside the grid at that level, a level beyond the loaded ones.
 StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,

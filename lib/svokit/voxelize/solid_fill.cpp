@@ -234,9 +234,11 @@ class WindingDecider {
         fast_(positions_, triangles_, accuracy) {
     edges_.reserve(open_edges.size());
     for (const OpenEdge& e : open_edges) {
-      edges_.push_back(
-          {positions_[e.a], positions_[e.b], static_cast<double>(std::llabs(e.multiplicity))});
+      edges_.push_back({positions_[e.a], positions_[e.b], static_cast<double>(e.multiplicity)});
     }
+    order_.resize(edges_.size());
+    std::iota(order_.begin(), order_.end(), 0u);
+    if (!edges_.empty()) BuildEdgeTree(0, static_cast<std::uint32_t>(edges_.size()));
   }
 
   /// Whether the centre p of a voxel is inside: |w| ≥ ½, the exact sum where the fast one is
@@ -254,16 +256,43 @@ class WindingDecider {
     const double w = fast_(c);
     const double margin = ThresholdMargin(w) - kFastError;
     if (margin <= 0) return 0;
-    // |∇w(x)| ≤ (1/4π) Σ_e m_e ∫_e dl / |x − l|² over the open edges (Biot–Savart): bound it over
-    // the ball by each edge's distance from c less h.
-    double change = 0;
-    for (const Edge& e : edges_) {
-      const double d = DistanceToSegment(c, e.a, e.b) - h;
-      if (d <= 0) return 0;
-      change += h * e.multiplicity * Length(e.b - e.a) / (4 * std::numbers::pi * d * d);
-      if (change >= margin) return 0;
+    return GradientBound(c, h) * h < margin ? (std::abs(w) >= 0.5 ? 1 : -1) : 0;
+  }
+
+  /// A bound on |∇w| over the ball (c, h), which no triangle meets. Off the surface ∇w is the
+  /// Biot–Savart field of the open edges, (1/4π) Σ m ∫ dl × r / |r|³: near edges count one by
+  /// one (∫ dl / |r|²), a far cluster as its net current S = Σ m (b − a) at its centre plus what
+  /// its spread ρ can change, |S|/D² + 2ρL/(D − ρ)³ (L = Σ |m| length), or L/(D − ρ)² if less:
+  /// loops far away add almost nothing. Infinite when an edge meets the ball.
+  double GradientBound(const Vec3d& c, double h) const {
+    if (edge_nodes_.empty()) return 0;
+    constexpr double kInv4Pi = 1 / (4 * std::numbers::pi);
+    double bound = 0;
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const EdgeNode& node = edge_nodes_[stack[--top]];
+      const double d = Length(node.centre - c) - h;  // from the ball to the cluster's centre
+      if (d > 8 * node.radius) {
+        // Also at most its length at the nearest distance: whichever is smaller.
+        const double spread = d - node.radius;
+        bound += kInv4Pi * std::min(node.length / (spread * spread),
+                                    Length(node.current) / (d * d) +
+                                        2 * node.radius * node.length / (spread * spread * spread));
+      } else if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          const Edge& e = edges_[order_[i]];
+          const double de = DistanceToSegment(c, e.a, e.b) - h;
+          if (de <= 0) return std::numeric_limits<double>::infinity();
+          bound += kInv4Pi * std::abs(e.multiplicity) * Length(e.b - e.a) / (de * de);
+        }
+      } else {
+        stack[top++] = node.children[1];
+        stack[top++] = node.children[0];
+      }
     }
-    return std::abs(w) >= 0.5 ? 1 : -1;
+    return bound;
   }
 
  private:
@@ -271,8 +300,59 @@ class WindingDecider {
   static constexpr double kFastError = 0.05;
   struct Edge {
     Vec3d a, b;
-    double multiplicity;
+    double multiplicity;  // signed: traversals a → b less b → a
   };
+  // A cluster of open edges: a ball holding them, their net current and total weighted length.
+  struct EdgeNode {
+    Vec3d centre{0, 0, 0}, current{0, 0, 0};
+    double radius = 0, length = 0;
+    std::uint32_t first = 0, count = 0;  // a leaf's edges: order_[first, first + count)
+    std::uint32_t children[2] = {0, 0};
+  };
+
+  std::uint32_t BuildEdgeTree(std::uint32_t first, std::uint32_t count) {
+    const auto index = static_cast<std::uint32_t>(edge_nodes_.size());
+    edge_nodes_.emplace_back();
+    EdgeNode node;
+    Vec3d lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+    for (std::uint32_t i = first; i < first + count; ++i) {
+      const Edge& e = edges_[order_[i]];
+      for (const Vec3d& p : {e.a, e.b}) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+      node.current = node.current + (e.b - e.a) * e.multiplicity;
+      node.length += std::abs(e.multiplicity) * Length(e.b - e.a);
+    }
+    node.centre = (lo + hi) * 0.5;
+    for (std::uint32_t i = first; i < first + count; ++i) {
+      const Edge& e = edges_[order_[i]];
+      node.radius = std::max({node.radius, Length(e.a - node.centre), Length(e.b - node.centre)});
+    }
+    if (count <= 4) {
+      node.first = first;
+      node.count = count;
+      edge_nodes_[index] = node;
+      return index;
+    }
+    // Median split of the midpoints along the box's longest axis, ties by index.
+    const Vec3d extent = hi - lo;
+    const int axis =
+        extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const auto key = [&](std::uint32_t i) {
+      const Vec3d m = (edges_[i].a + edges_[i].b) * 0.5;
+      return axis == 0 ? m.x : (axis == 1 ? m.y : m.z);
+    };
+    const auto begin = order_.begin() + first;
+    std::nth_element(begin, begin + count / 2, begin + count,
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       return key(a) < key(b) || (key(a) == key(b) && a < b);
+                     });
+    node.children[0] = BuildEdgeTree(first, count / 2);
+    node.children[1] = BuildEdgeTree(first + count / 2, count - count / 2);
+    edge_nodes_[index] = node;
+    return index;
+  }
 
   static double ThresholdMargin(double w) { return std::min(std::abs(w - 0.5), std::abs(w + 0.5)); }
   static double DistanceToSegment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
@@ -291,6 +371,8 @@ class WindingDecider {
   std::vector<Triangle> triangles_;
   FastWindingNumber fast_;
   std::vector<Edge> edges_;
+  std::vector<std::uint32_t> order_;
+  std::vector<EdgeNode> edge_nodes_;
 };
 
 // ---------------------------------------------------------------------------------------------
