@@ -61,6 +61,12 @@ int main(int argc, char** argv) {
     VfragMetadata source;
     StatusOr<std::optional<InteriorCubes>> interior = ReadVfragInterior(input);
     if (!interior.ok()) return app::Fail(tool, interior.status());
+    // An open surface's solid builds whole (its winding numbers may split cubes below empty
+    // pages): by pages only when asked, which then fails with the reason.
+    if (by_default && *interior && (*interior)->method != FillMethod::kColumns) {
+      by_default = false;
+      limit = std::uint64_t{0};
+    }
     std::unique_ptr<VfragCubes> cubes;
     if (*limit > 0) {
       StatusOr<std::unique_ptr<VfragCubes>> opened = app::RunStage(

@@ -91,7 +91,10 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
   {
     Progress::Stage stage(progress, "octree", 1);
     keys = LevelKeysFromVoxels(std::move(voxels.keys), svo.depth);
-    if (options.interior != nullptr) AddSplitNodes(*options.interior, keys);
+    // Only the winding numbers split cubes; crossings' cubes are free children of the surface.
+    if (options.interior != nullptr && options.interior->method == FillMethod::kWindingNumber) {
+      AddSplitNodes(*options.interior, keys);
+    }
     svo.tree = MaskTreeFromKeys(keys);
     if (options.interior != nullptr) {
       auto full = FullMasks(keys, svo.tree, *options.interior);

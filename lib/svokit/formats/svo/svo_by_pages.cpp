@@ -47,7 +47,7 @@ using CubesOf = std::function<std::vector<std::vector<std::uint64_t>>(
 // A solid's cubes as a build by pages needs them: from the mesh (exact crossings only: the
 // winding numbers may split cubes below the page level outside every page), or cut out of a
 // whole interior read before (a .vfrag's).
-StatusOr<CubesOf> SolidCubes(const BuildOptions& options) {
+StatusOr<CubesOf> SolidCubes(const BuildOptions& options, std::span<const std::uint64_t> pages) {
   if (options.interior_finder != nullptr) {
     const InteriorFinder* finder = options.interior_finder;
     if (finder->method() != FillMethod::kColumns) {
@@ -68,6 +68,17 @@ StatusOr<CubesOf> SolidCubes(const BuildOptions& options) {
       return Status::BadInput(
           "a solid of a surface with open edges is built whole: a build by pages fills closed "
           "surfaces only");
+    }
+    // Every cube below the page level must lie in a page, that is in a cube holding voxels.
+    const std::uint32_t page_level = PageLevel(interior->depth);
+    for (std::uint32_t l = page_level + 1; l < interior->levels.size(); ++l) {
+      for (const std::uint64_t cube : interior->levels[l]) {
+        const std::uint64_t page = cube >> (3 * (l - page_level));
+        if (!std::binary_search(pages.begin(), pages.end(), page)) {
+          return Status::BadInput(
+              "interior cube {} of level {} is not a free child of a node of the surface", cube, l);
+        }
+      }
     }
     return CubesOf(
         [interior](std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top) {
@@ -238,7 +249,6 @@ class PagePlan {
                                                 voxels.colors, voxels.normals,
                                                 voxels.shared_color));
     plan->mesh_ = mesh;
-    SVOKIT_RETURN_IF_ERROR(plan->SetSolid(options));
     std::uint64_t fixed = voxels.bytes;
     if (options.contours) {
       if (mesh == nullptr) return Status::BadInput("contours need the mesh");
@@ -253,6 +263,7 @@ class PagePlan {
       fixed += (*regions)->bytes() + plan->bins_.bytes();
     }
     plan->cells_ = voxels.cubes;
+    SVOKIT_RETURN_IF_ERROR(plan->SetSolid(options));
     const RegionVoxelizer::Bins& bins = plan->bins_;
     const std::span<const std::uint64_t> cells = plan->cells_;
     plan->read_ = [&voxels](std::size_t, const IBox3& box) { return voxels.read(box); };
@@ -353,7 +364,7 @@ class PagePlan {
   }
 
   Status SetSolid(const BuildOptions& options) {
-    StatusOr<CubesOf> cubes = SolidCubes(options);
+    StatusOr<CubesOf> cubes = SolidCubes(options, cells_);
     if (!cubes.ok()) return cubes.status();
     cubes_ = std::move(*cubes);
     frame_.shape.solid = static_cast<bool>(cubes_);

@@ -462,6 +462,32 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
       if (!sink.Add("node_outside_grid", name, "a voxel lies outside the grid")) return false;
     }
   }
+  // A solid's full leaves, and its nodes that hold only full leaves, start inside the grid too.
+  if (v.shape.solid) {
+    const auto inside = [&](std::uint64_t key, std::uint32_t level) {
+      const MortonCoord c = MortonDecode(key);
+      const std::uint32_t shift = v.shape.depth - level;
+      const auto& d = v.grid.dims();
+      return (std::uint64_t{c.x} << shift) < d[0] && (std::uint64_t{c.y} << shift) < d[1] &&
+             (std::uint64_t{c.z} << shift) < d[2];
+    };
+    for (std::uint32_t l = 0; l < v.shape.depth; ++l) {
+      const std::vector<std::uint64_t> keys = svo.LevelKeys(l);
+      for (std::size_t i = 0; i < keys.size(); ++i) {
+        const std::uint8_t full = svo.levels[l].nodes[i].full_mask;
+        bool outside = !inside(keys[i], l);
+        for (unsigned c = 0; c < 8; ++c) {
+          if (full >> c & 1u) outside = outside || !inside(keys[i] << 3 | c, l + 1);
+        }
+        if (outside) {
+          consistent = false;
+          if (!sink.Add("node_outside_grid", name, "a full leaf lies outside the grid")) {
+            return false;
+          }
+        }
+      }
+    }
+  }
   // A page's halo voxels are voxels of other pages, with their attributes.
   for (const Halo& h : halos) {
     const auto it = std::lower_bound(voxel_keys.begin(), voxel_keys.end(), h.key);
