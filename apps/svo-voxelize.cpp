@@ -103,12 +103,10 @@ int main(int argc, char** argv) {
       voxel_count = voxels->count;
       if (voxelize.solid()) {
         // The interior is found around the surface's keys, read once from the file's own bytes.
-        StatusOr<std::unique_ptr<InteriorFinder>> finder =
-            InteriorFinder::Create(*mesh, *grid, {}, progress);
-        if (!finder.ok()) return app::Fail(tool, finder.status().WithContext(input.string()));
-        interior = app::RunStage(progress, "solid: interior", [&] {
-          return (*finder)->Fill(file.KeyGaps(*voxels), voxels->count);
-        });
+        StatusOr<InteriorCubes> cubes =
+            FillInterior(*mesh, *grid, file.KeyGaps(*voxels), voxels->count, {}, progress);
+        if (!cubes.ok()) return app::Fail(tool, cubes.status().WithContext(input.string()));
+        interior = std::move(*cubes);
       }
       written = app::RunStage(
           progress, "write", [&] { return file.Commit(*voxels, interior ? &*interior : nullptr); });

@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
@@ -448,6 +449,7 @@ void DecideFreeChildren(const Groups& groups, std::uint32_t level,
   ParallelChunks(groups.parents.size(), kChunk, [&](std::size_t begin, std::size_t end) {
     auto& levels = found[begin / kChunk];
     levels.resize(out.size());
+    levels[level].reserve(2 * (end - begin));  // ~1.7 a node on a closed surface's voxels
     for (std::size_t i = begin; i < end; ++i) {
       decide(level, groups.parents[i], ~unsigned{groups.masks[i]} & 0xffu, levels);
     }
@@ -612,12 +614,6 @@ void InteriorFinder::AddCubes(std::span<const std::uint64_t> keys, std::uint32_t
   if (level > top) impl_->AddCubes(GroupByParent(keys), level, top, cubes);
 }
 
-void InteriorFinder::AddCubes(std::span<const std::uint8_t> key_gaps, std::uint64_t count,
-                              std::uint32_t level, std::uint32_t top,
-                              std::vector<std::vector<std::uint64_t>>& cubes) const {
-  if (level > top) impl_->AddCubes(GroupByParent(key_gaps, count), level, top, cubes);
-}
-
 void InteriorFinder::Impl::AddCubes(Groups groups, std::uint32_t level, std::uint32_t top,
                                     std::vector<std::vector<std::uint64_t>>& cubes) const {
   const Impl& impl = *this;
@@ -661,13 +657,6 @@ InteriorCubes InteriorFinder::Fill(std::span<const std::uint64_t> surface_keys) 
   return interior;
 }
 
-InteriorCubes InteriorFinder::Fill(std::span<const std::uint8_t> key_gaps,
-                                   std::uint64_t count) const {
-  InteriorCubes interior = Empty();
-  AddCubes(key_gaps, count, interior.depth, 0, interior.levels);
-  return interior;
-}
-
 InteriorCubes InteriorFinder::Empty() const {
   InteriorCubes interior;
   interior.depth = depth();
@@ -687,6 +676,24 @@ StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid
   if (!finder.ok()) return finder.status();
   Progress::Stage stage(progress, "solid: interior", 1);
   return (*finder)->Fill(surface_keys);
+}
+
+StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid,
+                                     std::span<const std::uint8_t> key_gaps, std::uint64_t count,
+                                     const FillOptions& options, Progress& progress) {
+  if (count == 0) {
+    return Status::BadInput("a solid needs surface voxels to fill between; there are none");
+  }
+  // Reading the keys is serial: it runs beside the finder's build, which is mostly parallel.
+  StatusOr<std::unique_ptr<InteriorFinder>> finder = std::unique_ptr<InteriorFinder>();
+  Groups groups;
+  tbb::parallel_invoke([&] { finder = InteriorFinder::Create(mesh, grid, options, progress); },
+                       [&] { groups = GroupByParent(key_gaps, count); });
+  if (!finder.ok()) return finder.status();
+  Progress::Stage stage(progress, "solid: interior", 1);
+  InteriorCubes interior = (*finder)->Empty();
+  (*finder)->impl_->AddCubes(std::move(groups), interior.depth, 0, interior.levels);
+  return interior;
 }
 
 }  // namespace svokit

@@ -81,13 +81,13 @@ class InteriorFinder {
   /// ascending order. The result for a subtree does not depend on the rest of the tree.
   void AddCubes(std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top,
                 std::vector<std::vector<std::uint64_t>>& cubes) const;
-  /// The same with the keys as varint gaps (core/key_gaps.hpp, a .vfrag's `KEYS`), read once.
-  void AddCubes(std::span<const std::uint8_t> key_gaps, std::uint64_t count, std::uint32_t level,
-                std::uint32_t top, std::vector<std::vector<std::uint64_t>>& cubes) const;
-  /// The whole interior around the surface voxels `surface_keys` (sorted, not empty), or around
-  /// `count` keys stored as varint gaps.
+  /// The whole interior around the surface voxels `surface_keys` (sorted, not empty).
   InteriorCubes Fill(std::span<const std::uint64_t> surface_keys) const;
-  InteriorCubes Fill(std::span<const std::uint8_t> key_gaps, std::uint64_t count) const;
+
+ private:
+  friend StatusOr<InteriorCubes> FillInterior(const Mesh&, const GridTransform&,
+                                              std::span<const std::uint8_t>, std::uint64_t,
+                                              const FillOptions&, Progress&);
 
  private:
   struct Impl;
@@ -101,6 +101,13 @@ class InteriorFinder {
 /// count. Fails on an empty surface; a mesh that encloses no voxel centre gives no cubes.
 StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid,
                                      std::span<const std::uint64_t> surface_keys,
+                                     const FillOptions& options = {},
+                                     Progress& progress = Progress::Silent());
+
+/// The same around `count` surface keys stored as varint gaps (core/key_gaps.hpp: a .vfrag's
+/// `KEYS`), read once, while the finder is built.
+StatusOr<InteriorCubes> FillInterior(const Mesh& mesh, const GridTransform& grid,
+                                     std::span<const std::uint8_t> key_gaps, std::uint64_t count,
                                      const FillOptions& options = {},
                                      Progress& progress = Progress::Silent());
 

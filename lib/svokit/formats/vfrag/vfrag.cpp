@@ -457,7 +457,14 @@ std::vector<std::uint8_t> EncodeInteriorSection(const InteriorCubes& interior) {
   std::uint8_t varint[kMaxVarintBytes];
   for (const std::vector<std::uint64_t>& level : interior.levels) {
     out.insert(out.end(), varint, varint + PutVarint(level.size(), varint));
-    AppendKeyGaps(std::span<const std::uint64_t>(level), kNoPreviousKey, out);
+    // Millions of cubes at the finest levels: encoded in parallel pieces, joined in order.
+    constexpr std::size_t kPiece = 1 << 20;
+    std::vector<std::vector<std::uint8_t>> pieces((level.size() + kPiece - 1) / kPiece);
+    ParallelChunks(level.size(), kPiece, [&](std::size_t begin, std::size_t end) {
+      AppendKeyGaps(std::span<const std::uint64_t>(level).subspan(begin, end - begin),
+                    begin == 0 ? kNoPreviousKey : level[begin - 1], pieces[begin / kPiece]);
+    });
+    for (const auto& piece : pieces) out.insert(out.end(), piece.begin(), piece.end());
   }
   return out;
 }
