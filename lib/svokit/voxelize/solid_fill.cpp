@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include "svokit/core/default_init.hpp"
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
@@ -148,6 +149,24 @@ void RasterizeColumns(const FixedPoint3& a, const FixedPoint3& b, const FixedPoi
 
 constexpr auto kRelaxed = std::memory_order_relaxed;
 
+// Running sums in place, on both cores: each chunk's own, then each offset by those before it.
+void InclusiveSum(std::vector<std::uint32_t>& values) {
+  constexpr std::size_t kChunk = 1 << 20;
+  const std::size_t chunks = (values.size() + kChunk - 1) / kChunk;
+  std::vector<std::uint32_t> totals(chunks);
+  ParallelChunks(values.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    std::partial_sum(values.begin() + static_cast<std::ptrdiff_t>(begin),
+                     values.begin() + static_cast<std::ptrdiff_t>(end),
+                     values.begin() + static_cast<std::ptrdiff_t>(begin));
+    totals[begin / kChunk] = values[end - 1];
+  });
+  std::exclusive_scan(totals.begin(), totals.end(), totals.begin(), 0u);
+  ParallelChunks(values.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    const std::uint32_t before = totals[begin / kChunk];
+    for (std::size_t i = begin; i < end; ++i) values[i] += before;
+  });
+}
+
 // Every column's crossings, sorted: the integer winding number at any voxel centre of a cycle.
 class ColumnCrossings {
  public:
@@ -182,8 +201,8 @@ class ColumnCrossings {
     tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t k) {
       for (const std::uint64_t entry : parts[k]) at(entry >> 32).fetch_add(1, kRelaxed);
     });
-    std::partial_sum(offsets_.begin(), offsets_.end(), offsets_.begin());
-    crossings_.resize(offsets_.back());
+    InclusiveSum(offsets_);
+    crossings_.resize(offsets_.back());  // not zeroed: every entry is placed below
     tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t k) {
       for (const std::uint64_t entry : parts[k]) {
         crossings_[at(entry >> 32).fetch_sub(1, kRelaxed) - 1] =
@@ -220,7 +239,7 @@ class ColumnCrossings {
  private:
   std::array<std::uint32_t, 3> dims_;
   std::vector<std::uint32_t> offsets_;
-  std::vector<Crossing> crossings_;
+  DefaultInitVector<Crossing> crossings_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -420,21 +439,65 @@ Groups GroupByParent(std::span<const std::uint64_t> keys) {
 }
 
 // The same from keys stored as varint gaps (a .vfrag's), read once: the voxels' keys are never
-// held, only their parents.
+// held, only their parents. The bytes are cut into pieces at varint boundaries (a byte below
+// 0x80 ends one); each piece's keys count and advance are summed first, then every piece is read
+// from its first key, all in parallel.
 Groups GroupByParent(std::span<const std::uint8_t> gaps, std::uint64_t count) {
-  Groups g;
-  const std::uint8_t* p = gaps.data();
-  const std::uint8_t* end = p + gaps.size();
-  std::uint64_t key = kNoPreviousKey, gap = 0;
-  for (std::uint64_t i = 0; i < count && GetVarint(p, end, gap); ++i) {
-    key += gap + 1;
-    if (g.parents.empty() || g.parents.back() != key >> 3) {
-      g.parents.push_back(key >> 3);
-      g.masks.push_back(0);
-    }
-    g.masks.back() = static_cast<std::uint8_t>(g.masks.back() | 1u << (key & 7));
+  constexpr std::size_t kPiece = 1 << 22;
+  const std::size_t pieces = std::max<std::size_t>(1, (gaps.size() + kPiece - 1) / kPiece);
+  std::vector<std::size_t> cut(pieces + 1, gaps.size());
+  for (std::size_t k = 0; k < pieces; ++k) {
+    std::size_t i = std::min(gaps.size(), k * kPiece);
+    while (i > 0 && i < gaps.size() && gaps[i - 1] >= 0x80) ++i;
+    cut[k] = i;
   }
-  return g;
+  const auto read = [&](std::size_t k, std::uint64_t limit, const auto& each) {
+    const std::uint8_t* p = gaps.data() + cut[k];
+    const std::uint8_t* end = gaps.data() + cut[k + 1];
+    std::uint64_t n = 0, gap = 0;
+    while (n < limit && GetVarint(p, end, gap)) {
+      each(gap);
+      ++n;
+    }
+    return n;
+  };
+  std::vector<std::uint64_t> keys_in(pieces), advance(pieces);
+  tbb::parallel_for(std::size_t{0}, pieces, [&](std::size_t k) {
+    keys_in[k] = read(k, count, [&](std::uint64_t gap) { advance[k] += gap + 1; });
+  });
+  std::vector<Groups> parts(pieces);
+  std::vector<std::uint64_t> first_key(pieces, kNoPreviousKey), first_index(pieces, 0);
+  for (std::size_t k = 1; k < pieces; ++k) {
+    first_key[k] = first_key[k - 1] + advance[k - 1];
+    first_index[k] = first_index[k - 1] + keys_in[k - 1];
+  }
+  tbb::parallel_for(std::size_t{0}, pieces, [&](std::size_t k) {
+    if (first_index[k] >= count) return;
+    Groups& g = parts[k];
+    std::uint64_t key = first_key[k];
+    read(k, count - first_index[k], [&](std::uint64_t gap) {
+      key += gap + 1;
+      if (g.parents.empty() || g.parents.back() != key >> 3) {
+        g.parents.push_back(key >> 3);
+        g.masks.push_back(0);
+      }
+      g.masks.back() = static_cast<std::uint8_t>(g.masks.back() | 1u << (key & 7));
+    });
+  });
+  // Joined in order; a parent cut between two pieces is one group.
+  Groups all;
+  for (Groups& g : parts) {
+    std::size_t from = 0;
+    if (!all.parents.empty() && !g.parents.empty() && g.parents.front() == all.parents.back()) {
+      all.masks.back() = static_cast<std::uint8_t>(all.masks.back() | g.masks.front());
+      from = 1;
+    }
+    all.parents.insert(all.parents.end(), g.parents.begin() + static_cast<std::ptrdiff_t>(from),
+                       g.parents.end());
+    all.masks.insert(all.masks.end(), g.masks.begin() + static_cast<std::ptrdiff_t>(from),
+                     g.masks.end());
+  }
+  return all;
 }
 
 // Calls decide(level, parent, free, out) for every group, with the mask of its free children at
@@ -638,13 +701,14 @@ void InteriorFinder::Impl::AddCubes(Groups groups, std::uint32_t level, std::uin
   for (std::uint32_t l = 0; l <= impl.depth; ++l) {
     std::vector<std::uint64_t>& level_cubes = cubes[l];
     const std::size_t first = level_cubes.size();
-    std::size_t count = 0;
-    for (const auto& part : parts[l]) count += part.size();
-    level_cubes.reserve(first + count);
-    for (auto& part : parts[l]) {
-      level_cubes.insert(level_cubes.end(), part.begin(), part.end());
-      std::vector<std::uint64_t>().swap(part);
-    }
+    std::vector<std::size_t> at(parts[l].size() + 1, first);
+    for (std::size_t k = 0; k < parts[l].size(); ++k) at[k + 1] = at[k] + parts[l][k].size();
+    level_cubes.resize(at.back());
+    tbb::parallel_for(std::size_t{0}, parts[l].size(), [&](std::size_t k) {
+      std::copy(parts[l][k].begin(), parts[l][k].end(),
+                level_cubes.begin() + static_cast<std::ptrdiff_t>(at[k]));
+      std::vector<std::uint64_t>().swap(parts[l][k]);
+    });
     // One pass finds a level's cubes in order; splits of larger cubes add to deeper levels.
     const auto begin = level_cubes.begin() + static_cast<std::ptrdiff_t>(first);
     if (!std::is_sorted(begin, level_cubes.end())) std::sort(begin, level_cubes.end());
