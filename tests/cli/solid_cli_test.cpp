@@ -337,8 +337,10 @@ TEST(SolidCli, BadInputIsOneLineExitTwoAndNoOutput) {
     // Progress lines of finished stages may precede it; the error is the one last line.
     const auto lines = r.ErrLines();
     ASSERT_FALSE(lines.empty()) << what;
+    const std::string prefix =
+        tool + ": ";  // lambdas cannot capture structured bindings (clang 14)
     EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
-                            [&](const std::string& l) { return l.starts_with(tool + ": "); }),
+                            [&](const std::string& l) { return l.starts_with(prefix); }),
               1)
         << what << ": " << r.err;
     EXPECT_TRUE(lines.back().starts_with(tool + ": ")) << what << ": " << r.err;
