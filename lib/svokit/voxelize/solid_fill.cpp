@@ -398,11 +398,6 @@ class WindingDecider {
 // ---------------------------------------------------------------------------------------------
 // The surface's octree, level by level from the voxels up, and the free children of its nodes.
 
-struct CubeAt {
-  std::uint32_t level;
-  std::uint64_t key;
-};
-
 // The nodes one level up from sorted keys, each with the mask of its children among them.
 struct Groups {
   std::vector<std::uint64_t> parents;
