@@ -256,6 +256,7 @@ class WindingDecider {
     for (const OpenEdge& e : open_edges) {
       edges_.push_back({positions_[e.a], positions_[e.b], static_cast<double>(e.multiplicity)});
     }
+    for (const Edge& e : edges_) midpoints_.push_back((e.a + e.b) * 0.5);
     order_.resize(edges_.size());
     std::iota(order_.begin(), order_.end(), 0u);
     if (!edges_.empty()) BuildEdgeTree(0, static_cast<std::uint32_t>(edges_.size()));
@@ -355,19 +356,7 @@ class WindingDecider {
       edge_nodes_[index] = node;
       return index;
     }
-    // Median split of the midpoints along the box's longest axis, ties by index.
-    const Vec3d extent = hi - lo;
-    const int axis =
-        extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-    const auto key = [&](std::uint32_t i) {
-      const Vec3d m = (edges_[i].a + edges_[i].b) * 0.5;
-      return axis == 0 ? m.x : (axis == 1 ? m.y : m.z);
-    };
-    const auto begin = order_.begin() + first;
-    std::nth_element(begin, begin + count / 2, begin + count,
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       return key(a) < key(b) || (key(a) == key(b) && a < b);
-                     });
+    MedianSplit(std::span(order_).subspan(first, count), midpoints_, hi - lo);
     node.children[0] = BuildEdgeTree(first, count / 2);
     node.children[1] = BuildEdgeTree(first + count / 2, count - count / 2);
     edge_nodes_[index] = node;
@@ -391,6 +380,7 @@ class WindingDecider {
   std::vector<Triangle> triangles_;
   FastWindingNumber fast_;
   std::vector<Edge> edges_;
+  std::vector<Vec3d> midpoints_;  // per edge, what the tree splits by
   std::vector<std::uint32_t> order_;
   std::vector<EdgeNode> edge_nodes_;
 };

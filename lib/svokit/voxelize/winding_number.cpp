@@ -43,6 +43,21 @@ double SquaredDistanceToTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b,
 
 }  // namespace
 
+void MedianSplit(std::span<std::uint32_t> order, std::span<const Vec3d> points,
+                 const Vec3d& extent) {
+  const int axis =
+      extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+  const auto key = [&](std::uint32_t i) {
+    const Vec3d& p = points[i];
+    return axis == 0 ? p.x : (axis == 1 ? p.y : p.z);
+  };
+  std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(order.size() / 2),
+                   order.end(), [&](std::uint32_t a, std::uint32_t b) {
+                     const double ka = key(a), kb = key(b);
+                     return ka < kb || (ka == kb && a < b);
+                   });
+}
+
 double TriangleSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
   const Vec3d u = a - p, v = b - p, w = c - p;
   const double lu = Length(u), lv = Length(v), lw = Length(w);
@@ -105,21 +120,8 @@ std::uint32_t FastWindingNumber::Build(std::uint32_t first, std::uint32_t count)
     nodes_[index] = node;
     return index;
   }
-  // Median split of the centroids along the box's longest axis; ties broken by index, so the
-  // tree depends on the mesh alone.
-  const Vec3d extent = hi - lo;
-  const int axis =
-      extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-  auto key = [&](std::uint32_t t) {
-    const Vec3d& c = centroids_[t];
-    return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
-  };
-  const auto begin = order_.begin() + first;
   const std::uint32_t half = count / 2;
-  std::nth_element(begin, begin + half, begin + count, [&](std::uint32_t a, std::uint32_t b) {
-    const double ka = key(a), kb = key(b);
-    return ka < kb || (ka == kb && a < b);
-  });
+  MedianSplit(std::span(order_).subspan(first, count), centroids_, hi - lo);
   node.children[0] = Build(first, half);
   node.children[1] = Build(first + half, count - half);
   nodes_[index] = node;

@@ -23,6 +23,12 @@ double TriangleSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c, const 
 double WindingNumber(std::span<const Vec3d> positions, std::span<const Triangle> triangles,
                      const Vec3d& p);
 
+/// Reorders `order` (indices into `points`) about its median along the longest axis of `extent`:
+/// the first count/2 hold the points below it. Ties go by index, so a tree built of these splits
+/// depends on its input alone.
+void MedianSplit(std::span<std::uint32_t> order, std::span<const Vec3d> points,
+                 const Vec3d& extent);
+
 /// Winding numbers of one triangle soup at many points in O(log n) each: a median-split tree of
 /// the triangles (leaves of at most 8), each node with its triangles' area-weighted normal sum,
 /// centre and radius. A node whose ball, grown by `accuracy`, does not hold the point counts as a
