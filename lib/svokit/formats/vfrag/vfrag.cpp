@@ -515,7 +515,10 @@ StatusOr<InteriorCubes> DecodeInteriorSection(std::span<const std::uint8_t> byte
 }
 
 StatusOr<std::optional<InteriorCubes>> ReadVfragInterior(const std::filesystem::path& path) {
-  const auto file = container::Reader::Open(path, kVfragFormat);
+  // Only GRID and FILL are read and checked: the voxels' sections are the build's to read.
+  const auto file = container::Reader::Open(
+      path, kVfragFormat,
+      [](container::Tag tag, const void*) { return tag == kGrid || tag == kInterior; });
   if (!file.ok()) return file.status();
   const auto fill = file->Find(kInterior);
   if (!fill) return std::optional<InteriorCubes>{};
