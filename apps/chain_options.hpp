@@ -1,6 +1,6 @@
 #pragma once
 // The options of the chain's stages, declared once: svo-voxelize and mesh2svo share the
-// voxelization options, svo-build and mesh2svo the build options.
+// voxelization options, svo-build and mesh2svo the build options, into the pipeline's requests.
 
 #include <charconv>
 #include <map>
@@ -9,11 +9,11 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
-#include "svokit/core/grid_transform.hpp"
+#include "apps/cli.hpp"
 #include "svokit/core/status.hpp"
-#include "svokit/formats/svo/svo_chunk.hpp"
-#include "svokit/svo/build.hpp"
-#include "svokit/voxelize/voxelize.hpp"
+#include "svokit/formats/provenance.hpp"
+#include "svokit/formats/svo/svo_part.hpp"
+#include "svokit/pipeline/chain.hpp"
 
 namespace svokit::app {
 
@@ -25,32 +25,12 @@ inline const std::map<std::string, VoxelMethod> kVoxelMethods = {
     {"fragment", VoxelMethod::kFragment},
     {"hybrid", VoxelMethod::kHybrid}};
 
-/// The name of `value` in `names` ("" for none).
-template <class Enum>
-std::string NameOf(const std::map<std::string, Enum>& names, Enum value) {
-  for (const auto& [name, v] : names) {
-    if (v == value) return name;
-  }
-  return "";
-}
-
-/// An option taking one of `names` (any case), shown as "a|b|c" in --help with its default.
-template <class Enum>
-CLI::Option* AddChoice(CLI::App& cli, const std::string& flags, Enum& value,
-                       const std::map<std::string, Enum>& names, const std::string& order,
-                       const std::string& description) {
-  return cli.add_option(flags, value, description)
-      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case).description(""))
-      ->option_text(order)
-      ->default_str(NameOf(names, value));
-}
-
 struct VoxelizeCli {
   std::uint32_t resolution = 0, pad = 0;
   double voxel_size = 0;
   std::string attributes = "color,normal";
   std::string fill = "surface";
-  /// Mode, method and cutoff as given; Options() adds the attributes.
+  /// Mode, method and cutoff as given.
   VoxelizeOptions parsed;
 
   void Add(CLI::App& cli) {
@@ -92,37 +72,23 @@ struct VoxelizeCli {
         ->check(NonNegativeOrInfinite());
   }
 
-  /// The grid is given, by --resolution or --voxel-size.
-  Status Check() const {
+  /// The voxelization asked for; the grid must be given, by --resolution or --voxel-size.
+  StatusOr<VoxelizeRequest> Request() const {
     if (resolution == 0 && voxel_size == 0) {
       return Status::BadInput("give the grid as --resolution N or --voxel-size S");
     }
-    return Status::Ok();
-  }
-
-  /// The voxelizer's options: those given and the attributes asked for.
-  VoxelizeOptions Options() const {
-    VoxelizeOptions o = parsed;
-    o.colors = attributes.find("color") != std::string::npos;
-    o.normals = attributes.find("normal") != std::string::npos;
-    return o;
-  }
-
-  StatusOr<GridTransform> Grid(const Box3d& bounds) const {
-    return resolution > 0 ? GridTransform::FitResolution(bounds, resolution, pad)
-                          : GridTransform::FitVoxelSize(bounds, voxel_size, pad);
+    VoxelizeRequest r;
+    r.grid = {resolution, resolution > 0 ? 0 : voxel_size, pad};
+    r.settings.mode = parsed.mode;
+    r.settings.colors = attributes.find("color") != std::string::npos;
+    r.settings.normals = attributes.find("normal") != std::string::npos;
+    r.settings.solid = fill == "solid";
+    r.split = parsed;
+    return r;
   }
 
   std::string ModeName() const { return NameOf(kVoxelModes, parsed.mode); }
   bool solid() const { return fill == "solid"; }
-
-  /// What shapes the voxels, as the command line spells it (methods and threads do not).
-  std::string Recorded() const {
-    const std::string grid = resolution > 0 ? fmt::format("--resolution {}", resolution)
-                                            : fmt::format("--voxel-size {}", voxel_size);
-    return fmt::format("{} --pad {} --mode {} --attributes {}{}", grid, pad, ModeName(), attributes,
-                       solid() ? " --fill solid" : "");
-  }
 };
 
 struct BuildCli {
@@ -146,33 +112,45 @@ struct BuildCli {
         ->capture_default_str();
   }
 
-  /// The compression option, or why it is not one.
-  StatusOr<SvoCompression> Compression() const {
-    if (compression == "none") return SvoCompression{false, 0};
-    if (compression == "zstd") return SvoCompression{};
+  /// The build asked for, or why --compression is not one.
+  StatusOr<BuildSettings> Settings() const {
+    BuildSettings s;
+    s.brick_side = bricks == "none" ? 0 : static_cast<std::uint32_t>(std::stoul(bricks));
+    s.contours = contours;
+    if (compression == "none") {
+      s.compression = {false, 0};
+      return s;
+    }
+    if (compression == "zstd") return s;
     if (compression.starts_with("zstd:")) {
       const std::string level = compression.substr(5);
       int value = 0;
       const auto [end, ec] = std::from_chars(level.data(), level.data() + level.size(), value);
       if (ec == std::errc() && end == level.data() + level.size() && value >= 1 && value <= 22) {
-        return SvoCompression{true, value};
+        s.compression = {true, value};
+        return s;
       }
     }
     return Status::BadInput("--compression '{}': expected zstd, zstd:LEVEL (1 to 22) or none",
                             compression);
   }
-
-  BuildOptions Options() const {
-    BuildOptions o;
-    o.brick_side = bricks == "none" ? 0 : static_cast<std::uint32_t>(std::stoul(bricks));
-    o.contours = contours;
-    return o;
-  }
-
-  std::string Recorded() const {
-    return fmt::format("--bricks {} --{} --compression {}", bricks,
-                       contours ? "contours" : "no-contours", compression);
-  }
 };
+
+/// "K/N": part K (0-based) of N.
+inline StatusOr<SvoPartOf> ParsePart(const std::string& option, const std::string& text) {
+  SvoPartOf part;
+  const std::size_t slash = text.find('/');
+  const char* end = text.data() + text.size();
+  const auto k =
+      std::from_chars(text.data(), text.data() + std::min(slash, text.size()), part.part);
+  const auto n = slash == std::string::npos
+                     ? std::from_chars_result{end, std::errc::invalid_argument}
+                     : std::from_chars(text.data() + slash + 1, end, part.parts);
+  if (k.ec != std::errc() || n.ec != std::errc() || n.ptr != end || k.ptr != text.data() + slash ||
+      part.parts == 0 || part.part >= part.parts) {
+    return Status::BadInput("{} '{}': expected K/N with 0 ≤ K < N, e.g. 0/4", option, text);
+  }
+  return part;
+}
 
 }  // namespace svokit::app

@@ -4,10 +4,14 @@
 #include <filesystem>
 #include <optional>
 
-#include "apps/app.hpp"
+#include "apps/cli.hpp"
+#include "apps/run.hpp"
+#include "apps/summary.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/export.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -28,19 +32,19 @@ int main(int argc, char** argv) {
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
-    if (Status s = app::CheckOutputPath(output, ExportExtensions(), input); !s.ok()) {
+    if (Status s = CheckOutputPath(output, ExportExtensions(), input); !s.ok()) {
       return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Svo> svo = app::ReadSvoStage(progress, input, level);
+    StatusOr<Svo> svo = ReadSvoStage(progress, input, level);
     if (!svo.ok()) return app::Fail(tool, svo.status());
 
     ExportOptions options;
     options.level = level;
     const Status written =
-        app::RunStage(progress, "export", [&] { return ExportSvo(*svo, output, options); });
+        RunStage(progress, "export", [&] { return ExportSvo(*svo, output, options); });
     if (!written.ok()) return app::Fail(tool, written);
 
     const std::uint32_t exported = level.value_or(svo->depth);

@@ -2,12 +2,15 @@
 
 #include <filesystem>
 
-#include "apps/app.hpp"
+#include "apps/cli.hpp"
+#include "apps/run.hpp"
+#include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/mesh_report.hpp"
+#include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -29,18 +32,17 @@ int main(int argc, char** argv) {
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     if (!output.empty()) {
-      if (Status s = app::CheckOutputPath(output, {"svm"}, input); !s.ok())
-        return app::Fail(tool, s);
+      if (Status s = CheckOutputPath(output, {"svm"}, input); !s.ok()) return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Mesh> mesh = app::ImportStage(progress, input);
+    StatusOr<Mesh> mesh = ImportStage(progress, input);
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
 
     const MeshReport report = AnalyzeMesh(*mesh, input.string(), report_options, progress);
     if (!output.empty()) {
-      const Status written = app::RunStage(
+      const Status written = RunStage(
           progress, "write", [&] { return WriteSvm(*mesh, input.filename().string(), output); },
           [&](const Status&) { return output.string(); });
       if (!written.ok()) return app::Fail(tool, written);

@@ -5,13 +5,17 @@
 #include <optional>
 #include <vector>
 
-#include "apps/app.hpp"
+#include "apps/cli.hpp"
+#include "apps/run.hpp"
+#include "apps/summary.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"
+#include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -61,7 +65,7 @@ int main(int argc, char** argv) {
     const StatusOr<std::array<int, 2>> size = ParseImageSize(size_text);
     if (!size.ok()) return app::Fail(tool, size.status());
     if (!render_path.empty()) {
-      if (Status s = app::CheckOutputPath(render_path, {"png"}, input); !s.ok()) {
+      if (Status s = CheckOutputPath(render_path, {"png"}, input); !s.ok()) {
         return app::Fail(tool, s);
       }
     }
@@ -72,14 +76,14 @@ int main(int argc, char** argv) {
       if (!parsed.ok()) return app::Fail(tool, parsed.status());
       slice = *parsed;
       slice_path = slice_args[1];
-      if (Status s = app::CheckOutputPath(slice_path, {"png"}, input); !s.ok()) {
+      if (Status s = CheckOutputPath(slice_path, {"png"}, input); !s.ok()) {
         return app::Fail(tool, s);
       }
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Svo> svo = app::ReadSvoStage(progress, input, level);
+    StatusOr<Svo> svo = ReadSvoStage(progress, input, level);
     if (!svo.ok()) return app::Fail(tool, svo.status());
 
     InspectReport report;
@@ -102,7 +106,7 @@ int main(int argc, char** argv) {
       options.shade = *shade;
       options.contours = !no_contours;
       const StatusOr<RenderResult> rendered =
-          app::RunStage(progress, "render", [&]() -> StatusOr<RenderResult> {
+          RunStage(progress, "render", [&]() -> StatusOr<RenderResult> {
             StatusOr<RenderResult> r = RenderSvo(*svo, options);
             if (!r.ok()) return r;
             SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(r->image, render_path));
@@ -122,13 +126,12 @@ int main(int argc, char** argv) {
     if (slice) {
       SliceOptions options;
       options.level = level;
-      const StatusOr<RgbaImage> image =
-          app::RunStage(progress, "slice", [&]() -> StatusOr<RgbaImage> {
-            StatusOr<RgbaImage> r = RenderSlice(*svo, *slice, options);
-            if (!r.ok()) return r;
-            SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(*r, slice_path));
-            return r;
-          });
+      const StatusOr<RgbaImage> image = RunStage(progress, "slice", [&]() -> StatusOr<RgbaImage> {
+        StatusOr<RgbaImage> r = RenderSlice(*svo, *slice, options);
+        if (!r.ok()) return r;
+        SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(*r, slice_path));
+        return r;
+      });
       if (!image.ok()) return app::Fail(tool, image.status().WithContext(input.string()));
       report.slice = SlicePicture{.path = slice_path.string(),
                                   .axis = slice->axis,
@@ -137,8 +140,7 @@ int main(int argc, char** argv) {
                                   .height = image->height};
     }
 
-    const SvoStats stats =
-        app::RunStage(progress, "statistics", [&] { return ComputeSvoStats(*svo); });
+    const SvoStats stats = RunStage(progress, "statistics", [&] { return ComputeSvoStats(*svo); });
     fmt::print("{}", json ? FormatStatsJson(stats, report) : FormatStatsText(stats, report));
     return 0;
   });

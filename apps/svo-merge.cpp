@@ -3,9 +3,13 @@
 #include <filesystem>
 #include <vector>
 
-#include "apps/app.hpp"
+#include "apps/cli.hpp"
+#include "apps/run.hpp"
+#include "apps/summary.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
-#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/pipeline/stages.hpp"
+#include "svokit/pipeline/svo_parts.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -26,7 +30,7 @@ int main(int argc, char** argv) {
   app::AddCommonOptions(cli, common, "svo-merge out/*.svopart -o scene.svo");
 
   return app::Run(tool, cli, argc, argv, parts.empty() ? std::filesystem::path{} : parts[0], [&] {
-    if (Status s = app::CheckOutputPath(output, {"svo"}, parts.front()); !s.ok()) {
+    if (Status s = CheckOutputPath(output, {"svo"}, parts.front()); !s.ok()) {
       return app::Fail(tool, s);
     }
     ThreadLimit threads(common.threads);

@@ -4,9 +4,13 @@
 
 #include <filesystem>
 
-#include "apps/app.hpp"
+#include "apps/cli.hpp"
+#include "apps/run.hpp"
+#include "apps/summary.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/pipeline/stages.hpp"
 #include "svokit/validate/validate.hpp"
 
 int main(int argc, char** argv) {
@@ -30,15 +34,14 @@ int main(int argc, char** argv) {
   return app::Run(tool, cli, argc, argv, input, [&] {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-    StatusOr<LenientSvo> file =
-        app::RunStage(progress, "read", [&] { return ReadSvoLenient(input); });
+    StatusOr<LenientSvo> file = RunStage(progress, "read", [&] { return ReadSvoLenient(input); });
     if (!file.ok()) return app::Fail(tool, file.status());
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
       // A damaged grid cannot vouch for or against the mesh: the checks will say what they can.
-      StatusOr<Mesh> m = file->complete ? app::ImportSourceMesh(progress, mesh_path, file->svo.grid,
-                                                                input, "the octree was built from")
-                                        : app::ImportStage(progress, mesh_path);
+      StatusOr<Mesh> m = file->complete ? ImportSourceMesh(progress, mesh_path, file->svo.grid,
+                                                           input, "the octree was built from")
+                                        : ImportStage(progress, mesh_path);
       if (!m.ok()) return app::Fail(tool, m.status());
       mesh = std::move(*m);
     }

@@ -10,7 +10,10 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "tests/bake/bake_scenes.hpp"
 
@@ -85,23 +88,27 @@ TEST(AoSection, ReadsBackWholeAndDownToALevel) {
   TempDir dir;
   const Svo& baked = Torus48().svo;
   const std::filesystem::path plain = Torus48().plain, out = dir / "baked.svo";
-  ASSERT_TRUE(WriteBakedSvo(plain, baked, "--ao", out).ok());
+  BakeSettings bake;
+  bake.distance = 2;
+  ASSERT_TRUE(WriteBakedSvo(plain, baked, bake, out).ok());
   StatusOr<Svo> whole = ReadSvo(out);
   ASSERT_TRUE(whole.ok()) << whole.status().message();
   ASSERT_TRUE(whole->has_ao);
   for (std::uint32_t l = 0; l <= baked.depth; ++l)
     EXPECT_EQ(whole->levels[l].ao, baked.levels[l].ao);
-  EXPECT_NE(whole->metadata.find("\"bake\":\"--ao\""), std::string::npos);
+  EXPECT_EQ(ParseProvenance(whole->metadata).bake, bake);
   StatusOr<Svo> top = ReadSvo(out, 2);
   ASSERT_TRUE(top.ok()) << top.status().message();
   ASSERT_EQ(top->levels.size(), 3u);
   for (std::uint32_t l = 0; l <= 2; ++l) EXPECT_EQ(top->levels[l].ao, baked.levels[l].ao);
   // The plain file has none; baking again replaces the section.
   EXPECT_FALSE(ReadSvo(plain)->has_ao);
-  ASSERT_TRUE(WriteBakedSvo(out, baked, "--ao --cones 5", dir / "again.svo").ok());
+  bake.cones = 5;
+  ASSERT_TRUE(WriteBakedSvo(out, baked, bake, dir / "again.svo").ok());
   StatusOr<Svo> again = ReadSvo(dir / "again.svo");
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->levels.back().ao, baked.levels.back().ao);
+  EXPECT_EQ(ParseProvenance(again->metadata).bake, bake);
   // A damaged section is refused (its checksum), naming the file.
   std::vector<std::uint8_t> bytes = ReadBytes(out);
   bytes[bytes.size() - 3] ^= 0x40;
@@ -229,28 +236,41 @@ TEST(RasterizeUvs, TexelsOfTheUvTrianglesAndDilatedGutters) {
   EXPECT_FALSE(RasterizeUvs(mesh, 0).ok());
 }
 
+// Typed META, and the option text files written before recorded: both say the grid fit.
 TEST(CheckMeshMatchesOctree, OnlyTheOctreesOwnMeshPasses) {
-  Svo svo = Torus48().svo;
-  svo.metadata = R"({"voxelize":"--resolution 48 --pad 0 --mode conservative"})";
   StatusOr<Mesh> torus = ImportMesh(DataDir() / "uv-torus.obj");
   ASSERT_TRUE(torus.ok());
-  EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
-  Mesh moved = *torus;
-  for (Vec3d& p : moved.positions) p.x += 1e-3;
-  const Status s = CheckMeshMatchesOctree(moved, svo, "moved.obj");
-  ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("moved.obj"), std::string::npos);
-  EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), svo, "sphere").ok());
-  // Same bounds, another triangle count (one triangle dropped, its corners still used).
-  svo.metadata = R"({"triangles":2304,"voxelize":"--resolution 48 --pad 0"})";
-  EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
-  Mesh fewer = *torus;
-  fewer.triangles.pop_back();
-  fewer.material_ids.pop_back();
-  const Status count = CheckMeshMatchesOctree(fewer, svo, "fewer.obj");
-  ASSERT_FALSE(count.ok());
-  EXPECT_NE(count.message().find("has 2303 triangles, the octree's 2304"), std::string::npos)
-      << count.message();
+  Provenance typed;
+  typed.grid = GridFit{48, 0, 0};
+  const std::string forms[2][2] = {
+      {R"({"voxelize":"--resolution 48 --pad 0 --mode conservative"})", ProvenanceJson(typed)},
+      {R"({"triangles":2304,"voxelize":"--resolution 48 --pad 0"})", ProvenanceJson([&] {
+         Provenance p = typed;
+         p.triangles = 2304;
+         return p;
+       }())}};
+  for (int form = 0; form < 2; ++form) {
+    SCOPED_TRACE(forms[0][form]);
+    Svo svo = Torus48().svo;
+    svo.metadata = forms[0][form];
+    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+    Mesh moved = *torus;
+    for (Vec3d& p : moved.positions) p.x += 1e-3;
+    const Status s = CheckMeshMatchesOctree(moved, svo, "moved.obj");
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("moved.obj"), std::string::npos);
+    EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), svo, "sphere").ok());
+    // Same bounds, another triangle count (one triangle dropped, its corners still used).
+    svo.metadata = forms[1][form];
+    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+    Mesh fewer = *torus;
+    fewer.triangles.pop_back();
+    fewer.material_ids.pop_back();
+    const Status count = CheckMeshMatchesOctree(fewer, svo, "fewer.obj");
+    ASSERT_FALSE(count.ok());
+    EXPECT_NE(count.message().find("has 2303 triangles, the octree's 2304"), std::string::npos)
+        << count.message();
+  }
 }
 
 }  // namespace

@@ -38,7 +38,8 @@
 #include "svokit/bake/ray_ao.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/image_codec.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {
@@ -100,7 +101,7 @@ Svo Build(const Mesh& mesh, std::uint32_t depth) {
   if (!voxels.ok()) Fail(voxels.status().message());
   BuildOptions bo;
   bo.contours = false;
-  auto svo = BuildSvo(*voxels, nullptr, bo, R"({"source":"ao_bench"})");
+  auto svo = BuildReferenceSvo(*voxels, nullptr, bo, R"({"source":"ao_bench"})");
   if (!svo.ok()) Fail(svo.status().message());
   return std::move(*svo);
 }

@@ -9,8 +9,10 @@
 #include <vector>
 
 #include "bench_main.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {
@@ -29,7 +31,7 @@ void Build(benchmark::State& state, const Scene* scene, std::uint32_t brick_side
   options.contours = contours;
   for (auto _ : state) {
     if (reference) {
-      auto svo = svokit::BuildSvo(scene->voxels, &scene->mesh, options);
+      auto svo = svokit::BuildReferenceSvo(scene->voxels, &scene->mesh, options);
       if (!svo.ok()) {
         state.SkipWithError(svo.status().message().c_str());
         return;

@@ -25,8 +25,10 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/formats/svo_v1_writer.hpp"
@@ -196,7 +198,7 @@ int Run(int argc, char** argv) {
     const std::filesystem::path v2 = tmp / "v2.svo", v1 = tmp / "v1.svo";
     if (!WriteSvo(*compact, v2).ok()) return 2;
     compact = CompactSvo{};
-    auto ref = BuildSvo(*voxels, &scene->mesh, options);
+    auto ref = BuildReferenceSvo(*voxels, &scene->mesh, options);
     if (!ref.ok()) return 2;
     auto reader = SvoReader::Open(v2);
     if (!reader.ok()) {

@@ -175,7 +175,7 @@ TEST(SvoVoxelizeCli, OneVoxelGridsHoldTheWholeMesh) {
       args.insert(args.end(), grid.begin(), grid.end());
       const ToolResult r = RunTool("svo-voxelize", args);
       ASSERT_EQ(r.exit_code, 0) << mesh << " " << grid[1] << ": " << r.err;
-      VfragMetadata meta;
+      Provenance meta;
       StatusOr<VoxelSet> voxels = ReadVfrag(out, &meta);
       ASSERT_TRUE(voxels.ok()) << voxels.status().message();
       ASSERT_EQ(voxels->keys.size(), 1u) << mesh << " " << grid[1];

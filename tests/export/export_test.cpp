@@ -15,7 +15,8 @@
 
 #include "svokit/export/export.hpp"
 #include "svokit/formats/mesh_import.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -82,7 +83,7 @@ Svo Build(const VoxelSet& set, std::uint32_t brick_side = 3) {
   BuildOptions options;
   options.brick_side = brick_side;
   options.contours = false;
-  StatusOr<Svo> svo = BuildSvo(set, nullptr, options);
+  StatusOr<Svo> svo = BuildReferenceSvo(set, nullptr, options);
   if (!svo.ok()) throw std::runtime_error(svo.status().message());
   return std::move(svo).value();
 }

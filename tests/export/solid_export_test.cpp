@@ -18,6 +18,8 @@
 #include "svokit/export/export.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/svo/sample_codec.hpp"
 #include "svokit/voxelize/solid_fill.hpp"

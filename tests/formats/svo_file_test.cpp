@@ -13,7 +13,8 @@
 
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/mesh_import.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/formats/svo_v1_writer.hpp"
 #include "tests/test_util.hpp"
@@ -41,7 +42,7 @@ Svo HandSvo(std::uint32_t side = 3) {
   BuildOptions options;
   options.brick_side = side;
   options.contours = false;
-  auto svo = BuildSvo(set, nullptr, options, R"({"source":"hand","build":"--bricks 3"})");
+  auto svo = BuildReferenceSvo(set, nullptr, options, R"({"source":"hand","build":"--bricks 3"})");
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }
@@ -89,9 +90,9 @@ Svo BuiltTorus(std::uint32_t resolution, std::uint32_t side, bool contours) {
   BuildOptions options;
   options.brick_side = side;
   options.contours = contours;
-  auto svo = BuildSvo(t.voxels, &t.mesh, options,
-                      R"({"source":"uv-torus.obj","voxelize":"--resolution )" +
-                          std::to_string(resolution) + R"("})");
+  auto svo = BuildReferenceSvo(t.voxels, &t.mesh, options,
+                               R"({"source":"uv-torus.obj","voxelize":"--resolution )" +
+                                   std::to_string(resolution) + R"("})");
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }

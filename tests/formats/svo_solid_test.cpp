@@ -20,6 +20,10 @@
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/pipeline/svo_by_pages.hpp"
+#include "svokit/pipeline/svo_parts.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxelize.hpp"
@@ -278,7 +282,7 @@ TEST(SvoSolid, FullLeavesReadBackAsTheInteriorCubes) {
                  std::to_string(c.side));
     const Solid s = MakeSolid(test::Icosphere(4), c.resolution, c.side, c.contours);
     ASSERT_EQ(s.interior.method, FillMethod::kColumns);
-    ASSERT_TRUE(s.svo.solid);
+    ASSERT_TRUE(s.svo.frame.shape.solid);
     for (const SvoCompression& compression : {SvoCompression{}, SvoCompression{false, 0}}) {
       SvoFileStats stats;
       const std::vector<std::uint8_t> bytes = EncodeSvo(s.svo, compression, &stats);
@@ -289,8 +293,8 @@ TEST(SvoSolid, FullLeavesReadBackAsTheInteriorCubes) {
       EXPECT_TRUE(*back == AssembleSvo(s.svo));
       // Closed: no node was split, the tree is the surface's.
       const auto surface =
-          LevelKeysFromVoxels(std::span<const std::uint64_t>(s.voxels.keys), s.svo.depth);
-      for (std::uint32_t l = 0; l <= s.svo.depth; ++l) {
+          LevelKeysFromVoxels(std::span<const std::uint64_t>(s.voxels.keys), s.svo.depth());
+      for (std::uint32_t l = 0; l <= s.svo.depth(); ++l) {
         EXPECT_EQ(back->LevelKeys(l), surface[l]) << l;
       }
       EXPECT_EQ(HeadFlags(bytes) & kSolidFlag, kSolidFlag);
@@ -303,7 +307,7 @@ TEST(SvoSolid, FullLeavesReadBackAsTheInteriorCubes) {
         if (sec.name == "full leaves") raw = sec.raw;
       }
       std::uint64_t nodes = 0;
-      for (std::uint32_t l = 0; l < s.svo.depth; ++l) nodes += s.svo.NodeCount(l);
+      for (std::uint32_t l = 0; l < s.svo.depth(); ++l) nodes += s.svo.NodeCount(l);
       EXPECT_EQ(raw, nodes);
       auto lenient = DecodeSvoLenient(bytes, "solid.svo");
       ASSERT_TRUE(lenient.ok());
@@ -316,7 +320,7 @@ TEST(SvoSolid, FullLeavesReadBackAsTheInteriorCubes) {
     auto read = ReadSvo(dir / "s.svo");
     ASSERT_TRUE(read.ok()) << read.status().message();
     ExpectSolidOctree(*read, s);
-    for (std::uint32_t k = 0; k < s.svo.depth; ++k) {
+    for (std::uint32_t k = 0; k < s.svo.depth(); ++k) {
       auto top = ReadSvo(dir / "s.svo", k);
       ASSERT_TRUE(top.ok()) << k << ": " << top.status().message();
       EXPECT_TRUE(top->solid);
@@ -338,8 +342,8 @@ TEST(SvoSolid, SurfaceFilesCarryNoFullLeaves) {
   bo.contours = false;
   auto svo = BuildCompactSvo(*voxels, &sphere, bo);
   ASSERT_TRUE(svo.ok());
-  EXPECT_FALSE(svo->solid);
-  EXPECT_TRUE(svo->tree.full.empty());
+  EXPECT_FALSE(svo->frame.shape.solid);
+  EXPECT_TRUE(svo->whole.tree.full.empty());
   SvoFileStats stats;
   const std::vector<std::uint8_t> bytes = EncodeSvo(*svo, {}, &stats);
   EXPECT_EQ(HeadFlags(bytes) & kSolidFlag, 0u);
@@ -373,7 +377,7 @@ void ExpectOpenSolid(const Mesh& mesh, std::uint32_t resolution, bool expect_spl
   // Split nodes: not nodes of the surface, each holding full leaves only; every other node is one
   // of the surface's.
   const auto surface =
-      LevelKeysFromVoxels(std::span<const std::uint64_t>(s.voxels.keys), s.svo.depth);
+      LevelKeysFromVoxels(std::span<const std::uint64_t>(s.voxels.keys), s.svo.depth());
   std::uint64_t split = 0;
   for (std::uint32_t l = 0; l < back->depth; ++l) {
     const std::vector<std::uint64_t> keys = back->LevelKeys(l);
@@ -415,7 +419,7 @@ TEST(SvoSolid, PagedSolidsHaveFullLeavesInTheTopChunkAndBuildByPagesAlike) {
   const Mesh sphere = test::Icosphere(4, false);
   const std::uint32_t resolution = 400;  // depth 9, pages below level 2; one page cube is inside
   const Solid s = MakeSolid(sphere, resolution, 0, false, false);
-  ASSERT_EQ(s.svo.depth, 9u);
+  ASSERT_EQ(s.svo.depth(), 9u);
   const std::vector<std::uint8_t> bytes = EncodeSvo(s.svo);
   auto reader = SvoReader::FromBytes(bytes, "ball.svo");
   ASSERT_TRUE(reader.ok()) << reader.status().message();
@@ -516,11 +520,11 @@ void ExpectRefused(const CompactSvo& svo, const std::string& expect, bool whole_
 TEST(SvoSolid, AFullLeafThatIsAlsoAChildIsRefused) {
   const Solid s = MakeSolid(test::Icosphere(4), 64, 3, false);
   // At the root, at the page level's parent and just above the voxels.
-  for (const std::uint32_t level : {0u, 3u, s.svo.depth - 1}) {
+  for (const std::uint32_t level : {0u, 3u, s.svo.depth() - 1}) {
     CompactSvo bad = s.svo;
-    std::vector<std::uint8_t>& masks = bad.tree.masks[level];
+    std::vector<std::uint8_t>& masks = bad.whole.tree.masks[level];
     const std::size_t node = masks.size() / 2;
-    bad.tree.full[level][node] |= static_cast<std::uint8_t>(masks[node] & -masks[node]);
+    bad.whole.tree.full[level][node] |= static_cast<std::uint8_t>(masks[node] & -masks[node]);
     ExpectRefused(bad, "both full and not");
   }
 }
@@ -530,11 +534,11 @@ TEST(SvoSolid, ANodeWithNeitherChildrenNorFullLeavesIsRefused) {
   // A split cube's node with its full leaves cleared: an empty node.
   CompactSvo bad = s.svo;
   bool found = false;
-  for (std::uint32_t l = 0; l < bad.depth && !found; ++l) {
-    for (std::size_t i = 0; i < bad.tree.masks[l].size() && !found; ++i) {
-      if (bad.tree.masks[l][i] == 0) {
-        ASSERT_NE(bad.tree.full[l][i], 0);
-        bad.tree.full[l][i] = 0;
+  for (std::uint32_t l = 0; l < bad.depth() && !found; ++l) {
+    for (std::size_t i = 0; i < bad.whole.tree.masks[l].size() && !found; ++i) {
+      if (bad.whole.tree.masks[l][i] == 0) {
+        ASSERT_NE(bad.whole.tree.full[l][i], 0);
+        bad.whole.tree.full[l][i] = 0;
         found = true;
       }
     }
@@ -557,8 +561,8 @@ TEST(SvoSolid, HeadFlagAndFullLeafStreamMustAgree) {
       << unflagged.status().message();
 
   CompactSvo surface = s.svo;
-  surface.solid = false;
-  surface.tree.full.clear();
+  surface.frame.shape.solid = false;
+  surface.whole.tree.full.clear();
   const std::vector<std::uint8_t> plain = EncodeSvo(surface);
   ASSERT_TRUE(DecodeSvo(plain, "plain.svo").ok());
   auto flagged = DecodeSvo(WithHeadFlags(plain, HeadFlags(plain) | kSolidFlag), "bad.svo");
@@ -577,10 +581,10 @@ TEST(SvoSolid, HeadFlagAndFullLeafStreamMustAgree) {
 TEST(SvoSolid, AFullLeafOutsideTheGridIsRefused) {
   // The torus' grid is 64 × 17 × 64: the root's children with y = 1 (y ≥ 32) lie outside it.
   const Solid s = MakeSolid(Imported(test::DataDir() / "uv-torus.obj"), 64, 3, false);
-  ASSERT_EQ(s.svo.grid.dims()[1], 17u);
-  ASSERT_EQ(s.svo.tree.masks[0][0] & 0xcc, 0) << "no root child above y = 32 expected";
+  ASSERT_EQ(s.svo.frame.grid.dims()[1], 17u);
+  ASSERT_EQ(s.svo.whole.tree.masks[0][0] & 0xcc, 0) << "no root child above y = 32 expected";
   CompactSvo bad = s.svo;
-  bad.tree.full[0][0] |= 0x04;  // child (0, 1, 0): voxels (0..31, 32..63, 0..31)
+  bad.whole.tree.full[0][0] |= 0x04;  // child (0, 1, 0): voxels (0..31, 32..63, 0..31)
   ExpectRefused(bad, "outside the grid", /*whole_file=*/true);
 }
 

@@ -18,6 +18,8 @@
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/formats/svo_v1_writer.hpp"
@@ -115,7 +117,7 @@ TEST(SvoFileV2, LevelsDownToAnyLevel) {
   const auto bytes = EncodeSvo(b.svo);
   auto whole = DecodeSvo(bytes, "t.svo");
   ASSERT_TRUE(whole.ok());
-  for (std::uint32_t k = 0; k <= b.svo.depth; ++k) {
+  for (std::uint32_t k = 0; k <= b.svo.depth(); ++k) {
     auto top = DecodeSvo(bytes, "t.svo", k);
     ASSERT_TRUE(top.ok()) << k << ": " << top.status().message();
     ASSERT_EQ(top->levels.size(), k + 1);
@@ -379,7 +381,7 @@ TEST(SvoReader, FileStatsByLevelSplitEachKindOfArrayExactly) {
     const auto split = reader->FileStats(true);
     ASSERT_TRUE(whole.ok() && split.ok());
     EXPECT_TRUE(whole->levels.empty());
-    const std::uint32_t depth = b.svo.depth;
+    const std::uint32_t depth = b.svo.depth();
     ASSERT_EQ(split->levels.size(), depth + 1);
     ASSERT_EQ(split->sections.size(), whole->sections.size());
     const auto at = [&](std::uint32_t level, const std::string& name) {
@@ -418,7 +420,7 @@ TEST(SvoReader, FileStatsByLevelSplitEachKindOfArrayExactly) {
     for (std::uint32_t l = 0; l < depth; ++l) {
       EXPECT_EQ(at(l, "masks").raw, b.svo.NodeCount(l)) << l;
       EXPECT_EQ(at(l, "opacity").raw, samples[l]) << l;
-      EXPECT_GE(samples[l], b.svo.layouts[l].size()) << l;
+      EXPECT_GE(samples[l], b.svo.whole.layouts[l].size()) << l;
       EXPECT_EQ(at(l, "voxel normals").raw, 0u) << l;
       EXPECT_GT(at(l, "contours").raw, 0u) << l;
     }

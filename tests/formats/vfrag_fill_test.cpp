@@ -221,7 +221,8 @@ std::vector<std::uint8_t> WithSection(const std::vector<std::uint8_t>& file, con
 TEST(VfragFill, SolidFileWrittenInPlaceHoldsTheInterior) {
   const Filled f = Fill(test::Icosphere(3), 64);
   test::TempDir dir;
-  const VfragMetadata meta{"ico.obj", "--resolution 64 --fill solid", 1280};
+  const Provenance meta{"ico.obj", 1280, GridFit{64},
+                        VoxelizeSettings{VoxelMode::kConservative, true, true, true}};
   VoxelizeOptions vo;
   vo.colors = vo.normals = true;
   {

@@ -30,8 +30,8 @@ VoxelSet Sample() {
 
 TEST(Vfrag, RoundTripIsExact) {
   const VoxelSet s = Sample();
-  const auto bytes = EncodeVfrag(s, {"m.obj", "--resolution 7"});
-  EXPECT_EQ(EncodeVfrag(s, {"m.obj", "--resolution 7"}), bytes);
+  const auto bytes = EncodeVfrag(s, {"m.obj", 0, GridFit{7}});
+  EXPECT_EQ(EncodeVfrag(s, {"m.obj", 0, GridFit{7}}), bytes);
   auto back = DecodeVfrag(bytes, "mem.vfrag");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->grid, s.grid);
@@ -105,10 +105,9 @@ TEST(Vfrag, AConsumedSetWritesTheSameFile) {
   s.colors.assign(1, Rgba{0.25f, 0.5f, 0.75f, 1});
   for (const bool shared_normal : {false, true}) {
     if (shared_normal) s.normals.assign(s.size(), Vec3f{0, 0, 1});
-    const std::vector<std::uint8_t> expected = EncodeVfrag(s, {"m.obj", "--resolution 4096"});
+    const std::vector<std::uint8_t> expected = EncodeVfrag(s, {"m.obj", 0, GridFit{4096}});
     VoxelSet consumed = s;
-    ASSERT_TRUE(
-        WriteVfrag(std::move(consumed), {"m.obj", "--resolution 4096"}, dir / "c.vfrag").ok());
+    ASSERT_TRUE(WriteVfrag(std::move(consumed), {"m.obj", 0, GridFit{4096}}, dir / "c.vfrag").ok());
     EXPECT_EQ(consumed.size(), 0u);
     EXPECT_TRUE(consumed.normals.empty());
     const auto written = ReadFileBytes(dir / "c.vfrag");
@@ -122,7 +121,7 @@ TEST(Vfrag, AConsumedSetWritesTheSameFile) {
     const PackedVoxelSet packed = Packed(s);
     EXPECT_GT(packed.key_gaps.size(), s.size());
     EXPECT_LT(packed.key_gaps.size(), 2 * s.size());
-    EXPECT_TRUE(EncodeVfrag(packed, {"m.obj", "--resolution 4096"}) == expected);
+    EXPECT_TRUE(EncodeVfrag(packed, {"m.obj", 0, GridFit{4096}}) == expected);
   }
   // Keys whose gaps are all the same byte are still stored one per voxel (only attributes every
   // voxel shares are stored once).
@@ -377,7 +376,7 @@ TEST(Vfrag, EveryFlippedByteIsDetected) {
     s.normals.push_back(Vec3f{0, 0, 1});
     s.coverage.push_back(static_cast<float>(i));
   }
-  const auto clean = EncodeVfrag(s, {"m.obj", "--resolution 7"});
+  const auto clean = EncodeVfrag(s, {"m.obj", 0, GridFit{7}});
   for (std::size_t i = 0; i < clean.size(); ++i) {
     auto bytes = clean;
     bytes[i] ^= 0x08;
@@ -433,8 +432,8 @@ TEST(Vfrag, PlyPointsAreVoxelCentres) {
 // The source name goes into the META JSON: one that is not UTF-8 is escaped, not thrown on.
 TEST(Vfrag, NonUtf8SourceNameIsEscaped) {
   std::vector<std::uint8_t> bytes;
-  ASSERT_NO_THROW(bytes = EncodeVfrag(Sample(), {"\xFF.svm", "--resolution 7"}));
-  VfragMetadata meta;
+  ASSERT_NO_THROW(bytes = EncodeVfrag(Sample(), {"\xFF.svm", 0, GridFit{7}}));
+  Provenance meta;
   ASSERT_TRUE(DecodeVfrag(bytes, "mem.vfrag", &meta).ok());
   EXPECT_EQ(meta.source, "\\xFF.svm");
 }

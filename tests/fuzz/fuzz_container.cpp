@@ -71,7 +71,7 @@ void Decode(std::span<const std::uint8_t> bytes) {
     ExpectAccepted(mesh.status(), bytes.size());
     if (mesh.ok()) CheckMesh(*mesh);
   } else if constexpr (kFormat == "vfrag") {
-    VfragMetadata meta;
+    Provenance meta;
     StatusOr<VoxelSet> set = DecodeVfrag(bytes, "fuzz.vfrag", &meta);
     ExpectAccepted(set.status(), bytes.size());
     if (set.ok()) {

@@ -25,6 +25,8 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/formats/svo_v1_writer.hpp"
@@ -239,7 +241,7 @@ void ChainFiles() {
     options.colors = options.normals = resolution > 4;
     auto voxels = svokit::Voxelize(mesh, *grid, options);
     if (!voxels.ok()) continue;
-    const auto vfrag = svokit::EncodeVfrag(*voxels, {"tetra", fmt::format("-r {}", resolution)});
+    const auto vfrag = svokit::EncodeVfrag(*voxels, {"tetra", 0, svokit::GridFit{resolution}});
     Put("vfrag", fmt::format("tetra-{}.vfrag", resolution), Bytes(vfrag.data(), vfrag.size()));
     svokit::BuildOptions build;
     build.brick_side = resolution > 4 ? 3 : 0;

@@ -14,6 +14,8 @@
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/mesh_report.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 

@@ -9,7 +9,8 @@
 #include <vector>
 
 #include "svokit/formats/mesh_import.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"
@@ -29,7 +30,7 @@ inline Svo BuildScene(const Mesh& mesh, std::uint32_t resolution, bool attribute
   if (!voxels.ok()) return {};
   BuildOptions bo;
   bo.contours = contours;
-  auto svo = BuildSvo(*voxels, contours ? &mesh : nullptr, bo, R"({"source":"test"})");
+  auto svo = BuildReferenceSvo(*voxels, contours ? &mesh : nullptr, bo, R"({"source":"test"})");
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   if (voxels_out) *voxels_out = std::move(*voxels);
   return svo.ok() ? std::move(*svo) : Svo{};

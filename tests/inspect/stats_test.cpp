@@ -13,6 +13,8 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/mesh/image_codec.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit {
@@ -34,7 +36,8 @@ Svo TinyOctree() {
   }
   BuildOptions options;
   options.contours = false;
-  auto svo = BuildSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
+  auto svo =
+      BuildReferenceSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }

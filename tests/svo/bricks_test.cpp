@@ -26,7 +26,8 @@
 
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/mesh_import.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -66,7 +67,7 @@ Svo Build(std::uint32_t n, std::vector<HandVoxel> voxels, std::uint32_t side = 3
   BuildOptions options;
   options.brick_side = side;
   options.contours = false;
-  auto svo = BuildSvo(set, nullptr, options);
+  auto svo = BuildReferenceSvo(set, nullptr, options);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }
@@ -642,7 +643,7 @@ RealSvo TorusSvo(std::uint32_t side) {
   BuildOptions build;
   build.brick_side = side;
   build.contours = false;
-  auto svo = BuildSvo(*voxels, nullptr, build);
+  auto svo = BuildReferenceSvo(*voxels, nullptr, build);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   if (!svo.ok()) return r;
   r.svo = std::move(*svo);
@@ -701,6 +702,9 @@ void CheckSharedBorders(const RealSvo& r) {
 // from the finer bricks alone: the finer sample at a lattice point is that of any finer node whose
 // closed cube holds it (all agree, CheckSharedBorders), or 0.
 void CheckParentsAreTents(const RealSvo& r) {
+  struct TentSum {  // opacity, and colour and normal weighted by it
+    float opacity = 0, r = 0, g = 0, b = 0, a = 0, nx = 0, ny = 0, nz = 0;
+  };
   const Svo& svo = r.svo;
   const auto side = static_cast<std::int64_t>(svo.brick_side);
   const std::int64_t cell = side - 1;
@@ -725,7 +729,7 @@ void CheckParentsAreTents(const RealSvo& r) {
             // The parent's lattice point in finer spacings is twice its own lattice point.
             const std::int64_t px = 2 * (c.x * cell + sx), py = 2 * (c.y * cell + sy),
                                pz = 2 * (c.z * cell + sz);
-            PremultipliedSample acc;
+            TentSum acc;
             for (int dz = 0; dz < 3; ++dz)
               for (int dy = 0; dy < 3; ++dy)
                 for (int dx = 0; dx < 3; ++dx) {
@@ -817,8 +821,8 @@ TEST(Bricks, AColourHeldOnceBuildsTheBricksOfTheSameColourPerVoxel) {
   per_voxel.colors.assign(per_voxel.size(), once->colors[0]);
   BuildOptions build;
   build.contours = false;
-  auto a = BuildSvo(*once, nullptr, build);
-  auto b = BuildSvo(per_voxel, nullptr, build);
+  auto a = BuildReferenceSvo(*once, nullptr, build);
+  auto b = BuildReferenceSvo(per_voxel, nullptr, build);
   ASSERT_TRUE(a.ok() && b.ok());
   ASSERT_EQ(a->levels.size(), b->levels.size());
   for (std::size_t l = 0; l < a->levels.size(); ++l) {
@@ -841,7 +845,7 @@ TEST(Bricks, RealMeshVoxelSamplesFollowTheDefinition) {
   ASSERT_TRUE(voxels.ok());
   BuildOptions build;
   build.contours = false;
-  auto svo = BuildSvo(*voxels, nullptr, build);
+  auto svo = BuildReferenceSvo(*voxels, nullptr, build);
   ASSERT_TRUE(svo.ok());
   std::unordered_map<std::uint64_t, std::size_t> index;
   for (std::size_t i = 0; i < voxels->keys.size(); ++i) index[voxels->keys[i]] = i;

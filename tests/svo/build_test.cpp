@@ -2,8 +2,6 @@
 // first-child + popcount addressing and breadth-first Morton order, checked against octrees worked
 // out by hand; rejected inputs; determinism over thread counts on a real voxelized mesh.
 
-#include "svokit/svo/build.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +14,8 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -53,7 +53,7 @@ BuildOptions NoContours(std::uint32_t side = 3) {
 }
 
 Svo BuildOk(const VoxelSet& set, const BuildOptions& options, const Mesh* mesh = nullptr) {
-  auto svo = BuildSvo(set, mesh, options);
+  auto svo = BuildReferenceSvo(set, mesh, options);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }
@@ -249,7 +249,7 @@ TEST(SvoBuild, FullGridHasEveryChild) {
 TEST(SvoBuild, MetadataAndModeAreKept) {
   VoxelSet set = MakeSet(Grid(3, 3, 3), {{1, 2, 0}});
   set.mode = VoxelMode::kThin;
-  auto svo = BuildSvo(set, nullptr, NoContours(), R"({"source":"x.obj"})");
+  auto svo = BuildReferenceSvo(set, nullptr, NoContours(), R"({"source":"x.obj"})");
   ASSERT_TRUE(svo.ok()) << svo.status().message();
   EXPECT_EQ(svo->metadata, R"({"source":"x.obj"})");
   EXPECT_EQ(svo->mode, VoxelMode::kThin);
@@ -259,13 +259,13 @@ TEST(SvoBuild, RejectsEmptySetBadBrickSideContoursWithoutMeshAndAttributeMismatc
   const VoxelSet good = MakeSet(Grid(4, 4, 4), {{1, 1, 1}, {2, 2, 2}});
   VoxelSet empty;
   empty.grid = Grid(4, 4, 4);
-  auto r = BuildSvo(empty, nullptr, NoContours());
+  auto r = BuildReferenceSvo(empty, nullptr, NoContours());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
   EXPECT_NE(r.status().message().find("empty"), std::string::npos) << r.status().message();
 
   for (std::uint32_t side : {1u, 4u, 27u}) {
-    r = BuildSvo(good, nullptr, NoContours(side));
+    r = BuildReferenceSvo(good, nullptr, NoContours(side));
     ASSERT_FALSE(r.ok()) << side;
     EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
     EXPECT_NE(r.status().message().find("bricks"), std::string::npos) << r.status().message();
@@ -273,7 +273,7 @@ TEST(SvoBuild, RejectsEmptySetBadBrickSideContoursWithoutMeshAndAttributeMismatc
 
   BuildOptions contours;
   contours.contours = true;
-  r = BuildSvo(good, nullptr, contours);
+  r = BuildReferenceSvo(good, nullptr, contours);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
   EXPECT_NE(r.status().message().find("mesh"), std::string::npos) << r.status().message();
@@ -282,12 +282,12 @@ TEST(SvoBuild, RejectsEmptySetBadBrickSideContoursWithoutMeshAndAttributeMismatc
   const VoxelSet three = MakeSet(Grid(4, 4, 4), {{1, 1, 1}, {2, 2, 2}, {3, 3, 3}});
   VoxelSet short_colors = three;
   short_colors.colors.pop_back();
-  r = BuildSvo(short_colors, nullptr, NoContours());
+  r = BuildReferenceSvo(short_colors, nullptr, NoContours());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
   VoxelSet short_normals = good;
   short_normals.normals.pop_back();
-  EXPECT_FALSE(BuildSvo(short_normals, nullptr, NoContours()).ok());
+  EXPECT_FALSE(BuildReferenceSvo(short_normals, nullptr, NoContours()).ok());
 }
 
 // The sample torus voxelized at 64 with colours and normals (shared by the tests below).

@@ -14,6 +14,10 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
+#include "svokit/svo/reference_build.hpp"
+#include "svokit/svo/svo_assembler.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -59,7 +63,7 @@ void ExpectSameAsReference(const Mesh& mesh, const Case& c) {
   BuildOptions bo;
   bo.brick_side = c.side;
   bo.contours = c.contours;
-  auto reference = BuildSvo(*voxels, &mesh, bo);
+  auto reference = BuildReferenceSvo(*voxels, &mesh, bo);
   ASSERT_TRUE(reference.ok());
   for (const std::size_t threads : {1u, 2u}) {
     ThreadLimit limit(threads);
@@ -123,7 +127,7 @@ TEST(CompactSvo, AssemblesToTheReferenceOctreeOnRandomVoxelClouds) {
       BuildOptions bo;
       bo.brick_side = side;
       bo.contours = false;
-      auto reference = BuildSvo(set, nullptr, bo);
+      auto reference = BuildReferenceSvo(set, nullptr, bo);
       auto compact = BuildCompactSvo(set, nullptr, bo);
       ASSERT_TRUE(reference.ok() && compact.ok());
       EXPECT_EQ(Difference(AssembleSvo(*compact), *reference), "")
@@ -135,15 +139,15 @@ TEST(CompactSvo, AssemblesToTheReferenceOctreeOnRandomVoxelClouds) {
 // An octree cut into pages at any level and joined again is the octree: every page's samples laid
 // out over its own nodes, its voxel bricks computed from its voxels and halo.
 Svo JoinedPages(const CompactSvo& svo, std::uint32_t page_level) {
-  SvoAssembler assembler(Shape(svo), svo.depth);
+  SvoAssembler assembler(svo.frame.shape, svo.depth());
   assembler.Append(TopChunk(svo, page_level));
-  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.whole.tree, page_level);
   std::vector<std::uint64_t> keys = {0};
   for (std::uint32_t l = 0; l < page_level; ++l) {
     std::vector<std::uint64_t> next;
     for (std::size_t i = 0; i < keys.size(); ++i) {
       for (unsigned c = 0; c < 8; ++c) {
-        if (svo.tree.masks[l][i] >> c & 1u) next.push_back(keys[i] << 3 | c);
+        if (svo.whole.tree.masks[l][i] >> c & 1u) next.push_back(keys[i] << 3 | c);
       }
     }
     keys = std::move(next);
@@ -151,7 +155,7 @@ Svo JoinedPages(const CompactSvo& svo, std::uint32_t page_level) {
   for (std::size_t p = 0; p < keys.size(); ++p) {
     assembler.Append(PageChunk(svo, page_level, p, nbs[p], keys[p]));
   }
-  return assembler.Finish(svo.grid, svo.mode, svo.metadata);
+  return assembler.Finish(svo.frame.grid, svo.frame.mode, svo.frame.metadata);
 }
 
 TEST(SvoPages, PagesAtEveryLevelJoinToTheOctree) {
@@ -168,7 +172,7 @@ TEST(SvoPages, PagesAtEveryLevelJoinToTheOctree) {
     auto compact = BuildCompactSvo(*voxels, &*mesh, bo);
     ASSERT_TRUE(compact.ok());
     const Svo whole = AssembleSvo(*compact);
-    for (std::uint32_t page_level = 0; page_level < compact->depth; ++page_level) {
+    for (std::uint32_t page_level = 0; page_level < compact->depth(); ++page_level) {
       EXPECT_EQ(Difference(JoinedPages(*compact, page_level), whole), "")
           << "side " << side << ", page level " << page_level;
     }
@@ -191,14 +195,14 @@ TEST(SvoPages, PagesAreSubtreesOf128CubedVoxels) {
   bo.contours = false;
   auto compact = BuildCompactSvo(*voxels, nullptr, bo);
   ASSERT_TRUE(compact.ok());
-  const std::uint32_t level = PageLevel(compact->depth);
+  const std::uint32_t level = PageLevel(compact->depth());
   ASSERT_EQ(level, 2u);
-  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->tree, level);
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->whole.tree, level);
   ASSERT_GT(nbs.size(), 8u);
   std::uint64_t voxels_in_pages = 0;
   for (std::size_t p = 0; p < nbs.size(); ++p) {
     const SvoChunk page = PageChunk(*compact, level, p, nbs[p], 0);
-    const std::uint64_t n = page.tree.NodeCount(compact->depth);
+    const std::uint64_t n = page.tree.NodeCount(compact->depth());
     EXPECT_GT(n, 0u);
     voxels_in_pages += n;
   }
@@ -216,9 +220,9 @@ TEST(SvoPages, TheHaloIsTheVoxelsTouchingThePage) {
   bo.contours = false;
   auto compact = BuildCompactSvo(*voxels, nullptr, bo);
   ASSERT_TRUE(compact.ok());
-  const std::uint32_t page_level = 3, shift = 3 * (compact->depth - page_level);
-  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->tree, page_level);
-  const auto keys = LevelKeysFromVoxels(voxels->keys, compact->depth);
+  const std::uint32_t page_level = 3, shift = 3 * (compact->depth() - page_level);
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->whole.tree, page_level);
+  const auto keys = LevelKeysFromVoxels(voxels->keys, compact->depth());
   std::set<std::uint64_t> all(voxels->keys.begin(), voxels->keys.end());
   std::size_t halos = 0;
   for (std::size_t p = 0; p < keys[page_level].size(); ++p) {
@@ -262,22 +266,22 @@ TEST(CompactSvo, EveryLatticePointIsStoredOnce) {
     bo.contours = false;
     auto compact = BuildCompactSvo(*voxels, nullptr, bo);
     ASSERT_TRUE(compact.ok());
-    const auto keys = LevelKeysFromVoxels(voxels->keys, compact->depth);
-    for (std::uint32_t l = 0; l < compact->depth; ++l) {
+    const auto keys = LevelKeysFromVoxels(voxels->keys, compact->depth());
+    for (std::uint32_t l = 0; l < compact->depth(); ++l) {
       std::map<std::uint64_t, std::uint64_t> stored_at;  // lattice point → stored index
-      const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->tree, l);
+      const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(compact->whole.tree, l);
       for (std::size_t i = 0; i < keys[l].size(); ++i) {
         const MortonCoord c = MortonDecode(keys[l][i]);
         for (unsigned s = 0; s < side * side * side; ++s) {
           const std::uint32_t k[3] = {s % side, s / side % side, s / (side * side)};
           const std::uint64_t point = MortonEncode((side - 1) * c.x + k[0], (side - 1) * c.y + k[1],
                                                    (side - 1) * c.z + k[2]);
-          const std::uint64_t at = SampleIndex(compact->layouts[l], nbs[i], s);
+          const std::uint64_t at = SampleIndex(compact->whole.layouts[l], nbs[i], s);
           const auto [it, inserted] = stored_at.emplace(point, at);
           ASSERT_EQ(it->second, at) << "level " << l << ": a point stored twice";
         }
       }
-      EXPECT_EQ(stored_at.size(), compact->layouts[l].size()) << "level " << l;
+      EXPECT_EQ(stored_at.size(), compact->whole.layouts[l].size()) << "level " << l;
       std::set<std::uint64_t> indices;
       for (const auto& [point, at] : stored_at) indices.insert(at);
       EXPECT_EQ(indices.size(), stored_at.size()) << "level " << l << ": two points, one index";

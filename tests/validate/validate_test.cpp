@@ -18,8 +18,10 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
+#include "svokit/svo/reference_build.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
 #include "svokit/voxelize/voxelize.hpp"
@@ -76,7 +78,7 @@ Svo Build(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3, bool
   BuildOptions options;
   options.brick_side = side;
   options.contours = contours;
-  auto svo = BuildSvo(voxels, &mesh, options);
+  auto svo = BuildReferenceSvo(voxels, &mesh, options);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }

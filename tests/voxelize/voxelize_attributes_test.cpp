@@ -355,7 +355,7 @@ TEST(VfragFileWriter, WritesTheBytesOfWriteVfrag) {
                         {&sphere, 100, true, true, VoxelMode::kConservative},
                         {&square, 61, true, true, VoxelMode::kConservative},
                         {&square, 61, false, false, VoxelMode::kConservative}};
-  const VfragMetadata meta{"mesh.obj", "--resolution N"};
+  const Provenance meta{"mesh.obj", 0, GridFit{1024}};
   for (const Case& c : cases) {
     auto grid = GridTransform::FitResolution(c.mesh->Bounds(), c.resolution);
     ASSERT_TRUE(grid.ok());

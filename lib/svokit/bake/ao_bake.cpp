@@ -11,6 +11,7 @@
 #include "svokit/core/hash.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/svo/sample_codec.hpp"
 
 namespace svokit {
@@ -40,19 +41,6 @@ Vec3d VoxelNormal(const Svo& svo, std::uint64_t voxel) {
     sum = sum + Vec3d{n.x, n.y, n.z} * DecodeUnorm8(level.opacity[first + s]);
   }
   return Normalized(sum);
-}
-
-// The number after `key` in the metadata (`--resolution 512` in the recorded options, or the
-// JSON member `"triangles":2304`), if there is one.
-std::optional<double> RecordedNumber(const std::string& metadata, std::string_view key) {
-  const bool member = key.back() == ':';
-  const std::size_t at = metadata.find(member ? std::string(key) : std::string(key) + " ");
-  if (at == std::string::npos) return std::nullopt;
-  const char* begin = metadata.c_str() + at + key.size() + (member ? 0 : 1);
-  char* end = nullptr;
-  const double value = std::strtod(begin, &end);
-  if (end == begin || !std::isfinite(value)) return std::nullopt;
-  return value;
 }
 
 }  // namespace
@@ -343,26 +331,19 @@ Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<c
 }
 
 Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name) {
-  if (const std::optional<double> triangles = RecordedNumber(svo.metadata, "\"triangles\":");
-      triangles && *triangles != static_cast<double>(mesh.triangle_count())) {
+  const Provenance recorded = ParseProvenance(svo.metadata);
+  if (recorded.triangles > 0 && recorded.triangles != mesh.triangle_count()) {
     return Status::BadInput(
         "{}: the mesh has {} triangles, the octree's {}: not the mesh it was voxelized from",
-        mesh_name, mesh.triangle_count(), static_cast<std::uint64_t>(*triangles));
+        mesh_name, mesh.triangle_count(), recorded.triangles);
   }
-  const std::optional<double> resolution = RecordedNumber(svo.metadata, "--resolution");
-  const std::optional<double> voxel_size = RecordedNumber(svo.metadata, "--voxel-size");
-  const double pad = RecordedNumber(svo.metadata, "--pad").value_or(0);
   const Box3d bounds = mesh.Bounds();
-  if (!resolution && !voxel_size) {
-    // No recorded grid options: the mesh must at least lie inside the grid.
+  if (!recorded.grid) {
+    // No recorded grid fit: the mesh must at least lie inside the grid.
     if (svo.grid.GridBounds().Contains(bounds)) return Status::Ok();
     return Status::BadInput("{}: the mesh lies outside the octree's grid: not its mesh", mesh_name);
   }
-  const StatusOr<GridTransform> fitted =
-      resolution
-          ? GridTransform::FitResolution(bounds, static_cast<std::uint32_t>(*resolution),
-                                         static_cast<std::uint32_t>(pad))
-          : GridTransform::FitVoxelSize(bounds, *voxel_size, static_cast<std::uint32_t>(pad));
+  const StatusOr<GridTransform> fitted = recorded.grid->Fit(bounds);
   const GridTransform& g = svo.grid;
   const double tolerance = 1e-6 * g.voxel_size();
   if (!fitted.ok() || fitted->dims() != g.dims() ||
@@ -370,8 +351,7 @@ Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::strin
       Length(fitted->origin() - g.origin()) > tolerance) {
     return Status::BadInput(
         "{}: the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] do not give "
-        "the "
-        "octree's grid: not the mesh it was voxelized from",
+        "the octree's grid: not the mesh it was voxelized from",
         mesh_name, bounds.lo.x, bounds.lo.y, bounds.lo.z, bounds.hi.x, bounds.hi.y, bounds.hi.z);
   }
   return Status::Ok();

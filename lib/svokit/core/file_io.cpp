@@ -430,4 +430,32 @@ std::string ReadFullyAt(int fd, std::uint64_t offset, std::span<std::uint8_t> ou
   return {};
 }
 
+Status CheckOutputPath(const std::filesystem::path& path,
+                       const std::vector<std::string>& extensions,
+                       const std::filesystem::path& input) {
+  const std::string ext = LowerExtension(path);
+  if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+    std::string list;
+    for (const std::string& e : extensions) list += (list.empty() ? "." : ", .") + e;
+    return Status::BadInput("{}: output must be a {} file", path.string(), list);
+  }
+  const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return Status::BadInput("{}: output directory does not exist", path.string());
+  }
+  // Refused before any work: found at the final rename, these cost the whole run.
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::BadInput("{}: is a directory, not a file", path.string());
+  }
+  if (!input.empty() && std::filesystem::equivalent(path, input, ec)) {
+    return Status::BadInput("{}: is the input file; write the output elsewhere", path.string());
+  }
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    return Status::CannotWrite("{}: output directory is not writable ({})", path.string(),
+                               std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
 }  // namespace svokit

@@ -140,6 +140,13 @@ class ScratchFile {
   std::uint64_t size_ = 0;
 };
 
+/// Checks an output path before any work is done: its extension is one of `extensions`, its
+/// directory exists and is writable, and it is neither a directory nor the file `input`, so a long
+/// run never ends in "cannot write" nor replaces its own input.
+Status CheckOutputPath(const std::filesystem::path& path,
+                       const std::vector<std::string>& extensions,
+                       const std::filesystem::path& input = {});
+
 /// Writes `bytes` to `path` atomically.
 Status WriteFileAtomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
 

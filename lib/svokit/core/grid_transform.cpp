@@ -101,4 +101,9 @@ std::uint32_t OctreeDepth(const GridTransform& grid) {
   return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
 }
 
+StatusOr<GridTransform> GridFit::Fit(const Box3d& bounds) const {
+  return resolution > 0 ? GridTransform::FitResolution(bounds, resolution, pad)
+                        : GridTransform::FitVoxelSize(bounds, voxel_size, pad);
+}
+
 }  // namespace svokit

@@ -71,4 +71,15 @@ class GridTransform {
 /// inner node).
 std::uint32_t OctreeDepth(const GridTransform& grid);
 
+/// How a grid is fitted to a mesh's bounds: `resolution` voxels along the longest axis, or (with
+/// resolution 0) voxels of `voxel_size`; and `pad` empty voxels on every side.
+struct GridFit {
+  std::uint32_t resolution = 0;
+  double voxel_size = 0;
+  std::uint32_t pad = 0;
+
+  StatusOr<GridTransform> Fit(const Box3d& bounds) const;
+  bool operator==(const GridFit&) const = default;
+};
+
 }  // namespace svokit

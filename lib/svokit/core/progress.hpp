@@ -72,4 +72,30 @@ class Progress {
   std::vector<Timing> timings_;
 };
 
+/// Runs `work` as the stage `name` of `progress` (one unit) and returns what it returns. A result
+/// that is not ok (a Status or StatusOr) cancels the stage: no "done" line.
+template <class Work>
+auto RunStage(Progress& progress, std::string name, const Work& work) -> decltype(work()) {
+  Progress::Stage stage(progress, std::move(name), 1);
+  auto result = work();
+  if constexpr (requires { result.ok(); }) {
+    if (!result.ok()) stage.Cancel();
+  }
+  return result;
+}
+
+/// The same, with `summarize(result)` appended to the "done" line of a stage that succeeds.
+template <class Work, class Summarize>
+auto RunStage(Progress& progress, std::string name, const Work& work, const Summarize& summarize)
+    -> decltype(work()) {
+  Progress::Stage stage(progress, std::move(name), 1);
+  auto result = work();
+  if (result.ok()) {
+    stage.SetSummary(summarize(result));
+  } else {
+    stage.Cancel();
+  }
+  return result;
+}
+
 }  // namespace svokit

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/importers.hpp"
@@ -45,6 +47,14 @@ StatusOr<Mesh> ImportMesh(const std::filesystem::path& path) {
   if (!mesh.ok()) return mesh;
   SVOKIT_RETURN_IF_ERROR(ValidateAndSanitize(*mesh, name));
   return mesh;
+}
+
+StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path) {
+  return RunStage(
+      progress, "import", [&] { return ImportMesh(path); },
+      [](const StatusOr<Mesh>& mesh) {
+        return fmt::format("{} triangles", mesh->triangle_count());
+      });
 }
 
 }  // namespace svokit

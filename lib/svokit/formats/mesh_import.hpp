@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
 
@@ -19,5 +20,8 @@ const std::vector<std::string>& SupportedMeshExtensions();
 
 /// Reads, triangulates and validates a mesh. Every error message starts with the file name.
 StatusOr<Mesh> ImportMesh(const std::filesystem::path& path);
+
+/// ImportMesh as the "import" stage of `progress`, its line giving the triangle count.
+StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path);
 
 }  // namespace svokit

@@ -3,12 +3,47 @@
 // filter (sample_filter.cpp), which must agree to the last bit: premultiplied sums, the tent, and
 // the encoding of a sample. Internal to lib/svokit/svo.
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
-#include "svokit/svo/bricks.hpp"
 #include "svokit/svo/sample_codec.hpp"
-#include "svokit/svo/sample_filter.hpp"
+#include "svokit/svo/sample_layout.hpp"
+#include "svokit/svo/svo.hpp"
+
+namespace svokit {
+
+/// A sample as the filter sees it: opacity, colour·opacity and normal·opacity, all linear.
+struct PremultipliedSample {
+  float opacity = 0;
+  float r = 0, g = 0, b = 0, a = 0;
+  float nx = 0, ny = 0, nz = 0;
+};
+// Inline: the filter calls them for every sample it reads and writes.
+inline PremultipliedSample Premultiply(const BrickSample& s) {
+  const float o = s.opacity;
+  return {o,
+          s.color.r * o,
+          s.color.g * o,
+          s.color.b * o,
+          s.color.a * o,
+          s.normal.x * o,
+          s.normal.y * o,
+          s.normal.z * o};
+}
+inline BrickSample Unpremultiply(const PremultipliedSample& p) {
+  BrickSample s;
+  s.opacity = p.opacity;
+  if (p.opacity > 0) {
+    const float inv = 1.f / p.opacity;
+    s.color = {p.r * inv, p.g * inv, p.b * inv, p.a * inv};
+    const float len = std::sqrt(p.nx * p.nx + p.ny * p.ny + p.nz * p.nz);
+    if (len > 1e-12f) s.normal = {p.nx / len, p.ny / len, p.nz / len};
+  }
+  return s;
+}
+
+}  // namespace svokit
 
 namespace svokit::brick_math {
 

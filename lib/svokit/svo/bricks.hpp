@@ -9,7 +9,6 @@
 // so a checker can recompute every parent from the file alone. Each sample is a function of its
 // position only, so bricks that share a border store identical values.
 
-#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -29,35 +28,5 @@ void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uin
 /// (the voxels' own colours and normals are not in the file). `level_keys` as for FilterBricks.
 SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
                        std::uint32_t level);
-
-/// A sample as the filter sees it: opacity, colour·opacity and normal·opacity, all linear.
-struct PremultipliedSample {
-  float opacity = 0;
-  float r = 0, g = 0, b = 0, a = 0;
-  float nx = 0, ny = 0, nz = 0;
-};
-// Inline: the filter calls them for every sample it reads and writes.
-inline PremultipliedSample Premultiply(const BrickSample& s) {
-  const float o = s.opacity;
-  return {o,
-          s.color.r * o,
-          s.color.g * o,
-          s.color.b * o,
-          s.color.a * o,
-          s.normal.x * o,
-          s.normal.y * o,
-          s.normal.z * o};
-}
-inline BrickSample Unpremultiply(const PremultipliedSample& p) {
-  BrickSample s;
-  s.opacity = p.opacity;
-  if (p.opacity > 0) {
-    const float inv = 1.f / p.opacity;
-    s.color = {p.r * inv, p.g * inv, p.b * inv, p.a * inv};
-    const float len = std::sqrt(p.nx * p.nx + p.ny * p.ny + p.nz * p.nz);
-    if (len > 1e-12f) s.normal = {p.nx / len, p.ny / len, p.nz / len};
-  }
-  return s;
-}
 
 }  // namespace svokit

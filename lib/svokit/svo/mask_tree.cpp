@@ -1,5 +1,7 @@
 #include "svokit/svo/mask_tree.hpp"
 
+#include <utility>
+
 namespace svokit {
 
 namespace {
@@ -119,6 +121,31 @@ std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std:
     keys.push_back(std::move(next));
   }
   return keys;
+}
+
+std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
+  return std::move(TreeLevelKeys(tree, 0, level).back());
+}
+
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
+                                                            std::uint32_t depth) {
+  std::vector<std::vector<std::uint64_t>> levels(depth + 1);
+  levels[depth] = std::move(keys);
+  for (std::uint32_t l = depth; l-- > 0;) {
+    const std::vector<std::uint64_t>& finer = levels[l + 1];
+    std::vector<std::uint64_t>& coarser = levels[l];
+    // The most a level can hold, reserved once: pages past the keys written are never touched.
+    coarser.reserve(finer.size());
+    for (std::uint64_t k : finer) {
+      if (coarser.empty() || coarser.back() != k >> 3) coarser.push_back(k >> 3);
+    }
+  }
+  return levels;
+}
+
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
+                                                            std::uint32_t depth) {
+  return LevelKeysFromVoxels(std::vector<std::uint64_t>(keys.begin(), keys.end()), depth);
 }
 
 }  // namespace svokit

@@ -53,6 +53,13 @@ struct MaskTree {
   }
 };
 
+/// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending; the voxel
+/// level is `keys` itself (moved in, not copied, where the caller gives it up).
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
+                                                            std::uint32_t depth);
+std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
+                                                            std::uint32_t depth);
+
 /// The tree of `level_keys` (sorted Morton keys per level, level 0 the root, as
 /// LevelKeysFromVoxels gives them) for levels first .. level_keys.size() − 1.
 MaskTree MaskTreeFromKeys(std::span<const std::vector<std::uint64_t>> level_keys,
@@ -62,6 +69,9 @@ MaskTree MaskTreeFromKeys(std::span<const std::vector<std::uint64_t>> level_keys
 /// walked down from the root.
 std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std::uint64_t root_key,
                                                       std::uint32_t last_level);
+
+/// The Morton keys of `level` of a tree whose root has key 0.
+std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level);
 
 /// The neighbourhood of child `c` of a node of `level` whose neighbourhood is `parent`.
 Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,

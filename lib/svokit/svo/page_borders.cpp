@@ -6,6 +6,7 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/brick_math.hpp"
+#include "svokit/svo/sample_filter.hpp"
 
 namespace svokit {
 

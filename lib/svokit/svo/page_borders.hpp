@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "svokit/core/status.hpp"
-#include "svokit/svo/sample_filter.hpp"
-#include "svokit/svo/svo_pages.hpp"
+#include "svokit/svo/sample_layout.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 
 namespace svokit {
 

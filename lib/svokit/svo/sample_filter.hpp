@@ -19,14 +19,6 @@
 
 namespace svokit {
 
-/// One level's distinct samples, in its SampleLayout's order, encoded as SvoLevel's bricks are.
-struct LevelSamples {
-  std::vector<std::uint8_t> opacity;
-  std::vector<std::uint32_t> color;   ///< empty without colour
-  std::vector<std::uint16_t> normal;  ///< empty without normals
-  bool operator==(const LevelSamples&) const = default;
-};
-
 /// What the filter reads of the voxels: their colours (one for all, or one per voxel, in the
 /// order of the tree's last level) and normals, each optional.
 struct VoxelSamplesSource {

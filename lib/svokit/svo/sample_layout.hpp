@@ -29,6 +29,14 @@ struct SampleLayout {
   std::uint64_t size() const { return first.empty() ? 0 : first.back(); }
 };
 
+/// One level's distinct samples, in its SampleLayout's order, encoded as SvoLevel's bricks are.
+struct LevelSamples {
+  std::vector<std::uint8_t> opacity;
+  std::vector<std::uint32_t> color;   ///< empty without colour
+  std::vector<std::uint16_t> normal;  ///< empty without normals
+  bool operator==(const LevelSamples&) const = default;
+};
+
 /// The layout of `level` of `tree` for bricks of `side` (2 or 3); nodes outside the tree count as
 /// absent, so a page's layout is its own.
 SampleLayout LayOutSamples(const MaskTree& tree, std::uint32_t level, std::uint32_t side);

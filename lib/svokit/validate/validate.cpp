@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/mask_tree.hpp"
 #include "svokit/validate/checks.hpp"
 
 namespace svokit::validate {

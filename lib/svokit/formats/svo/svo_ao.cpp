@@ -3,8 +3,6 @@
 
 #include <zstd.h>
 
-#include <nlohmann/json.hpp>
-
 #include "svokit/core/bytes.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 
@@ -99,8 +97,8 @@ bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink,
 
 }  // namespace svo_detail
 
-Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked,
-                     const std::string& bake_options, const std::filesystem::path& output) {
+Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const BakeSettings& bake,
+                     const std::filesystem::path& output) {
   using namespace svo_detail;
   StatusOr<container::Frame> frame = container::Frame::Open(input, kSvoFormat);
   if (!frame.ok()) return frame.status();
@@ -109,13 +107,13 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked,
     return Status::BadInput("{}: a version-{} file; rebuild it to bake into it", input.string(),
                             frame->version());
   }
-  nlohmann::json meta = nlohmann::json::object();
+  Provenance provenance;
   if (const container::Frame::Section* m = frame->Find(kMetadata)) {
-    meta = nlohmann::json::parse(m->bytes.begin(), m->bytes.end(), nullptr, false);
-    if (!meta.is_object()) meta = nlohmann::json::object();
+    provenance = ParseProvenance(
+        std::string_view(reinterpret_cast<const char*>(m->bytes.data()), m->bytes.size()));
   }
-  meta["bake"] = bake_options;
-  std::string meta_text = meta.dump();
+  provenance.bake = bake;
+  const std::string meta_text = ProvenanceJson(provenance);
 
   container::Writer writer(kSvoFormat, frame->flags());
   for (const container::Frame::Section& s : frame->sections()) {

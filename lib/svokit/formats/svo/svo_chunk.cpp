@@ -526,17 +526,13 @@ StatusOr<ChunkBytes> ChunkStreamBytes(std::span<const std::uint8_t> bytes, const
   return out;
 }
 
-StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
-                               const ChunkFrame& frame, const std::string& name) {
-  StatusOr<StreamSet> read = StreamSet::Read(bytes, name);
-  if (!read.ok()) return read.status();
-  const StreamSet& set = *read;
-  SvoChunk chunk;
-  chunk.root_level = frame.root_level;
-  chunk.root_key = frame.root_key;
-  chunk.tree.first_level = frame.root_level;
+namespace {
 
-  // Masks, level by level: each level's node count is the popcount of the one above.
+// The child masks, level by level: each level's node count is the popcount of the one above.
+// Returns the node count of every level held.
+StatusOr<std::vector<std::uint64_t>> DecodeMasks(const StreamSet& set, const SvoShape& shape,
+                                                 const ChunkFrame& frame, const std::string& name,
+                                                 SvoChunk& chunk) {
   const std::uint32_t mask_levels = frame.page ? shape.depth - frame.root_level : frame.levels;
   const Bytes& masks = set[kMasks];
   std::uint64_t at = 0, nodes = 1;
@@ -566,8 +562,14 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
                             masks.size() - at);
   }
   chunk.tree.LinkChildren();
-  // A solid's full leaves: one mask per node above the voxels, disjoint from its children.
-  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kFullMasks, shape.solid ? masks.size() : 0, name));
+  return counts;
+}
+
+// A solid's full leaves: one mask per node above the voxels, disjoint from its children.
+Status DecodeFullMasks(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
+                       const std::string& name, SvoChunk& chunk) {
+  const std::uint64_t mask_bytes = set[kMasks].size();
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kFullMasks, shape.solid ? mask_bytes : 0, name));
   if (shape.solid) {
     const Bytes& full = set[kFullMasks];
     std::uint64_t from = 0;
@@ -589,8 +591,13 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
       from += level.size();
     }
   }
+  return Status::Ok();
+}
 
-  // Contours.
+// The contour words, delta-coded against the previous word, of the nodes whose bit is set.
+Status DecodeContours(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
+                      std::span<const std::uint64_t> counts, const std::string& name,
+                      SvoChunk& chunk) {
   std::uint64_t contour_count = 0, bit_bytes = 0;
   for (std::uint32_t k = 0; k < frame.levels; ++k) bit_bytes += (counts[k] + 7) / 8;
   if (shape.has_contours) SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourBits, bit_bytes, name));
@@ -630,8 +637,13 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
     }
     bit += (counts[k] + 7) / 8 * 8;
   }
+  return Status::Ok();
+}
 
-  // Samples, laid out over the chunk's own nodes.
+// The distinct samples, laid out over the chunk's own nodes; colours and normals of the
+// non-empty ones, delta-coded.
+Status DecodeSamples(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
+                     const std::string& name, SvoChunk& chunk) {
   const std::uint32_t sample_levels =
       shape.brick_side == 0 ? 0 : std::min(frame.levels, shape.depth - frame.root_level);
   std::uint64_t samples = 0;
@@ -671,9 +683,13 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
     }
     sample += n;
   }
+  return Status::Ok();
+}
 
-  // A page's voxels and halo.
-  const std::uint64_t voxels = frame.page ? counts.back() : 0;
+// A page's voxels' colours and normals.
+Status DecodeVoxels(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
+                    std::uint64_t voxel_count, const std::string& name, SvoChunk& chunk) {
+  const std::uint64_t voxels = frame.page ? voxel_count : 0;
   const bool per_voxel_colors = shape.has_color && shape.shared_color.empty();
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kVoxelColors, per_voxel_colors ? 8 * voxels : 0, name));
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kVoxelNormals, shape.has_normal ? 4 * voxels : 0, name));
@@ -685,6 +701,13 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
     chunk.normals.resize(voxels);
     FromDeltaLanes(set[kVoxelNormals], chunk.normals);
   }
+  return Status::Ok();
+}
+
+// A page's halo: keys ascending, each next to the page, with their colours and normals.
+Status DecodeHalo(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
+                  const std::string& name, SvoChunk& chunk) {
+  const bool per_voxel_colors = shape.has_color && shape.shared_color.empty();
   const Bytes& halo = set[kHaloKeys];
   if (!halo.empty()) {
     if (!frame.page) return Status::BadInput("{}: the top chunk has a halo", name);
@@ -727,6 +750,27 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
     chunk.halo_normals.resize(halo_count);
     FromDeltaLanes(set[kHaloNormals], chunk.halo_normals);
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
+                               const ChunkFrame& frame, const std::string& name) {
+  StatusOr<StreamSet> read = StreamSet::Read(bytes, name);
+  if (!read.ok()) return read.status();
+  const StreamSet& set = *read;
+  SvoChunk chunk;
+  chunk.root_level = frame.root_level;
+  chunk.root_key = frame.root_key;
+  chunk.tree.first_level = frame.root_level;
+  StatusOr<std::vector<std::uint64_t>> counts = DecodeMasks(set, shape, frame, name, chunk);
+  if (!counts.ok()) return counts.status();
+  SVOKIT_RETURN_IF_ERROR(DecodeFullMasks(set, shape, frame, name, chunk));
+  SVOKIT_RETURN_IF_ERROR(DecodeContours(set, shape, frame, *counts, name, chunk));
+  SVOKIT_RETURN_IF_ERROR(DecodeSamples(set, shape, frame, name, chunk));
+  SVOKIT_RETURN_IF_ERROR(DecodeVoxels(set, shape, frame, counts->back(), name, chunk));
+  SVOKIT_RETURN_IF_ERROR(DecodeHalo(set, shape, frame, name, chunk));
   return chunk;
 }
 

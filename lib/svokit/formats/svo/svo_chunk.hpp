@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "svokit/core/status.hpp"
-#include "svokit/svo/svo_pages.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 
 namespace svokit {
 

@@ -99,9 +99,6 @@ void SetPageSizes(std::vector<std::uint64_t> sizes, SvoFileStats& stats);
 /// Completes `stats` of a file of `file_bytes`: its size, and the frame's share ("frame").
 void CompleteStats(std::uint64_t file_bytes, SvoFileStats& stats);
 
-/// The Morton keys of a level of a tree whose root has key 0.
-std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level);
-
 /// Loads the sections of levels ≤ *context (version 1's per-level sections) and every other one
 /// but version 2's pages (which a reader checks page by page).
 bool SectionsToLoad(Tag tag, const void* context);

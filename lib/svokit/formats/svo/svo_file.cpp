@@ -1,8 +1,5 @@
 #include "svokit/formats/svo/svo_file.hpp"
 
-#include <nlohmann/json.hpp>
-
-#include "svokit/core/utf8.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 
 namespace svokit {
@@ -87,16 +84,6 @@ StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {
 }
 
 }  // namespace
-
-std::string SvoMetadataJson(const SvoMetadata& meta) {
-  // nlohmann::json orders the keys alphabetically; the files depend on that order.
-  nlohmann::json json = {{"source", EscapeInvalidUtf8(meta.source)},
-                         {"voxelize", meta.voxelize},
-                         {"build", meta.build},
-                         {"generator", "svokit " SVOKIT_VERSION}};
-  if (meta.triangles > 0) json["triangles"] = meta.triangles;
-  return json.dump();
-}
 
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level) {

@@ -17,26 +17,16 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/svo/compact_svo.hpp"
 #include "svokit/svo/svo.hpp"
-#include "svokit/voxelize/voxelize.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 
 namespace svokit {
 
 inline constexpr container::FormatId kSvoFormat{
     {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 2, "svokit sparse voxel octree (.svo)"};
-
-/// Provenance stored with the octree (the `META` section): what svo-voxelize + svo-build and
-/// mesh2svo record alike, so both routes write the same file.
-struct SvoMetadata {
-  std::string source;           ///< the mesh's file name, without directories
-  std::string voxelize;         ///< the voxelization options, as the command line spells them
-  std::string build;            ///< the build options, likewise
-  std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded); svo-bake checks it
-};
-/// The `META` section's JSON text (Svo::metadata; BuildSvo's `metadata`).
-std::string SvoMetadataJson(const SvoMetadata& meta);
 
 /// Stored and raw (decoded) bytes of one kind of array, over all chunks: "masks", "contours",
 /// "opacity", "colours", "normals", "voxel colours", "voxel normals", "halo", or "frame" (header,
@@ -57,15 +47,6 @@ struct SvoFileStats {
   /// levels' arrays compressed together, so its stored bytes are shared among its levels in
   /// proportion to their decoded bytes. The frame belongs to no level.
   std::vector<std::vector<SvoSectionBytes>> levels;
-};
-
-/// What a version-2 file says of the whole octree, besides its pages.
-struct SvoFrame {
-  GridTransform grid;
-  VoxelMode mode = VoxelMode::kConservative;
-  std::uint32_t depth = 0;
-  SvoShape shape;
-  std::string metadata;  ///< the META section's JSON
 };
 
 /// Writes a version-2 file as its pages arrive, in key order, from a build that may never hold
@@ -122,72 +103,11 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
                                     SvoFileStats* stats = nullptr);
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
                                 const SvoCompression& compression = {});
-/// The octree of the mesh `voxelizer` holds, built and written one page at a time (subtrees of
-/// 128³ voxels, each voxelized from the triangles binned to it, with the voxel around it its
-/// halo needs), pages in parallel, in at most `memory_limit` bytes besides the mesh (0: no
-/// limit); the same bytes as the octree built whole and written with WriteSvo. With bricks the
-/// pages pass twice, through an unnamed scratch file beside `path` (docs/design.md, "Builds by
-/// pages"). A limit too small for one page is an error naming the smallest.
-StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
-                                       const BuildOptions& options, const std::string& metadata,
-                                       const std::filesystem::path& path,
-                                       const SvoCompression& compression,
-                                       std::uint64_t memory_limit,
-                                       Progress& progress = Progress::Silent());
-
-/// Voxels a build by pages reads a box at a time instead of voxelizing a mesh (svo-build
-/// --memory-limit from a .vfrag: VfragCubes).
-struct BoxVoxels {
-  GridTransform grid;
-  VoxelMode mode = VoxelMode::kConservative;
-  bool colors = false, normals = false;
-  std::optional<HalfRgba> shared_color;  ///< the colour every voxel has, if one
-  /// The cubes of 2^kPageSideBits voxels that hold voxels (Morton keys at that size), ascending.
-  std::vector<std::uint64_t> cubes;
-  std::function<StatusOr<VoxelSet>(const IBox3& box)> read;  ///< the voxels inside a box
-  std::uint64_t bytes = 0;                                   ///< held for the whole build
-};
-/// The octree of `voxels`, built and written one page at a time as above, contours fitted to
-/// `mesh` (required with options.contours): the same bytes as the octree of all of them built
-/// whole.
-StatusOr<SvoFileStats> BuildSvoByPages(const BoxVoxels& voxels, const Mesh* mesh,
-                                       const BuildOptions& options, const std::string& metadata,
-                                       const std::filesystem::path& path,
-                                       const SvoCompression& compression,
-                                       std::uint64_t memory_limit,
-                                       Progress& progress = Progress::Silent());
-
-/// One share of a build by pages run as separate jobs (on one machine or many): part `part` of
-/// `parts` (0-based), of the build `identity` names (e.g. checksums of the input and options;
-/// merging refuses parts whose identities differ).
-struct SvoPartOf {
-  std::uint32_t part = 0, parts = 1;
-  std::uint64_t identity = 0;
-};
-struct SvoPartStats {
-  std::uint64_t cells = 0;  ///< the page cubes of its share that may hold voxels
-  std::uint64_t pages = 0, voxels = 0;
-};
-/// The pages of one share of BuildSvoByPages' cells (shares of equal triangle work) into a part
-/// file (.svopart: the container with the pages, their counts and, in part 0, the top levels'
-/// contours), so that MergeSvoParts of all parts writes BuildSvoByPages' file.
-StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const BuildOptions& options,
-                                    const std::string& metadata, const SvoPartOf& part,
-                                    const std::filesystem::path& path,
-                                    const SvoCompression& compression, std::uint64_t memory_limit,
-                                    Progress& progress = Progress::Silent());
-/// Joins the parts of one build, given in any order, into its .svo, after checking that they
-/// belong to the same build and cover its pages exactly once (an error names the missing,
-/// repeated or foreign part). The pages' bytes are copied, not recompressed.
-StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> parts,
-                                     const std::filesystem::path& path,
-                                     Progress& progress = Progress::Silent());
-
 /// Writes `input` (a version-2 .svo) again as `output` with `baked`'s per-node ambient occlusion
-/// (every level's `ao`) as its `AOCC` section and `bake_options` as META's "bake"; every other
-/// section is copied as it is.
-Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked,
-                     const std::string& bake_options, const std::filesystem::path& output);
+/// (every level's `ao`) as its `AOCC` section and `bake` in its META; every other section is
+/// copied as it is.
+Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const BakeSettings& bake,
+                     const std::filesystem::path& output);
 
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,

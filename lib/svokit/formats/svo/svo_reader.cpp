@@ -3,6 +3,8 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
+#include "svokit/svo/sample_filter.hpp"
+#include "svokit/svo/svo_assembler.hpp"
 
 namespace svokit {
 

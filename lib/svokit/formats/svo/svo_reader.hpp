@@ -15,7 +15,8 @@
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
-#include "svokit/svo/svo_pages.hpp"
+#include "svokit/svo/svo.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {

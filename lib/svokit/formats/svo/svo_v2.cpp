@@ -17,14 +17,12 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
+#include "svokit/svo/svo_assembler.hpp"
+#include "svokit/svo/svo_pages.hpp"
 
 namespace svokit {
 
 namespace svo_detail {
-
-std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level) {
-  return std::move(TreeLevelKeys(tree, 0, level).back());
-}
 
 namespace {
 
@@ -67,8 +65,8 @@ std::array<std::uint64_t, 3> ChunkLevelCounts(const SvoChunk& chunk, std::uint32
 
 PagedSvoWriter::PagedSvoWriter(const SvoFrame& frame, const SvoCompression& compression)
     : frame_(frame), compression_(compression) {
-  page_level_ = PageLevel(frame_.depth);
-  levels_.assign(frame_.depth + 1, {0, 0, 0});
+  page_level_ = PageLevel(frame_.depth());
+  levels_.assign(frame_.depth() + 1, {0, 0, 0});
   file_.AddSection(kGrid, EncodeGridSection(frame_.grid, frame_.mode));
   file_.AddSectionProduced(
       kPages, [this](const container::Writer::Emit& emit) { return ProducePages(emit); });
@@ -91,7 +89,7 @@ PagedSvoWriter::EncodedPage PagedSvoWriter::Encode(const SvoChunk& page) const {
   EncodedPage out;
   out.key = page.root_key;
   out.bytes = EncodeChunk(page, frame_.shape, compression_, &out.stats);
-  for (std::uint32_t l = page_level_; l <= frame_.depth; ++l) {
+  for (std::uint32_t l = page_level_; l <= frame_.depth(); ++l) {
     out.levels.push_back(ChunkLevelCounts(page, l));
   }
   return out;
@@ -127,7 +125,7 @@ Status PagedSvoWriter::Finish() {
   ByteWriter head;
   const SvoShape& shape = frame_.shape;
   const bool shared = !shape.shared_color.empty();
-  head.Put(frame_.depth);
+  head.Put(frame_.depth());
   head.Put(shape.brick_side);
   head.Put((shape.has_color ? kHasColor : 0) | (shape.has_normal ? kHasNormal : 0) |
            (shape.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0) |
@@ -135,7 +133,7 @@ Status PagedSvoWriter::Finish() {
   head.Put(page_level_);
   head.Put(static_cast<std::uint64_t>(keys_.size()));
   head.Put(shared ? shape.shared_color[0] : HalfRgba(0, 0, 0, 0));
-  head.Put(frame_.depth + 1);
+  head.Put(frame_.depth() + 1);
   head.Put(std::uint32_t{compression_.zstd ? 1u : 0u});
   for (const auto& level : levels_) {
     for (const std::uint64_t v : level) head.Put(v);
@@ -181,8 +179,8 @@ namespace {
 PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& writer) {
   return [&svo, &writer](const PagedSvoWriter::Take& take) -> Status {
     const std::uint32_t page_level = writer.page_level();
-    const std::vector<std::uint64_t> keys = KeysOfLevel(svo.tree, page_level);
-    const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.tree, page_level);
+    const std::vector<std::uint64_t> keys = KeysOfLevel(svo.whole.tree, page_level);
+    const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.whole.tree, page_level);
     const std::size_t batch = 64;
     std::vector<PagedSvoWriter::EncodedPage> encoded;
     for (std::size_t first = 0; first < keys.size(); first += batch) {
@@ -197,10 +195,6 @@ PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& 
     }
     return Status::Ok();
   };
-}
-
-SvoFrame FrameOf(const CompactSvo& svo) {
-  return {svo.grid, svo.mode, svo.depth, Shape(svo), svo.metadata};
 }
 
 }  // namespace
@@ -368,33 +362,13 @@ StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::st
   return chunk;
 }
 
-bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
-                    IssueSink& sink, Svo& svo) {
-  const std::string& name = file.name();
-  StatusOr<Version2> parsed = ParseVersion2(file, sink);
-  if (!parsed.ok()) return false;
-  const Version2& v = *parsed;
-  const std::uint32_t last = std::min(v.shape.depth, max_level.value_or(v.shape.depth));
-  StatusOr<SvoChunk> top = DecodeTop(v, name);
-  if (!top.ok()) {
-    sink.Add("page_decode", name, "{}", top.status().message().substr(name.size() + 2));
-    return false;
-  }
-  // The top chunk's last masks name the pages: the page table's keys, in order.
-  const std::vector<std::uint64_t> roots =
-      v.page_level == 0 ? std::vector<std::uint64_t>{0} : KeysOfLevel(top->tree, v.page_level);
-  if (roots.size() != v.pages.size() ||
-      !std::equal(roots.begin(), roots.end(), v.pages.begin(),
-                  [](std::uint64_t k, const Version2::Page& p) { return k == p.key; })) {
-    sink.Add("page_table", name, "the page table's keys are not the top chunk's level {}",
-             v.page_level);
-    return false;
-  }
-  SvoAssembler assembler(v.shape, last);
-  assembler.Append(*top);
-  // Pages, if the levels asked for reach them (one level above, for its contour masks).
-  bool complete = true;
-  std::vector<std::uint64_t> voxel_keys;
+namespace {
+
+// What the checks of the whole voxel set need from the pages: keys, attributes, halos.
+struct PageVoxels {
+  std::vector<std::uint64_t> keys;
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
   struct Halo {
     std::size_t page;
     std::uint64_t key;
@@ -402,10 +376,45 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
     OctNormal normal;
   };
   std::vector<Halo> halos;
-  DefaultInitVector<HalfRgba> colors;
-  DefaultInitVector<OctNormal> normals;
-  // Pages decode and assemble their bricks in parallel, a batch at a time, and join the octree
-  // in order; a failed page is decoded again to report it, so the report is in page order too.
+
+  void Add(std::size_t p, const SvoChunk& page) {
+    for (const std::uint64_t key : ChunkVoxelKeys(page)) keys.push_back(key);
+    colors.insert(colors.end(), page.colors.begin(), page.colors.end());
+    normals.insert(normals.end(), page.normals.begin(), page.normals.end());
+    for (std::size_t h = 0; h < page.halo_keys.size(); ++h) {
+      halos.push_back({p, page.halo_keys[h],
+                       page.halo_colors.empty() ? HalfRgba() : page.halo_colors[h],
+                       page.halo_normals.empty() ? OctNormal() : page.halo_normals[h]});
+    }
+  }
+};
+
+// The top chunk, whose last masks name the pages: the page table's keys, in order.
+StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, IssueSink& sink) {
+  StatusOr<SvoChunk> top = DecodeTop(v, name);
+  if (!top.ok()) {
+    sink.Add("page_decode", name, "{}", top.status().message().substr(name.size() + 2));
+    return top.status();
+  }
+  const std::vector<std::uint64_t> roots =
+      v.page_level == 0 ? std::vector<std::uint64_t>{0} : KeysOfLevel(top->tree, v.page_level);
+  if (roots.size() != v.pages.size() ||
+      !std::equal(roots.begin(), roots.end(), v.pages.begin(),
+                  [](std::uint64_t k, const Version2::Page& p) { return k == p.key; })) {
+    sink.Add("page_table", name, "the page table's keys are not the top chunk's level {}",
+             v.page_level);
+    return Status::BadInput("{}: page table", name);
+  }
+  return top;
+}
+
+// Pages, if the levels asked for reach them (one level above, for its contour masks), decode and
+// assemble their bricks in parallel, a batch at a time, and join the octree in order; a failed
+// page is decoded again to report it, so the report is in page order too. False when a page
+// failed.
+bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name, IssueSink& sink,
+                 SvoAssembler& assembler, PageVoxels& voxels) {
+  bool complete = true;
   const std::size_t batch = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   std::vector<std::optional<StatusOr<SvoChunk>>> decoded(batch);
   std::vector<std::vector<SvoLevel>> bricks(batch);
@@ -426,20 +435,15 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
         continue;
       }
       assembler.Append(*page, std::move(bricks[i]));
-      if (last < v.shape.depth) continue;
-      // For the checks of the whole voxel set: keys, attributes, halos.
-      for (const std::uint64_t key : ChunkVoxelKeys(*page)) voxel_keys.push_back(key);
-      colors.insert(colors.end(), page->colors.begin(), page->colors.end());
-      normals.insert(normals.end(), page->normals.begin(), page->normals.end());
-      for (std::size_t h = 0; h < page->halo_keys.size(); ++h) {
-        halos.push_back({p, page->halo_keys[h],
-                         page->halo_colors.empty() ? HalfRgba() : page->halo_colors[h],
-                         page->halo_normals.empty() ? OctNormal() : page->halo_normals[h]});
-      }
+      if (last == v.shape.depth) voxels.Add(p, *page);
     }
   }
-  if (!complete) return false;
-  svo = assembler.Finish(v.grid, v.mode, v.metadata);
+  return complete;
+}
+
+// Each level holds the nodes and contours HEAD says.
+bool CheckLevelCounts(const Version2& v, const Svo& svo, std::uint32_t last,
+                      const std::string& name, IssueSink& sink) {
   bool consistent = true;
   for (std::uint32_t l = 0; l <= last; ++l) {
     const std::uint64_t contours = svo.levels[l].contours.size();
@@ -453,48 +457,62 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
       }
     }
   }
-  if (last < v.shape.depth) return consistent;
-  // Every voxel inside the grid (and so every node above it).
-  for (const std::uint64_t key : voxel_keys) {
+  return consistent;
+}
+
+// Every voxel inside the grid (and so every node above it).
+bool CheckVoxelsInGrid(const Version2& v, const PageVoxels& voxels, const std::string& name,
+                       IssueSink& sink) {
+  bool consistent = true;
+  for (const std::uint64_t key : voxels.keys) {
     const MortonCoord c = MortonDecode(key);
     if (c.x >= v.grid.dims()[0] || c.y >= v.grid.dims()[1] || c.z >= v.grid.dims()[2]) {
       consistent = false;
       if (!sink.Add("node_outside_grid", name, "a voxel lies outside the grid")) return false;
     }
   }
-  // A solid's full leaves, and its nodes that hold only full leaves, start inside the grid too.
-  if (v.shape.solid) {
-    const auto inside = [&](std::uint64_t key, std::uint32_t level) {
-      const MortonCoord c = MortonDecode(key);
-      const std::uint32_t shift = v.shape.depth - level;
-      const auto& d = v.grid.dims();
-      return (std::uint64_t{c.x} << shift) < d[0] && (std::uint64_t{c.y} << shift) < d[1] &&
-             (std::uint64_t{c.z} << shift) < d[2];
-    };
-    for (std::uint32_t l = 0; l < v.shape.depth; ++l) {
-      const std::vector<std::uint64_t> keys = svo.LevelKeys(l);
-      for (std::size_t i = 0; i < keys.size(); ++i) {
-        const std::uint8_t full = svo.levels[l].nodes[i].full_mask;
-        bool outside = !inside(keys[i], l);
-        for (unsigned c = 0; c < 8; ++c) {
-          if (full >> c & 1u) outside = outside || !inside(keys[i] << 3 | c, l + 1);
-        }
-        if (outside) {
-          consistent = false;
-          if (!sink.Add("node_outside_grid", name, "a full leaf lies outside the grid")) {
-            return false;
-          }
+  return consistent;
+}
+
+// A solid's full leaves, and its nodes that hold only full leaves, start inside the grid too.
+bool CheckFullLeavesInGrid(const Version2& v, const Svo& svo, const std::string& name,
+                           IssueSink& sink) {
+  const auto inside = [&](std::uint64_t key, std::uint32_t level) {
+    const MortonCoord c = MortonDecode(key);
+    const std::uint32_t shift = v.shape.depth - level;
+    const auto& d = v.grid.dims();
+    return (std::uint64_t{c.x} << shift) < d[0] && (std::uint64_t{c.y} << shift) < d[1] &&
+           (std::uint64_t{c.z} << shift) < d[2];
+  };
+  bool consistent = true;
+  for (std::uint32_t l = 0; l < v.shape.depth; ++l) {
+    const std::vector<std::uint64_t> keys = svo.LevelKeys(l);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const std::uint8_t full = svo.levels[l].nodes[i].full_mask;
+      bool outside = !inside(keys[i], l);
+      for (unsigned c = 0; c < 8; ++c) {
+        if (full >> c & 1u) outside = outside || !inside(keys[i] << 3 | c, l + 1);
+      }
+      if (outside) {
+        consistent = false;
+        if (!sink.Add("node_outside_grid", name, "a full leaf lies outside the grid")) {
+          return false;
         }
       }
     }
   }
-  // A page's halo voxels are voxels of other pages, with their attributes.
-  for (const Halo& h : halos) {
-    const auto it = std::lower_bound(voxel_keys.begin(), voxel_keys.end(), h.key);
-    const std::size_t i = static_cast<std::size_t>(it - voxel_keys.begin());
-    const bool same = it != voxel_keys.end() && *it == h.key &&
-                      (colors.empty() || colors[i] == h.color) &&
-                      (normals.empty() || normals[i].bits == h.normal.bits);
+  return consistent;
+}
+
+// A page's halo voxels are voxels of other pages, with their attributes.
+bool CheckHalos(const PageVoxels& voxels, const std::string& name, IssueSink& sink) {
+  bool consistent = true;
+  for (const PageVoxels::Halo& h : voxels.halos) {
+    const auto it = std::lower_bound(voxels.keys.begin(), voxels.keys.end(), h.key);
+    const std::size_t i = static_cast<std::size_t>(it - voxels.keys.begin());
+    const bool same = it != voxels.keys.end() && *it == h.key &&
+                      (voxels.colors.empty() || voxels.colors[i] == h.color) &&
+                      (voxels.normals.empty() || voxels.normals[i].bits == h.normal.bits);
     if (!same) {
       consistent = false;
       if (!sink.Add("halo", name, "page {}: halo voxel {} is not the voxel of its neighbour page",
@@ -506,11 +524,37 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   return consistent;
 }
 
+}  // namespace
+
+bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
+                    IssueSink& sink, Svo& svo) {
+  const std::string& name = file.name();
+  StatusOr<Version2> parsed = ParseVersion2(file, sink);
+  if (!parsed.ok()) return false;
+  const Version2& v = *parsed;
+  const std::uint32_t last = std::min(v.shape.depth, max_level.value_or(v.shape.depth));
+  StatusOr<SvoChunk> top = DecodeTopOfPages(v, name, sink);
+  if (!top.ok()) return false;
+  SvoAssembler assembler(v.shape, last);
+  assembler.Append(*top);
+  PageVoxels voxels;
+  if (!AppendPages(v, last, name, sink, assembler, voxels)) return false;
+  svo = assembler.Finish(v.grid, v.mode, v.metadata);
+  // Each check reports every issue it finds, unless the sink stops at the first.
+  bool consistent = CheckLevelCounts(v, svo, last, name, sink);
+  if (last < v.shape.depth || (!consistent && sink.stops())) return consistent;
+  consistent = CheckVoxelsInGrid(v, voxels, name, sink) && consistent;
+  if (!consistent && sink.stops()) return false;
+  if (v.shape.solid) consistent = CheckFullLeavesInGrid(v, svo, name, sink) && consistent;
+  if (!consistent && sink.stops()) return false;
+  return CheckHalos(voxels, name, sink) && consistent;
+}
+
 }  // namespace svo_detail
 
 std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression,
                                     SvoFileStats* stats) {
-  PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
+  PagedSvoWriter writer(svo.frame, compression);
   return writer.Serialize(
       svo_detail::PagesOf(svo, writer),
       [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
@@ -521,7 +565,7 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
 
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
                                 const SvoCompression& compression) {
-  PagedSvoWriter writer(svo_detail::FrameOf(svo), compression);
+  PagedSvoWriter writer(svo.frame, compression);
   return writer.Write(path, svo_detail::PagesOf(svo, writer),
                       [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
                         return TopChunk(svo, writer.page_level());

@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstring>
 
-#include <nlohmann/json.hpp>
-
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/half.hpp"
@@ -14,7 +12,6 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/release_pages.hpp"
-#include "svokit/core/utf8.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/vfrag/vfrag_detail.hpp"
 
@@ -22,32 +19,13 @@ namespace svokit {
 
 namespace vfrag_detail {
 
-std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta) {
-  nlohmann::json j = {{"source", EscapeInvalidUtf8(meta.source)},
-                      {"options", EscapeInvalidUtf8(meta.options)},
-                      {"generator", "svokit " SVOKIT_VERSION}};
-  if (meta.triangles > 0) j["triangles"] = meta.triangles;
-  const std::string text = j.dump();
+std::vector<std::uint8_t> MetadataSection(const Provenance& meta) {
+  const std::string text = ProvenanceJson(meta);
   return {text.begin(), text.end()};
 }
 
-VfragMetadata ParseMetadata(std::span<const std::uint8_t> text) {
-  VfragMetadata meta;
-  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
-  if (j.is_object()) {
-    // value() throws on a member of another type; such metadata is ignored, not fatal.
-    const auto text_of = [&](const char* key) {
-      const auto it = j.find(key);
-      return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
-    };
-    meta.source = text_of("source");
-    meta.options = text_of("options");
-    const auto triangles = j.find("triangles");
-    if (triangles != j.end() && triangles->is_number_unsigned()) {
-      meta.triangles = triangles->get<std::uint64_t>();
-    }
-  }
-  return meta;
+Provenance ParseMetadata(std::span<const std::uint8_t> text) {
+  return ParseProvenance(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()));
 }
 
 }  // namespace vfrag_detail
@@ -141,7 +119,7 @@ Status ReadNormalsAsOctahedral(const container::Reader& file, std::size_t voxels
   return Status::Ok();
 }
 
-StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, VfragMetadata* meta) {
+StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Provenance* meta) {
   if (!file.ok()) return file.status();
   const std::string& name = file->name();
   auto grid = file->Require(kGrid);
@@ -200,7 +178,7 @@ StatusOr<VoxelSet> DecodeSections(const StatusOr<container::Reader>& file, Vfrag
   }
   if (meta != nullptr) {
     const auto text = file->Find(kMetadata);
-    *meta = text ? ParseMetadata(*text) : VfragMetadata{};
+    *meta = text ? ParseMetadata(*text) : Provenance{};
   }
   return set;
 }
@@ -310,7 +288,7 @@ container::Writer::Producer PackedKeysProducer(const PackedVoxelSet& set) {
 // The container reads the set's arrays as it writes; `set` must outlive the returned writer.
 // `release`: each array's pages are given back once written (the set is consumed).
 container::Writer MakeWriter(const VoxelAttributes& set, container::Writer::Producer keys,
-                             const VfragMetadata& meta, bool release) {
+                             const Provenance& meta, bool release) {
   container::Writer file(kVfragFormat, 0);
   file.AddSection(kGrid, EncodeGridSection(set.grid, set.mode));
   file.AddSectionProduced(kKeys, std::move(keys));
@@ -325,26 +303,25 @@ container::Writer MakeWriter(const VoxelAttributes& set, container::Writer::Prod
 
 }  // namespace
 
-std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta) {
+std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const Provenance& meta) {
   return MakeWriter(set, KeysProducer(set.keys, false), meta, false).Serialize();
 }
 
-std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta) {
+std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const Provenance& meta) {
   return MakeWriter(set, PackedKeysProducer(set), meta, false).Serialize();
 }
 
-Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
-                  const std::filesystem::path& path) {
+Status WriteVfrag(const VoxelSet& set, const Provenance& meta, const std::filesystem::path& path) {
   return MakeWriter(set, KeysProducer(set.keys, false), meta, false).WriteFile(path);
 }
 
-Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path) {
+Status WriteVfrag(VoxelSet&& set, const Provenance& meta, const std::filesystem::path& path) {
   const Status status = MakeWriter(set, KeysProducer(set.keys, true), meta, true).WriteFile(path);
   set = VoxelSet{};  // its pages are gone
   return status;
 }
 
-VfragFileWriter::VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta, bool solid)
+VfragFileWriter::VfragFileWriter(std::filesystem::path path, const Provenance& meta, bool solid)
     : path_(std::move(path)),
       metadata_(MetadataSection(meta)),
       grid_(kGridSectionSize, 0),          // its value comes with Commit()
@@ -533,11 +510,11 @@ StatusOr<std::optional<InteriorCubes>> ReadVfragInterior(const std::filesystem::
 }
 
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
-                               VfragMetadata* meta) {
+                               Provenance* meta) {
   return DecodeSections(container::Reader::FromBytes(bytes, name, kVfragFormat), meta);
 }
 
-StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta) {
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, Provenance* meta) {
   return DecodeSections(container::Reader::Open(path, kVfragFormat), meta);
 }
 

@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "svokit/core/box.hpp"
+#include "svokit/core/file_io.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
@@ -22,21 +24,13 @@ namespace svokit {
 inline constexpr container::FormatId kVfragFormat{
     {'\x89', 'V', 'F', 'R', '\r', '\n', '\x1a', '\n'}, 5, "svokit voxel fragment list (.vfrag)"};
 
-/// Provenance stored with the voxels (the `META` section).
-struct VfragMetadata {
-  std::string source;   ///< input file name, without directories
-  std::string options;  ///< the voxelization options, as the tool's command line spells them
-  std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded)
-};
-
-std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const VfragMetadata& meta);
-Status WriteVfrag(const VoxelSet& set, const VfragMetadata& meta,
-                  const std::filesystem::path& path);
+std::vector<std::uint8_t> EncodeVfrag(const VoxelSet& set, const Provenance& meta);
+Status WriteVfrag(const VoxelSet& set, const Provenance& meta, const std::filesystem::path& path);
 /// The same file from a set that is consumed: its arrays' memory goes back to the kernel as it is
 /// written, for the file's page cache to reuse (fresh pages are slow on VMs); `set` is left empty.
-Status WriteVfrag(VoxelSet&& set, const VfragMetadata& meta, const std::filesystem::path& path);
+Status WriteVfrag(VoxelSet&& set, const Provenance& meta, const std::filesystem::path& path);
 /// The same file from voxels whose keys are packed already (VoxelizePacked).
-std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMetadata& meta);
+std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const Provenance& meta);
 /// A .vfrag file that VoxelizePacked() writes into directly: its KEYS, COLR, NORM and COVR
 /// sections are regions of a temporary beside `path`, mapped (container::MappedWriter), which the
 /// voxelizer's threads fill in place; Commit() completes the file and renames it into place.
@@ -45,7 +39,7 @@ std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const VfragMeta
 class VfragFileWriter final : public PackedVoxelStorage {
  public:
   /// `solid`: the file will hold a solid's interior (Commit()'s `interior`).
-  VfragFileWriter(std::filesystem::path path, const VfragMetadata& meta, bool solid = false);
+  VfragFileWriter(std::filesystem::path path, const Provenance& meta, bool solid = false);
   StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
                                       std::size_t key_bytes) override;
   /// The keys written so far, as varint gaps (`voxels`: what VoxelizePacked() returned).
@@ -67,17 +61,39 @@ class VfragFileWriter final : public PackedVoxelStorage {
   PackedVoxelContents contents_;
 };
 
-class RegionVoxelizer;
-/// The .vfrag of the mesh `voxelizer` holds, voxelized one cube of 128³ voxels at a time (cubes in
-/// parallel, in key order, as many at once as `memory_limit` bytes besides the mesh allow; 0: no
-/// limit) and streamed through unnamed scratch files: WriteVfrag()'s bytes for Voxelize()'s
-/// voxels, at any resolution. Returns the voxel count. A limit too small for the triangle bins
-/// and one cube is an error naming the smallest limit that works.
-StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
-                                          const VfragMetadata& meta,
-                                          const std::filesystem::path& path,
-                                          std::uint64_t memory_limit,
-                                          Progress& progress = Progress::Silent());
+/// A .vfrag written from runs of voxels in ascending key order (cubes as they are voxelized),
+/// streamed through unnamed scratch files beside `path`, never held whole: WriteVfrag()'s bytes
+/// for all of them, at any resolution. Destroyed uncommitted, it leaves nothing behind.
+class VfragStreamWriter {
+ public:
+  /// `shared_color`: the colour every voxel has, stored once (runs then carry no colours).
+  static StatusOr<std::unique_ptr<VfragStreamWriter>> Create(
+      const std::filesystem::path& path, const GridTransform& grid, VoxelMode mode, bool colors,
+      bool normals, std::optional<HalfRgba> shared_color, const Provenance& meta);
+  ~VfragStreamWriter();
+  VfragStreamWriter(const VfragStreamWriter&) = delete;
+  VfragStreamWriter& operator=(const VfragStreamWriter&) = delete;
+
+  /// Appends voxels whose keys follow every key appended before; returns the key bytes added.
+  StatusOr<std::uint64_t> Append(const VoxelSet& run);
+  std::uint64_t voxel_count() const { return count_; }
+  /// Writes the file; none without voxels (an error naming the file).
+  Status Commit();
+
+ private:
+  struct Arrays;
+  VfragStreamWriter();
+
+  std::filesystem::path path_;
+  GridTransform grid_;
+  VoxelMode mode_ = VoxelMode::kConservative;
+  bool colors_ = false, normals_ = false;
+  std::optional<HalfRgba> shared_color_;
+  Provenance meta_;
+  std::unique_ptr<ScratchFile> keys_;
+  std::unique_ptr<Arrays> arrays_;
+  std::uint64_t count_ = 0, previous_ = 0;
+};
 
 /// The voxel count a .vfrag states, without reading its voxels: for choosing how to read it.
 StatusOr<std::uint64_t> VfragVoxelCount(const std::filesystem::path& path);
@@ -89,7 +105,7 @@ StatusOr<std::uint64_t> VfragVoxelCount(const std::filesystem::path& path);
 class VfragCubes {
  public:
   static StatusOr<std::unique_ptr<VfragCubes>> Open(const std::filesystem::path& path,
-                                                    int cube_bits, VfragMetadata* meta = nullptr);
+                                                    int cube_bits, Provenance* meta = nullptr);
   ~VfragCubes();
   VfragCubes(const VfragCubes&) = delete;
   VfragCubes& operator=(const VfragCubes&) = delete;
@@ -145,7 +161,7 @@ StatusOr<std::optional<InteriorCubes>> ReadVfragInterior(const std::filesystem::
 
 /// Verifies and decodes; fills `meta` (when given) from the META section.
 StatusOr<VoxelSet> DecodeVfrag(std::span<const std::uint8_t> bytes, const std::string& name,
-                               VfragMetadata* meta = nullptr);
-StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, VfragMetadata* meta = nullptr);
+                               Provenance* meta = nullptr);
+StatusOr<VoxelSet> ReadVfrag(const std::filesystem::path& path, Provenance* meta = nullptr);
 
 }  // namespace svokit

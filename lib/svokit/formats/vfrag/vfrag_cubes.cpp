@@ -1,5 +1,5 @@
-// .vfrag cube by cube (vfrag.hpp: WriteVfragByCubes, VfragCubes): a file written from cubes of
-// voxels as they are voxelized, and read a box at a time, never held whole.
+// .vfrag cube by cube (vfrag.hpp: VfragStreamWriter, VfragCubes): a file written from runs of
+// voxels as they come, and read a box at a time, never held whole.
 
 #include <algorithm>
 #include <cstring>
@@ -10,11 +10,9 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/formats/vfrag/vfrag_detail.hpp"
-#include "svokit/voxelize/voxelize.hpp"
 
 namespace svokit {
 
@@ -62,95 +60,80 @@ class ScratchArray {
 
 }  // namespace
 
-StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer,
-                                          const VfragMetadata& meta,
-                                          const std::filesystem::path& path,
-                                          std::uint64_t memory_limit, Progress& progress) {
-  constexpr int kCubeBits = 7;
-  RegionVoxelizer::Bins bins;
-  {
-    Progress::Stage stage(progress, "bin", 1);
-    bins = voxelizer.BinTriangles(kCubeBits, 0);
-  }
-  // Held whatever the cube: the snapped mesh and the bins; then per cube in flight at most a
-  // surface's voxels across it with their keys and attributes (~24 B a voxel).
-  const std::uint64_t fixed = voxelizer.bytes() + bins.bytes();
-  const std::uint64_t cube = std::uint64_t{24} * 4 << (2 * kCubeBits);
-  const StatusOr<std::size_t> in_flight =
-      InFlightWithin(memory_limit, fixed, cube, cube, "its bins and one cube");
-  if (!in_flight.ok()) return in_flight.status();
+struct VfragStreamWriter::Arrays {
+  ScratchArray<HalfRgba> colors;
+  ScratchArray<OctNormal> normals;
+  ScratchArray<Half> coverage;
+};
 
-  const VoxelizeOptions& options = voxelizer.options();
-  const bool shared = voxelizer.shared_color().has_value();
+VfragStreamWriter::VfragStreamWriter() = default;
+VfragStreamWriter::~VfragStreamWriter() = default;
+
+StatusOr<std::unique_ptr<VfragStreamWriter>> VfragStreamWriter::Create(
+    const std::filesystem::path& path, const GridTransform& grid, VoxelMode mode, bool colors,
+    bool normals, std::optional<HalfRgba> shared_color, const Provenance& meta) {
+  std::unique_ptr<VfragStreamWriter> w(new VfragStreamWriter());
+  w->path_ = path;
+  w->grid_ = grid;
+  w->mode_ = mode;
+  w->colors_ = colors;
+  w->normals_ = normals;
+  w->shared_color_ = shared_color;
+  w->meta_ = meta;
+  w->previous_ = kNoPreviousKey;
   StatusOr<std::unique_ptr<ScratchFile>> keys = ScratchFile::Create(path);
   if (!keys.ok()) return keys.status();
-  auto colors = ScratchArray<HalfRgba>::Create(path);
-  auto normals = ScratchArray<OctNormal>::Create(path);
-  auto coverage = ScratchArray<Half>::Create(path);
-  if (!colors.ok()) return colors.status();
-  if (!normals.ok()) return normals.status();
-  if (!coverage.ok()) return coverage.status();
-  std::uint64_t count = 0, previous = kNoPreviousKey;
-  Status made;
-  {
-    Progress::Stage stage(progress, "cubes", bins.cells.size());
-    struct Cube {
-      StatusOr<VoxelSet> voxels = Status::Ok();
-    };
-    made = ParallelInOrder<Cube>(
-        0, bins.cells.size(), *in_flight,
-        [&](std::size_t i) {
-          const MortonCoord c = MortonDecode(bins.cells[i]);
-          const std::int64_t s = std::int64_t{1} << kCubeBits;
-          const IBox3 box{{c.x * s, c.y * s, c.z * s}, {c.x * s + s, c.y * s + s, c.z * s + s}};
-          return Cube{voxelizer.Voxelize(box, bins.Of(i))};
-        },
-        [&](Cube cube_made) -> Status {
-          stage.Advance(1);
-          if (!cube_made.voxels.ok()) return cube_made.voxels.status();
-          const VoxelSet& v = *cube_made.voxels;
-          if (v.keys.empty()) return Status::Ok();
-          DefaultInitVector<std::uint8_t> gaps;
-          AppendKeyGaps(std::span<const std::uint64_t>(v.keys), previous, gaps);
-          previous = v.keys.back();
-          count += v.keys.size();
-          stage.AddBytes(gaps.size());
-          SVOKIT_RETURN_IF_ERROR((*keys)->Append(gaps).status());
-          if (options.colors && !shared) SVOKIT_RETURN_IF_ERROR(colors->Append(v.colors));
-          if (options.normals) SVOKIT_RETURN_IF_ERROR(normals->Append(v.normals));
-          if (!v.coverage.empty()) SVOKIT_RETURN_IF_ERROR(coverage->Append(v.coverage));
-          return Status::Ok();
-        });
-  }
-  SVOKIT_RETURN_IF_ERROR(made);
-  if (count == 0) return Status::BadInput("{}: the mesh has no voxels in the grid", path.string());
+  w->keys_ = std::move(*keys);
+  auto color_array = ScratchArray<HalfRgba>::Create(path);
+  auto normal_array = ScratchArray<OctNormal>::Create(path);
+  auto coverage_array = ScratchArray<Half>::Create(path);
+  if (!color_array.ok()) return color_array.status();
+  if (!normal_array.ok()) return normal_array.status();
+  if (!coverage_array.ok()) return coverage_array.status();
+  w->arrays_.reset(
+      new Arrays{std::move(*color_array), std::move(*normal_array), std::move(*coverage_array)});
+  return w;
+}
 
+StatusOr<std::uint64_t> VfragStreamWriter::Append(const VoxelSet& run) {
+  if (run.keys.empty()) return std::uint64_t{0};
+  DefaultInitVector<std::uint8_t> gaps;
+  AppendKeyGaps(std::span<const std::uint64_t>(run.keys), previous_, gaps);
+  previous_ = run.keys.back();
+  count_ += run.keys.size();
+  SVOKIT_RETURN_IF_ERROR(keys_->Append(gaps).status());
+  if (colors_ && !shared_color_) SVOKIT_RETURN_IF_ERROR(arrays_->colors.Append(run.colors));
+  if (normals_) SVOKIT_RETURN_IF_ERROR(arrays_->normals.Append(run.normals));
+  if (!run.coverage.empty()) SVOKIT_RETURN_IF_ERROR(arrays_->coverage.Append(run.coverage));
+  return static_cast<std::uint64_t>(gaps.size());
+}
+
+Status VfragStreamWriter::Commit() {
+  if (count_ == 0) {
+    return Status::BadInput("{}: the mesh has no voxels in the grid", path_.string());
+  }
   container::Writer file(kVfragFormat, 0);
-  file.AddSection(kGrid, EncodeGridSection(voxelizer.grid(), options.mode));
+  file.AddSection(kGrid, EncodeGridSection(grid_, mode_));
   file.AddSectionProduced(kKeys, [&](const container::Writer::Emit& emit) -> Status {
-    std::uint8_t head[sizeof(count)];
-    std::memcpy(head, &count, sizeof(count));
+    std::uint8_t head[sizeof(count_)];
+    std::memcpy(head, &count_, sizeof(count_));
     SVOKIT_RETURN_IF_ERROR(emit(head));
-    return (*keys)->ForEachPiece(emit);
+    return keys_->ForEachPiece(emit);
   });
-  if (options.colors) {
-    if (shared) {
-      const HalfRgba one(*voxelizer.shared_color());
+  if (colors_) {
+    if (shared_color_) {
+      const HalfRgba one = *shared_color_;
       file.AddSection(kColors, std::vector<std::uint8_t>(
                                    reinterpret_cast<const std::uint8_t*>(&one),
                                    reinterpret_cast<const std::uint8_t*>(&one) + sizeof(one)));
     } else {
-      file.AddSectionProduced(kColors, colors->Producer());
+      file.AddSectionProduced(kColors, arrays_->colors.Producer());
     }
   }
-  if (options.normals) file.AddSectionProduced(kNormals, normals->Producer());
-  if (options.colors || options.normals) file.AddSectionProduced(kCoverage, coverage->Producer());
-  file.AddSection(kMetadata, MetadataSection(meta));
-  {
-    Progress::Stage stage(progress, "write", 1);
-    SVOKIT_RETURN_IF_ERROR(file.WriteFile(path));
-  }
-  return count;
+  if (normals_) file.AddSectionProduced(kNormals, arrays_->normals.Producer());
+  if (colors_ || normals_) file.AddSectionProduced(kCoverage, arrays_->coverage.Producer());
+  file.AddSection(kMetadata, MetadataSection(meta_));
+  return file.WriteFile(path_);
 }
 
 namespace {
@@ -202,7 +185,7 @@ StatusOr<std::uint64_t> VfragVoxelCount(const std::filesystem::path& path) {
 }
 
 StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::path& path,
-                                                       int cube_bits, VfragMetadata* meta) {
+                                                       int cube_bits, Provenance* meta) {
   // The frame, with only the small sections loaded (and checked); the large ones are streamed.
   const auto small = [](container::Tag tag, const void*) {
     return tag == kGrid || tag == kMetadata;
@@ -231,7 +214,7 @@ StatusOr<std::unique_ptr<VfragCubes>> VfragCubes::Open(const std::filesystem::pa
   SVOKIT_RETURN_IF_ERROR(DecodeGridSection(grid->bytes, name, cubes->grid_, cubes->mode_));
   if (meta != nullptr) {
     const container::Frame::Section* m = frame->Find(kMetadata);
-    *meta = m != nullptr ? ParseMetadata(m->bytes) : VfragMetadata{};
+    *meta = m != nullptr ? ParseMetadata(m->bytes) : Provenance{};
   }
   std::uint64_t file_size = 0;
   StatusOr<int> fd = OpenRegularFile(path, file_size);

@@ -25,8 +25,8 @@ inline constexpr container::Tag kMetadata = MakeTag("META");
 inline constexpr container::Tag kInterior = MakeTag("FILL");
 
 /// The META section of `meta`, and back (metadata that is not such JSON reads as empty).
-std::vector<std::uint8_t> MetadataSection(const VfragMetadata& meta);
-VfragMetadata ParseMetadata(std::span<const std::uint8_t> text);
+std::vector<std::uint8_t> MetadataSection(const Provenance& meta);
+Provenance ParseMetadata(std::span<const std::uint8_t> text);
 
 /// Voxel `i`'s key checked against the grid of `dims` (a key with bit 63 set lies outside any).
 inline Status CheckKeyInGrid(std::uint64_t key, std::uint64_t i,

@@ -1,32 +1,13 @@
-#include "svokit/svo/build.hpp"
+#include "svokit/svo/reference_build.hpp"
 
 #include <algorithm>
 #include <utility>
 
 #include "svokit/svo/bricks.hpp"
+#include "svokit/svo/contour.hpp"
+#include "svokit/svo/mask_tree.hpp"
 
 namespace svokit {
-
-std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
-                                                            std::uint32_t depth) {
-  std::vector<std::vector<std::uint64_t>> levels(depth + 1);
-  levels[depth] = std::move(keys);
-  for (std::uint32_t l = depth; l-- > 0;) {
-    const std::vector<std::uint64_t>& finer = levels[l + 1];
-    std::vector<std::uint64_t>& coarser = levels[l];
-    // The most a level can hold, reserved once: pages past the keys written are never touched.
-    coarser.reserve(finer.size());
-    for (std::uint64_t k : finer) {
-      if (coarser.empty() || coarser.back() != k >> 3) coarser.push_back(k >> 3);
-    }
-  }
-  return levels;
-}
-
-std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::span<const std::uint64_t> keys,
-                                                            std::uint32_t depth) {
-  return LevelKeysFromVoxels(std::vector<std::uint64_t>(keys.begin(), keys.end()), depth);
-}
 
 namespace {
 
@@ -73,23 +54,9 @@ void StoreContours(const std::vector<std::vector<std::uint32_t>>& words, Svo& sv
 
 }  // namespace
 
-Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options) {
-  if (voxels.keys.empty()) return Status::BadInput("the voxel set is empty: nothing to build");
-  if (options.brick_side != 0 && options.brick_side != 2 && options.brick_side != 3) {
-    return Status::BadInput("bricks must be 3, 2 or none (got {})", options.brick_side);
-  }
-  if (options.contours && mesh == nullptr) {
-    return Status::BadInput("contours need the mesh the voxels came from");
-  }
-  if ((voxels.has_colors() && voxels.colors.size() != voxels.size() && voxels.colors.size() != 1) ||
-      (voxels.has_normals() && voxels.normals.size() != voxels.size())) {
-    return Status::BadInput("voxel attribute arrays do not match the voxel count");
-  }
-  return Status::Ok();
-}
-
-StatusOr<Svo> BuildSvo(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options,
-                       std::string metadata, Progress& progress) {
+StatusOr<Svo> BuildReferenceSvo(const VoxelSet& voxels, const Mesh* mesh,
+                                const BuildOptions& options, std::string metadata,
+                                Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckBuildInput(voxels, mesh, options));
   if (options.interior != nullptr) {
     return Status::BadInput("a solid's full leaves need a version-2 octree (BuildCompactSvo)");

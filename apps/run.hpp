@@ -1,0 +1,84 @@
+#pragma once
+// How every svokit tool runs as a process: huge pages for the big arrays, the command line parsed,
+// and the exit protocol (StatusCode: 0 ok, 1 check failed, 2 bad input or usage, 3 internal
+// error, 4 cannot write the output, 5 out of memory; one line on stderr per error).
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "svokit/core/status.hpp"
+
+namespace svokit::app {
+
+/// Prints each of `warnings` as one line on stderr.
+inline void Warn(const std::string& tool, const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) fmt::print(stderr, "{}: warning: {}\n", tool, w);
+}
+
+/// Prints `status` as one line on stderr and returns its exit code.
+inline int Fail(const std::string& tool, const Status& status) {
+  fmt::print(stderr, "{}: {}\n", tool, status.message());
+  return status.exit_code();
+}
+
+/// Re-executes the process once with glibc's malloc asking for transparent huge pages
+/// (glibc.malloc.hugetlb=1; read at start-up only) and growing its heaps 64 MB at a time
+/// (top_pad), so that whole 2 MB pages lie inside each madvised extension. Where THP is in
+/// `madvise` mode (Debian's and most VMs' default) first-touch page faults dominate the big
+/// arrays: 1024³ voxelize runs 1.5× faster, the 4096³ one 2–3× (README, design notes). Only
+/// touched pages are resident, so the padding costs address space, not memory. Nothing changes
+/// where hugetlb is already given (also `hugetlb=0`) or the exec fails.
+inline void UseHugePages(char** argv) {
+  // Under an address-space limit (ulimit -v) 64 MB steps would fail allocations that fit.
+  rlimit address_space{};
+  const bool unlimited =
+      ::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur == RLIM_INFINITY;
+  const char* const kTunables =
+      unlimited ? "glibc.malloc.hugetlb=1:glibc.malloc.top_pad=67108864" : "glibc.malloc.hugetlb=1";
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.hugetlb") != nullptr) return;
+  const std::string value = tunables != nullptr && *tunables != 0
+                                ? std::string(tunables) + ":" + kTunables
+                                : std::string(kTunables);
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+}
+
+/// Parses the command line and runs `body`, mapping usage errors to exit 2, a failed allocation to
+/// exit 5 and anything else thrown to a one-line message with exit 3; `input` (filled by the parse)
+/// is the file those messages name.
+inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
+               const std::filesystem::path& input, const std::function<int()>& body) {
+  UseHugePages(argv);
+  try {
+    try {
+      cli.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+      return cli.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+      return cli.exit(e);
+    } catch (const CLI::ParseError& e) {
+      fmt::print(stderr, "{}: {} (see --help)\n", tool, e.what());
+      return static_cast<int>(StatusCode::kBadInput);
+    }
+    return body();
+  } catch (const std::bad_alloc&) {
+    return Fail(tool, Status::OutOfMemory("{}: out of memory", input.string()));
+  } catch (const std::exception& e) {
+    return Fail(tool, Status::Internal("{}: internal error: {}", input.string(), e.what()));
+  }
+}
+
+}  // namespace svokit::app

@@ -1,0 +1,55 @@
+#pragma once
+// svo-bake's run: ambient occlusion cone traced through an octree's bricks, baked into the octree
+// (a byte per node) and onto the mesh it was made from (per-vertex PLY, a texture over its UVs),
+// with the rays of the Embree reference where asked for.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "svokit/bake/ao_bake.hpp"
+#include "svokit/bake/cone_tracer.hpp"
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+
+namespace svokit {
+
+struct AoBakeRequest {
+  std::filesystem::path input;        ///< the octree
+  std::filesystem::path output;       ///< the octree again with AO per node; may be empty
+  std::filesystem::path mesh;         ///< the mesh it was made from (vertices, texture, reference)
+  std::filesystem::path vertex_out;   ///< per-vertex AO as PLY; may be empty
+  std::filesystem::path texture_out;  ///< an AO map over the mesh's UVs; may be empty
+  int texture_size = 2048;
+  ConeOptions cones;  ///< distance 0: kDefaultAoDistance of the grid's diagonal
+  /// What the mesh's outputs hold: cones through the octree, or this many rays per point
+  /// (Embree on the mesh: the reference).
+  std::optional<std::uint32_t> rays;
+  std::optional<std::uint32_t> reference;  ///< also the vertices' error against this many rays
+};
+
+/// How far occluders count by default: this fraction of the diagonal of the octree's grid.
+inline constexpr double kDefaultAoDistance = 0.25;
+
+struct AoBakeReport {
+  std::uint32_t depth = 0;
+  std::uint64_t voxels = 0;
+  ConeOptions cones;  ///< as traced (the distance resolved)
+  struct Points {
+    std::uint64_t count = 0;
+    double mean_ao = 0;
+  };
+  std::optional<Points> octree;    ///< voxels traced into the output octree
+  std::uint64_t output_bytes = 0;  ///< the output octree's size
+  std::optional<Points> vertices;  ///< traced for the vertex output or the reference
+  std::optional<double> reference_mean_ao;
+  AoErrors reference_errors;     ///< the vertices' against the reference
+  std::optional<Points> texels;  ///< covered texels of the texture
+};
+
+/// Reads the octree, imports the mesh (checked to be the one the octree was made from), bakes
+/// and writes every output asked for. Outputs are checked before any work.
+StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& request,
+                                 Progress& progress = Progress::Silent());
+
+}  // namespace svokit

@@ -1,0 +1,235 @@
+#include "svokit/formats/provenance.hpp"
+
+#include <charconv>
+#include <map>
+#include <sstream>
+#include <string_view>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
+
+#include "svokit/core/utf8.hpp"
+
+namespace svokit {
+
+namespace {
+
+using Json = nlohmann::json;
+
+Json GridJson(const GridFit& g) {
+  Json j = {{"pad", g.pad}};
+  if (g.resolution > 0) {
+    j["resolution"] = g.resolution;
+  } else {
+    j["voxel_size"] = g.voxel_size;
+  }
+  return j;
+}
+
+Json VoxelizeJson(const VoxelizeSettings& v) {
+  return {{"mode", v.mode == VoxelMode::kThin ? "thin" : "conservative"},
+          {"color", v.colors},
+          {"normal", v.normals},
+          {"fill", v.solid ? "solid" : "surface"}};
+}
+
+Json BuildJson(const BuildSettings& b) {
+  Json j = {{"bricks", b.brick_side},
+            {"contours", b.contours},
+            {"compression", b.compression.zstd ? "zstd" : "none"}};
+  if (b.compression.zstd) j["zstd_level"] = b.compression.level;
+  return j;
+}
+
+Json BakeJson(const BakeSettings& b) {
+  Json j = {{"term", "ao"},           {"cones", b.cones},     {"aperture", b.aperture},
+            {"distance", b.distance}, {"falloff", b.falloff}, {"offset", b.offset}};
+  if (b.jitter_seed) j["jitter_seed"] = *b.jitter_seed;
+  return j;
+}
+
+// Typed members, read leniently: a member of another type is as good as absent.
+template <class T>
+std::optional<T> Member(const Json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end()) return std::nullopt;
+  if constexpr (std::is_same_v<T, bool>) {
+    if (!it->is_boolean()) return std::nullopt;
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    if (!it->is_string()) return std::nullopt;
+  } else if constexpr (std::is_floating_point_v<T>) {
+    if (!it->is_number()) return std::nullopt;
+  } else {
+    if (!it->is_number_unsigned()) return std::nullopt;
+  }
+  return it->get<T>();
+}
+
+std::optional<GridFit> ParseGrid(const Json& j) {
+  if (!j.is_object()) return std::nullopt;
+  GridFit g;
+  g.pad = Member<std::uint32_t>(j, "pad").value_or(0);
+  if (const auto r = Member<std::uint32_t>(j, "resolution")) {
+    g.resolution = *r;
+  } else if (const auto s = Member<double>(j, "voxel_size")) {
+    g.voxel_size = *s;
+  } else {
+    return std::nullopt;
+  }
+  return g;
+}
+
+std::optional<VoxelizeSettings> ParseVoxelize(const Json& j) {
+  if (!j.is_object()) return std::nullopt;
+  VoxelizeSettings v;
+  v.mode = Member<std::string>(j, "mode") == "thin" ? VoxelMode::kThin : VoxelMode::kConservative;
+  v.colors = Member<bool>(j, "color").value_or(false);
+  v.normals = Member<bool>(j, "normal").value_or(false);
+  v.solid = Member<std::string>(j, "fill") == "solid";
+  return v;
+}
+
+std::optional<BuildSettings> ParseBuild(const Json& j) {
+  if (!j.is_object()) return std::nullopt;
+  BuildSettings b;
+  b.brick_side = Member<std::uint32_t>(j, "bricks").value_or(0);
+  b.contours = Member<bool>(j, "contours").value_or(false);
+  b.compression.zstd = Member<std::string>(j, "compression") == "zstd";
+  b.compression.level = static_cast<int>(Member<std::uint32_t>(j, "zstd_level").value_or(3));
+  return b;
+}
+
+std::optional<BakeSettings> ParseBake(const Json& j) {
+  if (!j.is_object()) return std::nullopt;
+  BakeSettings b;
+  b.cones = Member<std::uint32_t>(j, "cones").value_or(b.cones);
+  b.aperture = Member<double>(j, "aperture").value_or(b.aperture);
+  b.distance = Member<double>(j, "distance").value_or(b.distance);
+  b.falloff = Member<double>(j, "falloff").value_or(b.falloff);
+  b.offset = Member<double>(j, "offset").value_or(b.offset);
+  b.jitter_seed = Member<std::uint64_t>(j, "jitter_seed");
+  return b;
+}
+
+// Files written before the typed members recorded each stage as the option text its tool was
+// given (formats/svo.md, "Metadata"): words led by two dashes, each with the value after it,
+// if any. That text is frozen; it is read here as data, by its words.
+std::map<std::string, std::string> OptionWords(const std::string& text) {
+  std::map<std::string, std::string> words;
+  std::istringstream in(text);
+  std::string token, name;
+  while (in >> token) {
+    if (token.size() > 2 && token[0] == '-' && token[1] == '-') {
+      name = token.substr(2);
+      words[name] = "";
+    } else if (!name.empty()) {
+      words[name] = token;
+      name.clear();
+    }
+  }
+  return words;
+}
+
+template <class T>
+std::optional<T> ParseNumber(std::string_view text) {
+  T value{};
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end) return std::nullopt;
+  return value;
+}
+
+template <class T>
+std::optional<T> Number(const std::map<std::string, std::string>& words, const char* word) {
+  const auto it = words.find(word);
+  return it == words.end() ? std::nullopt : ParseNumber<T>(it->second);
+}
+
+void ParseVoxelizeText(const std::string& text, Provenance& p) {
+  const auto words = OptionWords(text);
+  GridFit g;
+  g.pad = Number<std::uint32_t>(words, "pad").value_or(0);
+  if (const auto r = Number<std::uint32_t>(words, "resolution")) {
+    g.resolution = *r;
+    p.grid = g;
+  } else if (const auto s = Number<double>(words, "voxel-size")) {
+    g.voxel_size = *s;
+    p.grid = g;
+  }
+  VoxelizeSettings v;
+  const auto mode = words.find("mode");
+  v.mode =
+      mode != words.end() && mode->second == "thin" ? VoxelMode::kThin : VoxelMode::kConservative;
+  const auto attributes = words.find("attributes");
+  const std::string a = attributes == words.end() ? "" : attributes->second;
+  v.colors = a.find("color") != std::string::npos;
+  v.normals = a.find("normal") != std::string::npos;
+  const auto fill = words.find("fill");
+  v.solid = fill != words.end() && fill->second == "solid";
+  p.voxelize = v;
+}
+
+void ParseBuildText(const std::string& text, Provenance& p) {
+  const auto words = OptionWords(text);
+  BuildSettings b;
+  b.brick_side = Number<std::uint32_t>(words, "bricks").value_or(0);
+  b.contours = words.count("contours") > 0;
+  const auto compression = words.find("compression");
+  const std::string c = compression == words.end() ? "" : compression->second;
+  b.compression.zstd = c.starts_with("zstd");
+  if (c.starts_with("zstd:")) b.compression.level = ParseNumber<int>(c.substr(5)).value_or(3);
+  p.build = b;
+}
+
+void ParseBakeText(const std::string& text, Provenance& p) {
+  const auto words = OptionWords(text);
+  BakeSettings b;
+  b.cones = Number<std::uint32_t>(words, "cones").value_or(b.cones);
+  b.aperture = Number<double>(words, "aperture").value_or(b.aperture);
+  b.distance = Number<double>(words, "distance").value_or(b.distance);
+  b.falloff = Number<double>(words, "falloff").value_or(b.falloff);
+  b.offset = Number<double>(words, "offset").value_or(b.offset);
+  b.jitter_seed = Number<std::uint64_t>(words, "jitter");
+  p.bake = b;
+}
+
+}  // namespace
+
+std::string ProvenanceJson(const Provenance& p) {
+  // nlohmann::json orders the keys alphabetically: the bytes follow from the values alone.
+  Json j = {{"source", EscapeInvalidUtf8(p.source)}, {"generator", "svokit " SVOKIT_VERSION}};
+  if (p.triangles > 0) j["triangles"] = p.triangles;
+  if (p.grid) j["grid"] = GridJson(*p.grid);
+  if (p.voxelize) j["voxelize"] = VoxelizeJson(*p.voxelize);
+  if (p.build) j["build"] = BuildJson(*p.build);
+  if (p.bake) j["bake"] = BakeJson(*p.bake);
+  return j.dump();
+}
+
+Provenance ParseProvenance(std::string_view text) {
+  Provenance p;
+  const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+  if (!j.is_object()) return p;
+  p.source = Member<std::string>(j, "source").value_or("");
+  p.generator = Member<std::string>(j, "generator").value_or("");
+  p.triangles = Member<std::uint64_t>(j, "triangles").value_or(0);
+  if (const auto grid = j.find("grid"); grid != j.end()) p.grid = ParseGrid(*grid);
+  // Each stage: a typed object, or (files written before) its option text.
+  for (const char* key : {"voxelize", "options"}) {
+    const auto it = j.find(key);
+    if (it == j.end()) continue;
+    if (it->is_object()) p.voxelize = ParseVoxelize(*it);
+    if (it->is_string()) ParseVoxelizeText(it->get<std::string>(), p);
+  }
+  if (const auto it = j.find("build"); it != j.end()) {
+    if (it->is_object()) p.build = ParseBuild(*it);
+    if (it->is_string()) ParseBuildText(it->get<std::string>(), p);
+  }
+  if (const auto it = j.find("bake"); it != j.end()) {
+    if (it->is_object()) p.bake = ParseBake(*it);
+    if (it->is_string()) ParseBakeText(it->get<std::string>(), p);
+  }
+  return p;
+}
+
+}  // namespace svokit

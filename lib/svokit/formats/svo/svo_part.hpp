@@ -1,0 +1,84 @@
+#pragma once
+// .svopart — one share of a build by pages, as a job of many writes it and svo-merge reads it
+// (formats/svopart.md): the part's pages in key order, built alone, with the shells their
+// neighbours' faces need, and in part 0 the top levels' contour words. The builds that make parts
+// and the merge that joins them are pipeline/svo_parts.hpp.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "svokit/core/status.hpp"
+#include "svokit/formats/container/container.hpp"
+#include "svokit/formats/svo/svo_chunk.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/svo/svo_chunk.hpp"
+
+namespace svokit {
+
+inline constexpr container::FormatId kSvoPartFormat{
+    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 2, "svokit octree part (.svopart)"};
+
+/// Which share of a build by pages a part holds: part `part` of `parts` (0-based), of the build
+/// `identity` names (e.g. checksums of the input and options; merging refuses parts whose
+/// identities differ).
+struct SvoPartOf {
+  std::uint32_t part = 0, parts = 1;
+  std::uint64_t identity = 0;
+};
+
+/// What a part says of itself and of the build it belongs to (its GRID, PART and META sections).
+struct SvoPartHead {
+  SvoPartOf of;
+  /// The build's page cubes that may hold voxels, and this part's share of them: [first, end).
+  std::uint64_t cells = 0, first = 0, end = 0;
+  SvoFrame frame;
+  SvoCompression compression;  ///< what the merged file's pages are compressed with
+};
+
+/// Contour words of the top levels' nodes by Morton key, per level 0 .. page level − 1.
+using TopContours = std::vector<std::map<std::uint64_t, std::uint32_t>>;
+
+/// A page as a part stores it: encoded as built alone, and its shell (empty without bricks).
+using SvoPartPageSink =
+    std::function<Status(PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t> shell)>;
+/// Hands every page of the part to the sink, in ascending key order; stops at its first error.
+using SvoPartPages = std::function<Status(const SvoPartPageSink& take)>;
+
+/// Writes the part file `path`: `head`, the pages as `pages` makes them (their shells through an
+/// unnamed scratch file beside `path`), and `top` (part 0 with contours; else empty).
+Status WriteSvoPart(const std::filesystem::path& path, const SvoPartHead& head,
+                    const TopContours& top, const SvoPartPages& pages);
+
+/// One page of a read part: where its bytes and shell are, and its per-level counts (nodes,
+/// contours, samples) from the page table.
+struct SvoPartPage {
+  std::uint64_t key = 0, offset = 0, size = 0, shell_offset = 0, shell_size = 0;
+  std::vector<std::array<std::uint64_t, 3>> levels;
+};
+
+/// A part file, read and checked on its own (header, tables against sections); its pages' bytes
+/// stay in the mapped file.
+struct SvoPart {
+  std::string name;
+  container::Reader file;
+  SvoPartHead head;
+  std::vector<SvoPartPage> pages;
+  std::span<const std::uint8_t> page_bytes, shell_bytes;
+  TopContours top;
+
+  std::span<const std::uint8_t> PageBytes(const SvoPartPage& page) const {
+    return page_bytes.subspan(page.offset, page.size);
+  }
+  std::span<const std::uint8_t> ShellBytes(const SvoPartPage& page) const {
+    return shell_bytes.subspan(page.shell_offset, page.shell_size);
+  }
+};
+StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path);
+
+}  // namespace svokit

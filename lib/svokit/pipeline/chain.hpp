@@ -1,0 +1,99 @@
+#pragma once
+// The chain's stages as one call each, what the tools run: a mesh to voxels (svo-voxelize), voxels
+// to an octree (svo-build), a mesh to an octree (mesh2svo). Each checks its output path, imports,
+// chooses whole or by pages (memory_policy.hpp), runs, writes, and reports what its summary needs.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "svokit/core/grid_transform.hpp"
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/formats/provenance.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_part.hpp"
+#include "svokit/pipeline/memory_policy.hpp"
+#include "svokit/pipeline/svo_parts.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
+#include "svokit/voxelize/voxelize.hpp"
+
+namespace svokit {
+
+/// Receives each warning (e.g. a texture that does not decode) as it is found.
+using WarningSink = std::function<void(const std::string&)>;
+
+/// A solid's interior, as a summary reports it.
+struct InteriorSummary {
+  std::uint64_t voxels = 0, cubes = 0;
+  FillMethod method = FillMethod::kColumns;
+  std::uint64_t open_edges = 0;
+};
+
+/// What the voxelization is: the grid fit, what shapes the voxels, and how the work is split
+/// (VoxelizeOptions' method and cutoff; its attributes follow `settings`).
+struct VoxelizeRequest {
+  GridFit grid;
+  VoxelizeSettings settings;
+  VoxelizeOptions split;
+  VoxelizeOptions Options() const;
+};
+
+struct MeshToVoxelsRequest {
+  std::filesystem::path input;   ///< a mesh
+  std::filesystem::path output;  ///< .vfrag, or voxel centres as .xyz or .ply
+  VoxelizeRequest voxelize;
+  std::optional<std::uint64_t> memory_limit;  ///< none: MemoryPlan's default
+  WarningSink warn;
+};
+struct MeshToVoxelsReport {
+  std::uint64_t triangles = 0;
+  GridTransform grid;
+  std::uint64_t voxels = 0;
+  MemoryPlan memory;  ///< by cubes when memory.by_pages()
+  std::optional<InteriorSummary> interior;
+};
+StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& request,
+                                          Progress& progress = Progress::Silent());
+
+/// What an octree's summary reports, however it was built.
+struct OctreeReport {
+  std::uint64_t voxels = 0;
+  std::uint32_t depth = 0;
+  std::optional<InteriorSummary> interior;  ///< a solid built whole
+  std::string level_table;                  ///< built whole: LevelTable()
+  SvoFileStats file;
+  MemoryPlan memory;  ///< by pages when memory.by_pages()
+};
+
+struct VoxelsToSvoRequest {
+  std::filesystem::path input;  ///< a .vfrag
+  std::filesystem::path mesh;   ///< the mesh that was voxelized (for contours); may be empty
+  std::filesystem::path output;
+  BuildSettings build;
+  std::optional<std::uint64_t> memory_limit;
+};
+StatusOr<OctreeReport> VoxelsToSvo(const VoxelsToSvoRequest& request,
+                                   Progress& progress = Progress::Silent());
+
+struct MeshToSvoRequest {
+  std::filesystem::path input;   ///< a mesh
+  std::filesystem::path output;  ///< .svo, or .svopart for a part
+  VoxelizeRequest voxelize;
+  BuildSettings build;
+  std::optional<std::uint64_t> memory_limit;
+  std::optional<SvoPartOf> part;  ///< one job's share of a build by pages (identity: computed)
+  WarningSink warn;
+};
+struct MeshToSvoReport {
+  std::uint64_t triangles = 0;
+  GridTransform grid;
+  OctreeReport octree;
+  std::optional<SvoPartStats> part;  ///< a part was built
+};
+StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& request,
+                                    Progress& progress = Progress::Silent());
+
+}  // namespace svokit

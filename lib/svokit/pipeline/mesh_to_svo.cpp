@@ -1,0 +1,139 @@
+// mesh2svo's run: a mesh to an octree in one process — whole, by pages within a memory limit, or
+// one part of a build by pages — the same file as svo-voxelize and svo-build.
+
+#include <memory>
+
+#include "svokit/core/crc32c.hpp"
+#include "svokit/core/file_io.hpp"
+#include "svokit/pipeline/chain.hpp"
+#include "svokit/pipeline/stages.hpp"
+#include "svokit/pipeline/svo_by_pages.hpp"
+#include "svokit/svo/compact_build.hpp"
+
+namespace svokit {
+
+namespace {
+
+struct Build {
+  const MeshToSvoRequest& request;
+  const Mesh& mesh;
+  const GridTransform& grid;
+  std::string meta;
+  BuildOptions options;
+  MeshToSvoReport& report;
+  Progress& progress;
+
+  void Warn(const std::vector<std::string>& warnings) const {
+    if (!request.warn) return;
+    for (const std::string& w : warnings) request.warn(w);
+  }
+
+  StatusOr<std::unique_ptr<RegionVoxelizer>> Regions() const {
+    StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
+        RegionVoxelizer::Create(mesh, grid, request.voxelize.Options());
+    if (!regions.ok()) return regions.status().WithContext(request.input.string());
+    Warn((*regions)->warnings());
+    return regions;
+  }
+
+  // One job's share of the pages; its identity: the input's bytes and the options that shape the
+  // file.
+  Status Part() {
+    StatusOr<std::unique_ptr<RegionVoxelizer>> regions = Regions();
+    if (!regions.ok()) return regions.status();
+    StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(request.input);
+    if (!bytes.ok()) return bytes.status();
+    SvoPartOf part = *request.part;
+    part.identity = std::uint64_t{Crc32c(bytes->data(), bytes->size())} << 32 |
+                    Crc32c(meta.data(), meta.size());
+    StatusOr<SvoPartStats> made =
+        BuildSvoPart(**regions, options, meta, part, request.output, request.build.compression,
+                     report.octree.memory.limit, progress);
+    if (!made.ok()) return made.status().WithContext(request.input.string());
+    report.part = *made;
+    return Status::Ok();
+  }
+
+  Status ByPages(const InteriorFinder* finder) {
+    StatusOr<std::unique_ptr<RegionVoxelizer>> regions = Regions();
+    if (!regions.ok()) return regions.status();
+    options.interior_finder = finder;
+    StatusOr<SvoFileStats> written =
+        BuildSvoByPages(**regions, options, meta, request.output, request.build.compression,
+                        report.octree.memory.limit, progress);
+    if (!written.ok()) return written.status().WithContext(request.input.string());
+    report.octree.voxels = written->voxels;
+    report.octree.depth = OctreeDepth(grid);
+    report.octree.file = std::move(*written);
+    return Status::Ok();
+  }
+
+  Status Whole(const InteriorFinder* finder) {
+    StatusOr<VoxelSet> voxels = Voxelize(mesh, grid, request.voxelize.Options(), progress);
+    if (!voxels.ok()) return voxels.status().WithContext(request.input.string());
+    Warn(voxels->warnings);
+    InteriorCubes interior;
+    if (finder != nullptr) {
+      if (voxels->keys.empty()) {
+        return Status::BadInput("{}: no voxels to fill between", request.input.string());
+      }
+      interior = RunStage(progress, "solid: interior", [&] { return finder->Fill(voxels->keys); });
+      options.interior = &interior;
+      report.octree.interior = InteriorSummary{interior.voxel_count(), interior.cube_count(),
+                                               interior.method, interior.open_edges};
+    }
+    StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), &mesh, options, meta, progress);
+    if (!svo.ok()) return svo.status().WithContext(request.input.string());
+    StatusOr<SvoFileStats> written = RunStage(progress, "write", [&] {
+      return WriteSvo(*svo, request.output, request.build.compression);
+    });
+    if (!written.ok()) return written.status();
+    report.octree.voxels = svo->voxel_count();
+    report.octree.depth = svo->depth();
+    report.octree.level_table = LevelTable(*svo);
+    report.octree.file = std::move(*written);
+    return Status::Ok();
+  }
+};
+
+}  // namespace
+
+StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
+  SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
+  StatusOr<Mesh> mesh = ImportStage(progress, r.input);
+  if (!mesh.ok()) return mesh.status();
+  StatusOr<GridTransform> grid = r.voxelize.grid.Fit(mesh->Bounds());
+  if (!grid.ok()) return grid.status().WithContext(r.input.string());
+  MeshToSvoReport report;
+  report.triangles = mesh->triangle_count();
+  report.grid = *grid;
+  const Provenance provenance{r.input.filename().string(), mesh->triangle_count(), r.voxelize.grid,
+                              r.voxelize.settings, r.build};
+  Build build{r, *mesh, *grid, ProvenanceJson(provenance), {}, report, progress};
+  build.options.brick_side = r.build.brick_side;
+  build.options.contours = r.build.contours;
+  // A solid's interior is decided by what the mesh is: exact crossings build by pages too, the
+  // winding numbers of a surface with open edges only whole.
+  std::unique_ptr<InteriorFinder> finder;
+  if (r.voxelize.settings.solid) {
+    StatusOr<std::unique_ptr<InteriorFinder>> made =
+        InteriorFinder::Create(*mesh, *grid, {}, progress);
+    if (!made.ok()) return made.status().WithContext(r.input.string());
+    finder = std::move(*made);
+  }
+  // Parts go by pages whatever the limit (none: no limit).
+  if (r.part) {
+    report.octree.memory.limit = r.memory_limit.value_or(0);
+    SVOKIT_RETURN_IF_ERROR(build.Part());
+    return report;
+  }
+  const double per_voxel = r.build.brick_side == 0 ? kBuildBytes : kBuildBrickBytes;
+  const bool can_split = !finder || finder->method() == FillMethod::kColumns;
+  report.octree.memory = ChooseMemoryPlan(
+      r.memory_limit, r.memory_limit ? 0 : per_voxel * EstimateVoxelCount(*mesh, *grid), can_split);
+  SVOKIT_RETURN_IF_ERROR(report.octree.memory.by_pages() ? build.ByPages(finder.get())
+                                                         : build.Whole(finder.get()));
+  return report;
+}
+
+}  // namespace svokit

@@ -1,0 +1,20 @@
+#include "svokit/svo/build_options.hpp"
+
+namespace svokit {
+
+Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options) {
+  if (voxels.keys.empty()) return Status::BadInput("the voxel set is empty: nothing to build");
+  if (options.brick_side != 0 && options.brick_side != 2 && options.brick_side != 3) {
+    return Status::BadInput("bricks must be 3, 2 or none (got {})", options.brick_side);
+  }
+  if (options.contours && mesh == nullptr) {
+    return Status::BadInput("contours need the mesh the voxels came from");
+  }
+  if ((voxels.has_colors() && voxels.colors.size() != voxels.size() && voxels.colors.size() != 1) ||
+      (voxels.has_normals() && voxels.normals.size() != voxels.size())) {
+    return Status::BadInput("voxel attribute arrays do not match the voxel count");
+  }
+  return Status::Ok();
+}
+
+}  // namespace svokit

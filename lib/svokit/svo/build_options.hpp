@@ -1,0 +1,32 @@
+#pragma once
+// What an octree build takes besides the voxels: bricks, contours and a solid's interior, and the
+// inputs every builder refuses (reference_build.hpp, compact_build.hpp, the builds by pages).
+
+#include <cstdint>
+
+#include "svokit/core/status.hpp"
+#include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/contour.hpp"
+#include "svokit/voxelize/voxel_set.hpp"
+
+namespace svokit {
+
+struct InteriorCubes;
+class InteriorFinder;
+
+struct BuildOptions {
+  std::uint32_t brick_side = 3;  ///< 3, 2 or 0 (no bricks)
+  bool contours = true;          ///< needs the mesh
+  ContourOptions contour;
+  /// A solid's interior (FillInterior, same grid): its cubes become full leaves. Null: a surface.
+  const InteriorCubes* interior = nullptr;
+  /// A solid built by pages from the mesh: what decides each page's interior (by exact crossings;
+  /// InteriorFinder::method() kColumns). Null: a surface, or `interior` holds it.
+  const InteriorFinder* interior_finder = nullptr;
+};
+
+/// What every builder refuses: an empty voxel set, a brick side other than 3, 2 or 0, contours
+/// without the mesh, attribute arrays that do not match the voxels.
+Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOptions& options);
+
+}  // namespace svokit

@@ -1,0 +1,42 @@
+#pragma once
+// Chunks → the assembled Svo (svo.hpp): every node's record and brick, for consumers that want the
+// octree whole. A chunk's bricks above the voxels expand from its distinct samples; its voxel
+// bricks are computed from its voxels and halo.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "svokit/svo/svo.hpp"
+#include "svokit/svo/svo_chunk.hpp"
+
+namespace svokit {
+
+/// Joins chunks into the Svo they are parts of: the top chunk first, then the pages in order
+/// (each level's nodes in ascending Morton order), or one chunk holding the whole tree. Bricks
+/// are assembled chunk by chunk; node records and contours once all are in.
+class SvoAssembler {
+ public:
+  /// An octree of the levels 0 .. max_level (at most the depth).
+  SvoAssembler(const SvoShape& shape, std::uint32_t max_level);
+  /// The bricks of the levels `chunk` holds, down to max_level: the costly part of Append, which
+  /// may run for several chunks at once (it only reads the assembler).
+  std::vector<SvoLevel> Bricks(const SvoChunk& chunk) const;
+  /// Appends the levels `chunk` holds, down to max_level, with their Bricks(chunk).
+  void Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks);
+  void Append(const SvoChunk& chunk) { Append(chunk, Bricks(chunk)); }
+  Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
+
+ private:
+  SvoShape shape_;
+  std::uint32_t max_level_;
+  std::vector<std::vector<std::uint8_t>> masks_, full_;
+  std::vector<std::vector<std::uint32_t>> words_;
+  std::vector<SvoLevel> levels_;
+};
+
+/// The voxel bricks of a page (or of a whole tree, `halo` empty): side³ samples per voxel of
+/// `chunk` in its order, computed from its voxels and those of its halo.
+void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out);
+
+}  // namespace svokit
