@@ -40,7 +40,8 @@ Between.
 """
 
 # The older run's armadillo 1024 figures (0.50 s, 5.00x) are superseded; dragon's, measured in
-# that run only, stay; bytes are shown in MB, large counts grouped, ratios with their sign.
+# that run only, stay, in the order of the rows chosen; bytes are shown in MB, large counts
+# grouped, ratios with their sign.
 EXPECTED = """\
 # Doc
 
@@ -50,8 +51,8 @@ EXPECTED = """\
 
 | case               | time (s) | vdb/ours | svo file (MB) | voxels     |
 | ------------------ | -------: | -------: | ------------: | ---------: |
-| armadillo 1024 geo |     0.20 |   18.55× |         0.583 |          – |
 | dragon 1024 geo    |     0.11 |        – |             – |          – |
+| armadillo 1024 geo |     0.20 |   18.55× |         0.583 |          – |
 | armadillo 4096 geo |     1.29 |        – |             – | 41 690 253 |
 
 <!-- tables:end -->
