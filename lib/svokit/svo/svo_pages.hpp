@@ -1,5 +1,5 @@
 #pragma once
-// An octree cut into pages, as a version-2 .svo stores it (formats/svo/README.md): the top levels
+// An octree cut into pages, as a version-2 .svo stores it (formats/svo.md): the top levels
 // 0 .. P − 1 in one chunk, and below the page level P each node's subtree as a page holding its
 // levels P .. depth with indices of its own. A page is self-contained: its samples are laid out
 // over its own nodes (SampleLayout, nodes outside it absent), and it carries the voxels around it
@@ -47,7 +47,7 @@ struct SvoChunk {
 
 /// A page is the subtree of a node 2^kPageSideBits voxels on a side (or the whole tree, when it is
 /// no larger). Fixed, so the page level follows from the depth alone: a build that makes the
-/// pages one at a time knows it before any voxel exists (formats/svo/README.md, "Pages": why
+/// pages one at a time knows it before any voxel exists (formats/svo.md, "Pages": why
 /// 128). A full page of that side has 2.4 M nodes, so its streams stay far below a reader's
 /// limits.
 inline constexpr std::uint32_t kPageSideBits = 7;
