@@ -353,7 +353,7 @@ TEST(SolidCli, BadInputIsOneLineExitTwoAndNoOutput) {
 }
 
 // svo-build refuses FILL cubes that are not free children of the surface's nodes
-// (vfrag/README.md, "Interior"): a cube away from the surface contradicts a closed surface's
+// (formats/vfrag.md, "Interior"): a cube away from the surface contradicts a closed surface's
 // exact crossings, which only ever decide the free children of its nodes.
 TEST(SolidCli, SvoBuildRefusesAFillCubeAwayFromTheSurface) {
   TempDir inputs;

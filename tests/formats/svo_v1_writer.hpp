@@ -1,5 +1,5 @@
 #pragma once
-// A writer of version-1 .svo files (formats/svo/README.md, "Version 1"), which svokit reads but
+// A writer of version-1 .svo files (formats/svo.md, "Version 1"), which svokit reads but
 // no longer writes: the suite makes them to test that reader, and to hand the validator octrees
 // damaged on purpose (a version-1 file stores every node's brick as it is).
 

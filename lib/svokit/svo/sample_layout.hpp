@@ -1,5 +1,5 @@
 #pragma once
-// Where each distinct brick sample of a level is stored (formats/svo/README.md, "Samples").
+// Where each distinct brick sample of a level is stored (formats/svo.md, "Samples").
 //
 // The samples of a node of size S sit on a lattice of spacing S/(side − 1): sample k ∈ [0, side)³
 // of node n is lattice point q = (side − 1)·n + k, and the nodes sharing a point share its value.

@@ -1,6 +1,6 @@
 #pragma once
 // The sparse voxel octree in memory, laid out exactly as the .svo file stores it
-// (formats/svo/README.md): levels breadth-first, level 0 the root, level `depth` the voxels.
+// (formats/svo.md): levels breadth-first, level 0 the root, level `depth` the voxels.
 //
 // Node i of level L (< depth) has child c (0..7, Morton order: bit 0 = x, 1 = y, 2 = z) when bit c
 // of its child mask is set; that child is node first_child + popcount(child_mask & ((1 << c) - 1))

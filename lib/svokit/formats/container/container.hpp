@@ -1,7 +1,7 @@
 #pragma once
 // The sectioned container every svokit file format shares (.svm, and the later .vfrag and .svo):
 // a fixed header, a table of tagged sections with offsets, sizes and CRC-32C checksums, and the
-// 64-byte-aligned section payloads. Layout: formats/container/README.md.
+// 64-byte-aligned section payloads. Layout: formats/container.md.
 
 #include <array>
 #include <cstdint>

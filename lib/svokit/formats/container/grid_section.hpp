@@ -1,6 +1,6 @@
 #pragma once
 // The GRID section every voxel format stores (.vfrag, .svo): origin (3 × f64), voxel size (f64),
-// dims (3 × u32), voxelization mode (u32) — 48 bytes, little-endian (formats/vfrag/README.md).
+// dims (3 × u32), voxelization mode (u32) — 48 bytes, little-endian (formats/vfrag.md).
 
 #include <array>
 #include <cmath>

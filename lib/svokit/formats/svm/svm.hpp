@@ -1,7 +1,7 @@
 #pragma once
 // .svm — svokit's normalized mesh: what svo-import writes and later stages read fast. A
 // self-contained Mesh (textures embedded as their original bytes) in the shared container.
-// Byte layout: formats/svm/README.md.
+// Byte layout: formats/svm.md.
 
 #include <cstdint>
 #include <filesystem>

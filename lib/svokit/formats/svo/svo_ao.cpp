@@ -1,4 +1,4 @@
-// The `AOCC` section of a version-2 .svo (README.md, "Ambient occlusion"): one byte of baked
+// The `AOCC` section of a version-2 .svo (formats/svo.md, "Ambient occlusion"): one byte of baked
 // ambient occlusion per node of every level, in node order, zstd-compressed as one stream.
 
 #include <zstd.h>

@@ -18,7 +18,7 @@ namespace svokit {
 
 namespace {
 
-// Stream kinds, in the order a chunk stores them (README.md, "Chunks").
+// Stream kinds, in the order a chunk stores them (formats/svo.md, "Chunks").
 enum Stream : std::uint8_t {
   kMasks = 1,
   kContourBits,

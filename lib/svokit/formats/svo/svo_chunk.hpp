@@ -1,5 +1,5 @@
 #pragma once
-// The bytes of a version-2 .svo chunk (its top chunk or one page; README.md here, "Chunks"): a
+// The bytes of a version-2 .svo chunk (its top chunk or one page; formats/svo.md, "Chunks"): a
 // directory of streams, each array of the chunk after a transform that suits it (byte planes,
 // deltas), compressed with zstd or stored.
 

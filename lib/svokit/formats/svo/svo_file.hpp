@@ -2,7 +2,7 @@
 // .svo — the sparse voxel octree file svo-build and mesh2svo write, in the shared container.
 // Version 2 (what is written): the top levels in one chunk and each subtree below the page level
 // a page, compressed; version 1 (still read): levels breadth-first with every node's brick.
-// Layout: README.md here. A renderer that streams pages uses svo_reader.hpp.
+// Layout: formats/svo.md. A renderer that streams pages uses svo_reader.hpp.
 
 #include <array>
 #include <cstdint>

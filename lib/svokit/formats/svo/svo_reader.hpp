@@ -3,7 +3,7 @@
 // and top chunk are checked), load the top levels, then the pages it needs, by index or by a
 // world-space box, each checked (CRC-32C, streams, counts) when it is loaded. A page's bricks are
 // assembled into a brick pool, side³ samples per node, the bytes version 1 stored; its voxels'
-// colours and normals are at hand too. README.md here, "Reading pages", shows the loop.
+// colours and normals are at hand too. formats/svo.md, "Reading pages", shows the loop.
 
 #include <cstdint>
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Version 1 of .svo (README.md, "Version 1"): per-level sections of node records and per-node
+// Version 1 of .svo (formats/svo.md, "Version 1"): per-level sections of node records and per-node
 // bricks, read as they are.
 
 #include <bit>

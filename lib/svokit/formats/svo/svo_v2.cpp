@@ -1,6 +1,6 @@
-// Version 2 of .svo (README.md): GRID, HEAD, the top chunk (TOPL), the pages back to back (PAGE),
-// the page table (PTAB) and META. Pages are encoded in parallel and written in order; they are
-// decoded in parallel batches and joined in order.
+// Version 2 of .svo (formats/svo.md): GRID, HEAD, the top chunk (TOPL), the pages back to back
+// (PAGE), the page table (PTAB) and META. Pages are encoded in parallel and written in order; they
+// are decoded in parallel batches and joined in order.
 
 #include <algorithm>
 #include <bit>

@@ -1,6 +1,6 @@
 #pragma once
 // .vfrag — the voxel fragment list svo-voxelize writes and svo-build reads: a VoxelSet (sorted
-// unique Morton keys) with its GridTransform, in the shared container. Layout: README.md here.
+// unique Morton keys) with its GridTransform, in the shared container. Layout: formats/vfrag.md.
 
 #include <cstdint>
 #include <filesystem>
@@ -151,8 +151,8 @@ class VfragCubes {
   HalfRgba shared_color_value_{};
 };
 
-/// A solid's interior as the FILL section stores it (README.md), and back: every level's keys
-/// ascending and below 8^level, the depth the grid's, every cube's first voxel inside it.
+/// A solid's interior as the FILL section stores it (formats/vfrag.md), and back: every level's
+/// keys ascending and below 8^level, the depth the grid's, every cube's first voxel inside it.
 std::vector<std::uint8_t> EncodeInteriorSection(const InteriorCubes& interior);
 StatusOr<InteriorCubes> DecodeInteriorSection(std::span<const std::uint8_t> bytes,
                                               const GridTransform& grid, const std::string& name);
