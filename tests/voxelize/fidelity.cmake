@@ -5,7 +5,9 @@ svokit_test(test_voxelize_fidelity
   SOURCES
     voxelize/exact_reference.cpp
     voxelize/voxelize_fidelity_test.cpp
+    voxelize/solid_test_meshes.cpp
     voxelize/solid_fill_test.cpp
+    voxelize/column_winding_test.cpp
     voxelize/winding_number_test.cpp
   LIBS CGAL::CGAL)
 

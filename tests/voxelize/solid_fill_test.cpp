@@ -42,11 +42,24 @@
 #include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"
 #include "tests/voxelize/exact_reference.hpp"
+#include "tests/voxelize/solid_test_meshes.hpp"
 
 namespace svokit {
 namespace {
 
+using test::Box;
 using test::ExactInside;
+using test::FaceSplit;
+using test::Finish;
+using test::FlippedComponent;
+using test::Grid3;
+using test::MakeSurface;
+using test::NestedShells;
+using test::OverlappingSpheres;
+using test::SignedVolume6;
+using test::Surface;
+using test::VoxelName;
+using test::VoxelShape;
 
 constexpr VoxelMode kModes[] = {VoxelMode::kConservative, VoxelMode::kThin};
 
@@ -64,68 +77,6 @@ double Seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_cloc
 
 // ---------------------------------------------------------------------------------------------
 // Meshes.
-
-/// Drops per-corner attributes and gives every triangle the default material: for meshes edited
-/// triangle by triangle.
-void Finish(Mesh& mesh) {
-  mesh.normals.clear();
-  mesh.uvs.clear();
-  mesh.colors.clear();
-  mesh.material_ids.clear();
-  EnsureDefaultMaterial(mesh);
-}
-
-/// Appends `src` scaled about the origin, moved by `offset`, and turned inside out if `reversed`.
-void Append(Mesh& dst, const Mesh& src, double scale, const Vec3d& offset, bool reversed) {
-  const auto first = static_cast<std::uint32_t>(dst.positions.size());
-  for (const Vec3d& p : src.positions) dst.positions.push_back(p * scale + offset);
-  for (const Triangle& t : src.triangles) {
-    dst.triangles.push_back(reversed ? Triangle{first + t[0], first + t[2], first + t[1]}
-                                     : Triangle{first + t[0], first + t[1], first + t[2]});
-  }
-}
-
-/// Six times the signed volume a triangle set encloses (positive: outward).
-double SignedVolume6(const std::vector<Vec3d>& p, const std::vector<Triangle>& triangles) {
-  double v = 0;
-  for (const Triangle& t : triangles) v += Dot(p[t[0]], Cross(p[t[1]], p[t[2]]));
-  return v;
-}
-
-/// A shape given in voxel coordinates.
-struct VoxelShape {
-  std::vector<Vec3d> points;
-  std::vector<Triangle> triangles;
-};
-
-enum class FaceSplit { kDiagonal02, kDiagonal13, kFan };
-
-/// The box [lo, hi] (voxel coordinates) with outward faces, each split along the diagonal from
-/// its first to its third corner (corner 0 is the face's lowest), from the second to the fourth,
-/// or into four triangles around its centre.
-VoxelShape Box(const Vec3d& lo, const Vec3d& hi, FaceSplit split = FaceSplit::kDiagonal02) {
-  VoxelShape s;
-  for (int i = 0; i < 8; ++i) {
-    s.points.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
-  }
-  // Corner i is (x, y, z) = bits (0, 1, 2) of i; each face counter-clockwise seen from outside.
-  constexpr std::uint32_t kFaces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                          {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : kFaces) {
-    if (split == FaceSplit::kDiagonal02) {
-      s.triangles.push_back({q[0], q[1], q[2]});
-      s.triangles.push_back({q[0], q[2], q[3]});
-    } else if (split == FaceSplit::kDiagonal13) {
-      s.triangles.push_back({q[1], q[2], q[3]});
-      s.triangles.push_back({q[1], q[3], q[0]});
-    } else {
-      const auto c = static_cast<std::uint32_t>(s.points.size());
-      s.points.push_back((s.points[q[0]] + s.points[q[2]]) * 0.5);
-      for (int e = 0; e < 4; ++e) s.triangles.push_back({q[e], q[(e + 1) % 4], c});
-    }
-  }
-  return s;
-}
 
 /// The octahedron |x − c.x| + |y − c.y| + |z − c.z| ≤ r, outward.
 VoxelShape Octahedron(const Vec3d& c, double r) {
@@ -160,18 +111,6 @@ Mesh ToWorld(const VoxelShape& s, const GridTransform& grid) {
     EXPECT_EQ(FixedToVoxel(fixed[i]), s.points[i]) << "corner " << i << " does not snap exactly";
   }
   return mesh;
-}
-
-/// The shape's corners as fixed-point voxel-space points (exact).
-std::vector<FixedPoint3> ToFixed(const std::vector<Vec3d>& points) {
-  std::vector<FixedPoint3> fixed;
-  for (const Vec3d& p : points) {
-    const double s = static_cast<double>(kFixedPointOne);
-    const FixedPoint3 f{std::llround(p.x * s), std::llround(p.y * s), std::llround(p.z * s)};
-    EXPECT_EQ(FixedToVoxel(f), p) << "test coordinate not on the fixed-point grid";
-    fixed.push_back(f);
-  }
-  return fixed;
 }
 
 /// Triangles whose corners all lie above `z`, removed (with their corner attributes).
@@ -232,34 +171,6 @@ Mesh Soup(const Mesh& mesh, std::size_t drop, std::size_t jitter, double amount,
   return out;
 }
 
-/// A hollow ball (outer shell outward, inner one reversed) with a smaller ball in its cavity.
-Mesh NestedShells() {
-  Mesh mesh;
-  Append(mesh, test::Icosphere(4), 1.0, {0, 0, 0}, false);
-  Append(mesh, test::Icosphere(3), 0.6, {0, 0, 0}, true);
-  Append(mesh, test::Icosphere(3), 0.3, {0.05, -0.03, 0.02}, false);
-  Finish(mesh);
-  return mesh;
-}
-
-/// Two closed unit spheres overlapping (winding number 2 where they do).
-Mesh OverlappingSpheres() {
-  Mesh mesh;
-  Append(mesh, test::Icosphere(2), 1.0, {0, 0, 0}, false);
-  Append(mesh, test::Icosphere(2), 1.0, {0.9, 0.2, 0.1}, false);
-  Finish(mesh);
-  return mesh;
-}
-
-/// A closed sphere and, beside it, one turned inside out (winding number −1 in it).
-Mesh FlippedComponent() {
-  Mesh mesh;
-  Append(mesh, test::Icosphere(2), 1.0, {0, 0, 0}, false);
-  Append(mesh, test::Icosphere(2), 1.0, {2.6, 0.1, 0}, true);
-  Finish(mesh);
-  return mesh;
-}
-
 std::optional<Mesh> LoadCgalMesh(const std::string& file) {
   static std::map<std::string, Mesh> cache;
   const auto it = cache.find(file);
@@ -274,33 +185,6 @@ std::optional<Mesh> LoadCgalMesh(const std::string& file) {
 
 // ---------------------------------------------------------------------------------------------
 // Dense grids and descriptions.
-
-struct Grid3 {
-  std::int64_t nx = 0, ny = 0, nz = 0;
-  explicit Grid3(const GridTransform& g) : nx(g.dims()[0]), ny(g.dims()[1]), nz(g.dims()[2]) {}
-  std::size_t size() const { return static_cast<std::size_t>(nx * ny * nz); }
-  std::size_t Index(std::int64_t x, std::int64_t y, std::int64_t z) const {
-    return static_cast<std::size_t>((z * ny + y) * nx + x);
-  }
-  bool In(std::int64_t x, std::int64_t y, std::int64_t z) const {
-    return x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz;
-  }
-  std::array<std::int64_t, 3> Coord(std::size_t i) const {
-    const auto j = static_cast<std::int64_t>(i);
-    return {j % nx, (j / nx) % ny, j / (nx * ny)};
-  }
-  Vec3d Centre(std::size_t i) const {
-    const auto c = Coord(i);
-    return {static_cast<double>(c[0]) + 0.5, static_cast<double>(c[1]) + 0.5,
-            static_cast<double>(c[2]) + 0.5};
-  }
-};
-
-std::string VoxelName(const std::array<std::int64_t, 3>& c) {
-  std::ostringstream s;
-  s << "(" << c[0] << "," << c[1] << "," << c[2] << ")";
-  return s.str();
-}
 
 std::string CubeName(std::uint32_t depth, std::uint32_t level, std::uint64_t key) {
   const MortonCoord c = MortonDecode(key);
@@ -352,28 +236,6 @@ std::string FreeNode(const std::vector<std::vector<std::uint64_t>>& nodes, std::
     }
   }
   return "is a surface voxel";
-}
-
-struct Surface {
-  std::vector<std::uint64_t> keys;
-  std::vector<std::uint8_t> dense;  ///< per grid voxel: 1 for a surface voxel
-};
-
-Surface MakeSurface(const Mesh& mesh, const GridTransform& grid, VoxelMode mode) {
-  VoxelizeOptions options;
-  options.mode = mode;
-  StatusOr<VoxelSet> set = Voxelize(mesh, grid, options);
-  EXPECT_TRUE(set.ok()) << set.status().message();
-  Surface s;
-  const Grid3 g(grid);
-  s.dense.assign(g.size(), 0);
-  if (!set.ok()) return s;
-  s.keys.assign(set->keys.begin(), set->keys.end());
-  for (const std::uint64_t k : s.keys) {
-    const MortonCoord c = MortonDecode(k);
-    s.dense[g.Index(c.x, c.y, c.z)] = 1;
-  }
-  return s;
 }
 
 /// Whether a surface voxel is within Chebyshev distance 1 of voxel i.
@@ -1074,204 +936,6 @@ TEST(SolidFillChecks, FailOnWrongCubesByWindingNumber) {
     } else {
       EXPECT_GT(failures, 0) << name << " went unnoticed";
     }
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
-// CountOpenEdges and ColumnWinding on hand-built cases.
-
-struct FixedMesh {
-  std::vector<FixedPoint3> vertices;
-  std::vector<Triangle> triangles;
-};
-
-FixedMesh Tetrahedron() {
-  const VoxelShape s{{{1, 1, 1}, {5, 1, 1}, {1, 5, 1}, {1, 1, 5}},
-                     {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
-  EXPECT_GT(SignedVolume6(s.points, s.triangles), 0);
-  return {ToFixed(s.points), s.triangles};
-}
-
-TEST(CountOpenEdges, Tetrahedra) {
-  const FixedMesh tet = Tetrahedron();
-  EXPECT_EQ(CountOpenEdges(tet.vertices, tet.triangles), 0u);
-
-  FixedMesh removed = tet;
-  removed.triangles.pop_back();
-  EXPECT_EQ(CountOpenEdges(removed.vertices, removed.triangles), 3u);
-
-  // Its three edges now run the way their neighbours' do: twice one way, never the other.
-  FixedMesh flipped = tet;
-  std::swap(flipped.triangles[1][1], flipped.triangles[1][2]);
-  EXPECT_EQ(CountOpenEdges(flipped.vertices, flipped.triangles), 3u);
-
-  // Two triangles flipped: the edge they share cancels again, their other four do not.
-  std::swap(flipped.triangles[3][1], flipped.triangles[3][2]);
-  EXPECT_EQ(CountOpenEdges(flipped.vertices, flipped.triangles), 4u);
-
-  // All flipped: a cycle again.
-  FixedMesh inverted = tet;
-  for (Triangle& t : inverted.triangles) std::swap(t[1], t[2]);
-  EXPECT_EQ(CountOpenEdges(inverted.vertices, inverted.triangles), 0u);
-
-  // Positions are merged by their snapped coordinates: a soup of the tetrahedron is closed.
-  FixedMesh soup;
-  for (const Triangle& t : tet.triangles) {
-    const auto first = static_cast<std::uint32_t>(soup.vertices.size());
-    for (const std::uint32_t v : t) soup.vertices.push_back(tet.vertices[v]);
-    soup.triangles.push_back({first, first + 1, first + 2});
-  }
-  EXPECT_EQ(CountOpenEdges(soup.vertices, soup.triangles), 0u);
-  // ... but a corner one fixed-point unit off opens the two edges at it.
-  soup.vertices[0].x += 1;
-  EXPECT_EQ(CountOpenEdges(soup.vertices, soup.triangles), 4u);
-
-  // Two tetrahedra sharing an edge (four faces at it, non-manifold): still a cycle. The second is
-  // the first turned half way about that edge (the line y = z = 1).
-  FixedMesh two = tet;
-  const std::vector<FixedPoint3> turned = ToFixed({{1, -3, 1}, {1, 1, -3}});
-  two.vertices.insert(two.vertices.end(), turned.begin(), turned.end());
-  for (const Triangle& t : tet.triangles) {
-    Triangle u = t;
-    for (std::uint32_t& v : u) v = v == 2 ? 4 : (v == 3 ? 5 : v);
-    two.triangles.push_back(u);
-  }
-  EXPECT_EQ(CountOpenEdges(two.vertices, two.triangles), 0u);
-
-  // The same open triangle twice, the same way: its three edges, counted once each.
-  const FixedMesh twice{tet.vertices, {tet.triangles[0], tet.triangles[0]}};
-  EXPECT_EQ(CountOpenEdges(twice.vertices, twice.triangles), 3u);
-  // Back to back: closed, with no volume.
-  const Triangle t0 = tet.triangles[0];
-  const FixedMesh back_to_back{tet.vertices, {t0, {t0[0], t0[2], t0[1]}}};
-  EXPECT_EQ(CountOpenEdges(back_to_back.vertices, back_to_back.triangles), 0u);
-  EXPECT_EQ(CountOpenEdges(tet.vertices, {}), 0u);
-}
-
-FixedMesh FixedShape(const VoxelShape& s) {
-  EXPECT_GT(SignedVolume6(s.points, s.triangles), 0);
-  return {ToFixed(s.points), s.triangles};
-}
-
-/// ColumnWinding at every voxel of columns (x, y) in [0, n)², z in [0, n): `expected(x, y, z)`.
-template <class Expected>
-void ExpectColumns(const FixedMesh& m, std::uint32_t n, const Expected& expected,
-                   const std::string& label) {
-  int failures = 0;
-  for (std::uint32_t x = 0; x < n; ++x) {
-    for (std::uint32_t y = 0; y < n; ++y) {
-      for (std::uint32_t z = 0; z < n; ++z) {
-        const std::int64_t got = ColumnWinding(m.vertices, m.triangles, x, y, z);
-        const std::int64_t want = expected(x, y, z);
-        if (got != want && failures++ < 8) {
-          ADD_FAILURE() << label << ": ColumnWinding at voxel "
-                        << VoxelName({std::int64_t{x}, std::int64_t{y}, std::int64_t{z}}) << " is "
-                        << got << ", expected " << want;
-        }
-      }
-    }
-  }
-}
-
-// A cube with corners on voxel corners: columns through its inside (including those exactly on
-// the diagonals its top and bottom faces are split along, and through a vertex of a fan) cross it
-// once each way.
-TEST(ColumnWinding, CubeInsideAndOutside) {
-  const auto inside = [](std::uint32_t lo, std::uint32_t hi) {
-    return [=](std::uint32_t x, std::uint32_t y, std::uint32_t z) -> std::int64_t {
-      return x >= lo && x < hi && y >= lo && y < hi && z >= lo && z < hi ? 1 : 0;
-    };
-  };
-  for (const FaceSplit split : {FaceSplit::kDiagonal02, FaceSplit::kDiagonal13}) {
-    const FixedMesh cube = FixedShape(Box({2, 2, 2}, {6, 6, 6}, split));
-    ExpectColumns(cube, 9, inside(2, 6), "cube [2,6]^3 split " + std::to_string(int(split)));
-  }
-  // Fans around (4.5, 4.5) on the top and bottom: column (4, 4) through their centre vertex.
-  const FixedMesh fan = FixedShape(Box({2, 2, 2}, {7, 7, 7}, FaceSplit::kFan));
-  ExpectColumns(fan, 10, inside(2, 7), "fanned cube [2,7]^3");
-  // Turned inside out: −1 inside.
-  FixedMesh inverted = FixedShape(Box({2, 2, 2}, {6, 6, 6}));
-  for (Triangle& t : inverted.triangles) std::swap(t[1], t[2]);
-  ExpectColumns(
-      inverted, 9,
-      [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) { return -inside(2, 6)(x, y, z); },
-      "inverted cube");
-}
-
-// A box with corners on voxel centres: its top and bottom diagonals run through voxel centres,
-// its vertical edges are columns, its side faces hold columns. Columns strictly inside cross it
-// once each way; a column in a side face or on an edge must be consistent: nothing below the box
-// or above it, and one value all along it.
-TEST(ColumnWinding, ColumnsThroughEdgesVerticesAndFaces) {
-  for (const FaceSplit split : {FaceSplit::kDiagonal02, FaceSplit::kDiagonal13, FaceSplit::kFan}) {
-    const std::string label = "box [2.5,6.5]^3 split " + std::to_string(int(split));
-    const FixedMesh box = FixedShape(Box({2.5, 2.5, 2.5}, {6.5, 6.5, 6.5}, split));
-    for (std::uint32_t x = 0; x < 9; ++x) {
-      for (std::uint32_t y = 0; y < 9; ++y) {
-        const bool strictly = x >= 3 && x <= 5 && y >= 3 && y <= 5;
-        const bool boundary = !strictly && x >= 2 && x <= 6 && y >= 2 && y <= 6;
-        std::int64_t along = 0;
-        for (std::uint32_t z = 0; z < 9; ++z) {
-          const std::int64_t got = ColumnWinding(box.vertices, box.triangles, x, y, z);
-          const std::string at =
-              label + " voxel " + VoxelName({std::int64_t{x}, std::int64_t{y}, std::int64_t{z}});
-          if (z < 2 || z > 6) {
-            EXPECT_EQ(got, 0) << at << " (below or above the box)";
-          } else if (z >= 3 && z <= 5) {
-            if (strictly) {
-              EXPECT_EQ(got, 1) << at;
-            } else if (boundary) {
-              EXPECT_TRUE(got == 0 || got == 1) << at << ": " << got;
-              if (z == 3) along = got;
-              EXPECT_EQ(got, along) << at << ": the column in the boundary changes along it";
-            } else {
-              EXPECT_EQ(got, 0) << at;
-            }
-          }
-        }
-      }
-    }
-  }
-}
-
-// Off the surface, ColumnWinding is the (integer) winding number of a cycle: 1, 0, 2 where two
-// spheres overlap, −1 in one turned inside out, 0 in a cavity.
-TEST(ColumnWinding, IsTheWindingNumberOfCycles) {
-  const std::pair<Mesh, const char*> meshes[] = {{test::Icosphere(3), "icosphere"},
-                                                 {OverlappingSpheres(), "overlapping spheres"},
-                                                 {FlippedComponent(), "flipped component"},
-                                                 {NestedShells(), "nested shells"}};
-  for (const auto& [mesh, name] : meshes) {
-    StatusOr<GridTransform> grid = GridTransform::FitResolution(mesh.Bounds(), 64);
-    ASSERT_TRUE(grid.ok());
-    const std::vector<FixedPoint3> fixed = SnapToVoxelSpace(mesh, *grid);
-    std::vector<Vec3d> positions;
-    for (const FixedPoint3& f : fixed) positions.push_back(FixedToVoxel(f));
-    const Surface surface = MakeSurface(mesh, *grid, VoxelMode::kConservative);
-    const Grid3 g(*grid);
-    std::mt19937_64 rng(11);
-    std::map<std::int64_t, int> seen;
-    int failures = 0;
-    for (int i = 0; i < 3000; ++i) {
-      const std::size_t v = rng() % g.size();
-      if (surface.dense[v]) continue;
-      const auto c = g.Coord(v);
-      const double w = WindingNumber(positions, mesh.triangles, g.Centre(v));
-      const std::int64_t got =
-          ColumnWinding(fixed, mesh.triangles, static_cast<std::uint32_t>(c[0]),
-                        static_cast<std::uint32_t>(c[1]), static_cast<std::uint32_t>(c[2]));
-      ++seen[got];
-      if (got != std::llround(w) && failures++ < 8) {
-        ADD_FAILURE() << name << ": ColumnWinding at " << VoxelName(c) << " is " << got
-                      << ", the winding number " << w;
-      }
-    }
-    std::string values;
-    for (const auto& [value, count] : seen) {
-      values += std::to_string(value) + ":" + std::to_string(count) + " ";
-    }
-    std::cout << "  " << name << ": ColumnWinding values " << values << "\n";
-    EXPECT_GE(seen.size(), 2u) << name;
   }
 }
 

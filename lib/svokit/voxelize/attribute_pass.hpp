@@ -11,13 +11,18 @@
 #include <span>
 #include <vector>
 
+#include "svokit/core/box.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
-#include "svokit/voxelize/voxelize.hpp"
+#include "svokit/voxelize/voxelize_options.hpp"
+
+namespace svokit {
+class AttributeSampler;
+}  // namespace svokit
 
 namespace svokit::voxelize_detail {
 
@@ -133,12 +138,6 @@ struct CellTriangle {
 void BinToCells(const TriangleVoxelizer& tv, const std::array<Vec3d, 3>& corners,
                 std::uint32_t triangle, int cell_bits, std::int64_t grow,
                 std::vector<CellTriangle>& out);
-
-}  // namespace svokit::voxelize_detail
-namespace svokit {
-class AttributeSampler;
-}
-namespace svokit::voxelize_detail {
 
 /// The same walk with a sampler prepared once for many calls (RegionVoxelizer), whose shared
 /// colour, if any, is `shared_color`. Without colours and normals in `options` it finds the

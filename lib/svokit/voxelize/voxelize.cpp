@@ -119,15 +119,22 @@ class StorageOutput final : public VoxelOutput {
   PackedVoxelization& result_;
 };
 
-// The voxels alone: every triangle's exact runs into per-thread bit sets, by the triangle path,
-// the fragment path or both (VoxelMethod); their union is the result.
-Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& grid,
-                        const VoxelizeOptions& options, VoxelAttributes attributes,
-                        VoxelOutput& output, Progress& progress) {
-  const Mesh& mesh = voxelizer.mesh();
-  const std::vector<FixedPoint3>& vertices = voxelizer.vertices();
+// One bit set per worker thread; their union is the result, whatever the split or thread count.
+using BitSets = tbb::enumerable_thread_specific<VoxelBitSet>;
+
+// Walks columns [u0,u1)×[v0,v1) of a triangle into this thread's bit set.
+void WalkColumns(BitSets& parts, const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1,
+                 std::int64_t v0, std::int64_t v1) {
+  VoxelBitSet& bits = parts.local();
+  tv.RunsAlongAxis(u0, u1, v0, v1,
+                   [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
+                       bool) { bits.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k)); });
+}
+
+// Which triangles take the fragment path: a flag per triangle (classified in parallel).
+std::vector<std::uint8_t> FlagLargeTriangles(const MeshVoxelizer& voxelizer,
+                                             const VoxelizeOptions& options) {
   const std::size_t n = voxelizer.size();
-  // Which triangles take the fragment path (classified in parallel; listed in index order).
   std::vector<std::uint8_t> is_large(n, options.method == VoxelMethod::kFragment ? 1 : 0);
   if (options.method == VoxelMethod::kHybrid) {
     ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
@@ -136,94 +143,85 @@ Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& gri
       }
     });
   }
-  std::vector<std::uint32_t> large;
-  for (std::size_t t = 0; t < n; ++t) {
-    if (is_large[t]) large.push_back(static_cast<std::uint32_t>(t));
-  }
+  return is_large;
+}
 
-  std::optional<Progress::Stage> stage(std::in_place, progress, "voxelize", n);
-  // One bit set per worker thread; their union is the result, whatever the split or thread count.
-  tbb::enumerable_thread_specific<VoxelBitSet> parts;
-  // Walks columns [u0,u1)×[v0,v1) of triangle t into this thread's bit set.
-  auto walk = [&](const TriangleVoxelizer& tv, std::int64_t u0, std::int64_t u1, std::int64_t v0,
-                  std::int64_t v1) {
-    VoxelBitSet& bits = parts.local();
-    tv.RunsAlongAxis(u0, u1, v0, v1,
-                     [&](auto axis, std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t k,
-                         bool) { bits.InsertRun(Coord(x), Coord(y), Coord(z), axis, Coord(k)); });
+// Triangle path: every triangle not `is_large`, a batch of triangles per task, in Morton order
+// of their first corner's brick: a batch then shares bricks, so brick lookups hit the bit set's
+// cache and brick memory stays hot (the union does not depend on the order).
+void WalkSmallTriangles(const MeshVoxelizer& voxelizer, const GridTransform& grid,
+                        const std::vector<std::uint8_t>& is_large, BitSets& parts,
+                        Progress::Stage& stage) {
+  const Mesh& mesh = voxelizer.mesh();
+  const std::vector<FixedPoint3>& vertices = voxelizer.vertices();
+  const std::size_t n = voxelizer.size();
+  struct Ordered {
+    std::uint64_t brick;
+    std::uint32_t triangle;
   };
-
-  // Triangle path: every triangle not in `large`, a batch of triangles per task, in Morton order
-  // of their first corner's brick: a batch then shares bricks, so brick lookups hit the bit
-  // set's cache and brick memory stays hot (the union does not depend on the order).
-  {
-    struct Ordered {
-      std::uint64_t brick;
-      std::uint32_t triangle;
-    };
-    std::vector<Ordered> order(n);
-    const IBox3 box = grid.IndexBox();
-    ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t t = begin; t < end; ++t) {
-        const FixedPoint3& p = vertices[mesh.triangles[voxelizer.Global(t)][0]];
-        std::uint32_t c[3];
-        for (int a = 0; a < 3; ++a) {
-          c[a] = Coord(std::clamp(p[a] >> kFixedPointBits, box.lo[a], box.hi[a] - 1) >> 4);
-        }
-        order[t] = {MortonEncode(c[0], c[1], c[2]), static_cast<std::uint32_t>(t)};
+  std::vector<Ordered> order(n);
+  const IBox3 box = grid.IndexBox();
+  ParallelChunks(n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      const FixedPoint3& p = vertices[mesh.triangles[voxelizer.Global(t)][0]];
+      std::uint32_t c[3];
+      for (int a = 0; a < 3; ++a) {
+        c[a] = Coord(std::clamp(p[a] >> kFixedPointBits, box.lo[a], box.hi[a] - 1) >> 4);
       }
-    });
-    // Stable: triangles of one brick stay in index order. Morton keys of brick coordinates
-    // below 2^b take 3b bits.
-    const std::int64_t last_brick = (std::max({box.hi.x, box.hi.y, box.hi.z}) - 1) >> 4;
-    RadixSortByKey(order, 3 * KeyBits(static_cast<std::uint64_t>(last_brick)),
-                   [](const Ordered& o) { return o.brick; });
-    ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::size_t t = order[i].triangle;
-        if (is_large[t]) continue;
-        const TriangleVoxelizer tv = voxelizer.Triangle(t);
-        walk(tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
-      }
-      stage->Advance(end - begin);
-    });
-  }
+      order[t] = {MortonEncode(c[0], c[1], c[2]), static_cast<std::uint32_t>(t)};
+    }
+  });
+  // Stable: triangles of one brick stay in index order. Morton keys of brick coordinates below
+  // 2^b take 3b bits.
+  const std::int64_t last_brick = (std::max({box.hi.x, box.hi.y, box.hi.z}) - 1) >> 4;
+  RadixSortByKey(order, 3 * KeyBits(static_cast<std::uint64_t>(last_brick)),
+                 [](const Ordered& o) { return o.brick; });
+  ParallelChunks(n, kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t t = order[i].triangle;
+      if (is_large[t]) continue;
+      const TriangleVoxelizer tv = voxelizer.Triangle(t);
+      WalkColumns(parts, tv, tv.u_lo(), tv.u_hi(), tv.v_lo(), tv.v_hi());
+    }
+    stage.Advance(end - begin);
+  });
+}
 
-  // Fragment path: footprints of the large triangles cut into tiles; tiles spread over threads.
-  // Tiles are listed per chunk of large triangles in parallel, then joined in order.
-  if (!large.empty()) {
-    std::vector<std::vector<Tile>> listed((large.size() + kTrianglesPerTask - 1) /
-                                          kTrianglesPerTask);
-    ParallelChunks(large.size(), kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
-      std::vector<Tile>& part = listed[begin / kTrianglesPerTask];
-      for (std::size_t i = begin; i < end; ++i) {
-        const TriangleVoxelizer tv = voxelizer.Triangle(large[i]);
-        if (tv.empty()) continue;
-        for (std::int64_t v0 = tv.v_lo(); v0 < tv.v_hi(); v0 += kTileColumns) {
-          for (std::int64_t u0 = tv.u_lo(); u0 < tv.u_hi(); u0 += kTileColumns) {
-            part.push_back(
-                {large[i], static_cast<std::int32_t>(u0), static_cast<std::int32_t>(v0)});
-          }
+// Fragment path: footprints of the `large` triangles cut into tiles; tiles spread over threads.
+// Tiles are listed per chunk of large triangles in parallel, then joined in order.
+void WalkLargeTriangles(const MeshVoxelizer& voxelizer, const std::vector<std::uint32_t>& large,
+                        BitSets& parts) {
+  std::vector<std::vector<Tile>> listed((large.size() + kTrianglesPerTask - 1) / kTrianglesPerTask);
+  ParallelChunks(large.size(), kTrianglesPerTask, [&](std::size_t begin, std::size_t end) {
+    std::vector<Tile>& part = listed[begin / kTrianglesPerTask];
+    for (std::size_t i = begin; i < end; ++i) {
+      const TriangleVoxelizer tv = voxelizer.Triangle(large[i]);
+      if (tv.empty()) continue;
+      for (std::int64_t v0 = tv.v_lo(); v0 < tv.v_hi(); v0 += kTileColumns) {
+        for (std::int64_t u0 = tv.u_lo(); u0 < tv.u_hi(); u0 += kTileColumns) {
+          part.push_back({large[i], static_cast<std::int32_t>(u0), static_cast<std::int32_t>(v0)});
         }
       }
-    });
-    std::vector<Tile> tiles;
-    for (const std::vector<Tile>& part : listed)
-      tiles.insert(tiles.end(), part.begin(), part.end());
-    ParallelChunks(tiles.size(), kTilesPerTask, [&](std::size_t begin, std::size_t end) {
-      // A large triangle's tiles are neighbours in the list: its set-up serves them all.
-      std::optional<TriangleVoxelizer> tv;
-      for (std::size_t i = begin; i < end; ++i) {
-        const Tile& tile = tiles[i];
-        if (i == begin || tile.triangle != tiles[i - 1].triangle) {
-          tv.emplace(voxelizer.Triangle(tile.triangle));
-        }
-        walk(*tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
+    }
+  });
+  std::vector<Tile> tiles;
+  for (const std::vector<Tile>& part : listed) tiles.insert(tiles.end(), part.begin(), part.end());
+  ParallelChunks(tiles.size(), kTilesPerTask, [&](std::size_t begin, std::size_t end) {
+    // A large triangle's tiles are neighbours in the list: its set-up serves them all.
+    std::optional<TriangleVoxelizer> tv;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Tile& tile = tiles[i];
+      if (i == begin || tile.triangle != tiles[i - 1].triangle) {
+        tv.emplace(voxelizer.Triangle(tile.triangle));
       }
-    });
-    stage->Advance(large.size());
-  }
+      WalkColumns(parts, *tv, tile.u0, tile.u0 + kTileColumns, tile.v0, tile.v0 + kTileColumns);
+    }
+  });
+}
 
+// The union of the bit sets, as keys or packed, into arrays `output` reserves: the voxel count.
+StatusOr<std::uint64_t> WriteUnion(BitSets& parts, VoxelAttributes attributes,
+                                   VoxelOutput& output) {
   Status reserved;
   std::size_t key_bytes = 0;
   std::uint64_t count;
@@ -249,7 +247,30 @@ Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& gri
   }
   SVOKIT_RETURN_IF_ERROR(reserved);
   output.Finish(std::move(attributes), {}, count, key_bytes);
-  stage->SetSummary(fmt::format("{} voxels", count));
+  return count;
+}
+
+// The voxels alone: every triangle's exact runs into per-thread bit sets, by the triangle path,
+// the fragment path or both (VoxelMethod); their union is the result.
+Status VoxelizeGeometry(const MeshVoxelizer& voxelizer, const GridTransform& grid,
+                        const VoxelizeOptions& options, VoxelAttributes attributes,
+                        VoxelOutput& output, Progress& progress) {
+  const std::size_t n = voxelizer.size();
+  const std::vector<std::uint8_t> is_large = FlagLargeTriangles(voxelizer, options);
+  std::vector<std::uint32_t> large;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (is_large[t]) large.push_back(static_cast<std::uint32_t>(t));
+  }
+  Progress::Stage stage(progress, "voxelize", n);
+  BitSets parts;
+  WalkSmallTriangles(voxelizer, grid, is_large, parts, stage);
+  if (!large.empty()) {
+    WalkLargeTriangles(voxelizer, large, parts);
+    stage.Advance(large.size());
+  }
+  const StatusOr<std::uint64_t> count = WriteUnion(parts, std::move(attributes), output);
+  if (!count.ok()) return count.status();
+  stage.SetSummary(fmt::format("{} voxels", *count));
   return Status::Ok();
 }
 

@@ -16,24 +16,9 @@
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
+#include "svokit/voxelize/voxelize_options.hpp"
 
 namespace svokit {
-
-enum class VoxelMethod {
-  kTriangle,  ///< one task per batch of triangles; each walks its whole footprint
-  kFragment,  ///< each triangle's footprint cut into tiles of columns; tiles spread over threads
-  kHybrid,    ///< small triangles by the triangle path, large ones (projected area) by fragments
-};
-
-struct VoxelizeOptions {
-  VoxelMode mode = VoxelMode::kConservative;
-  VoxelMethod method = VoxelMethod::kHybrid;
-  /// Hybrid: triangles whose dominant-axis projection covers more voxel² go the fragment path.
-  double hybrid_cutoff = 4096.0;
-  /// Per-voxel attributes (VoxelSet::colors / normals, and coverage with either).
-  bool colors = false;
-  bool normals = false;
-};
 
 StatusOr<VoxelSet> Voxelize(const Mesh& mesh, const GridTransform& grid,
                             const VoxelizeOptions& options,
