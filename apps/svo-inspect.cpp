@@ -10,6 +10,7 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/ray_cast.hpp"
+#include "svokit/inspect/render_options.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"
 
