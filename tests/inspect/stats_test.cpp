@@ -1,6 +1,5 @@
 // svo-inspect's statistics: counts worked out by hand on a tiny octree, the JSON keys and their
-// values, contour and brick figures on a real mesh against the octree's own arrays; grid slices
-// against the voxel set; PNG writing through the plugin.
+// values, contour and brick figures on a real mesh against the octree's own arrays.
 
 #include "svokit/inspect/stats.hpp"
 
@@ -9,10 +8,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/inspect/slice.hpp"
-#include "svokit/mesh/image_codec.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit {
@@ -171,96 +167,6 @@ TEST(SvoStats, ContoursAndBricksOfARealMeshMatchTheArrays) {
     EXPECT_LT(st.bricks.normal[a].min, -0.9) << "a torus faces every way";
     EXPECT_GT(st.bricks.normal[a].max, 0.9);
   }
-}
-
-TEST(Slice, CellsAreTheVoxelsWithTheirColours) {
-  const test::TorusScene& scene = test::Torus24();
-  const Svo& svo = scene.svo;
-  const auto& dims = svo.grid.dims();
-  std::map<std::array<std::uint32_t, 3>, std::size_t> voxel;
-  for (std::size_t i = 0; i < scene.voxels.keys.size(); ++i) {
-    const MortonCoord c = MortonDecode(scene.voxels.keys[i]);
-    voxel[{c.x, c.y, c.z}] = i;
-  }
-  int occupied = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (std::uint32_t k = 0; k < dims[axis]; k += 3) {
-      SliceOptions options;
-      options.scale = 1;
-      const StatusOr<RgbaImage> img = RenderSlice(svo, {axis, k}, options);
-      ASSERT_TRUE(img.ok()) << img.status().message();
-      // Columns and rows as slice.hpp orients them.
-      const int col_axis = axis == 0 ? 2 : 0, row_axis = axis == 1 ? 2 : 1;
-      ASSERT_EQ(img->width, int(dims[col_axis]));
-      ASSERT_EQ(img->height, int(dims[row_axis]));
-      for (int y = 0; y < img->height; ++y) {
-        for (int x = 0; x < img->width; ++x) {
-          std::array<std::uint32_t, 3> ijk{};
-          ijk[axis] = k;
-          ijk[col_axis] = std::uint32_t(x);
-          ijk[row_axis] = axis == 1 ? std::uint32_t(y) : dims[row_axis] - 1 - std::uint32_t(y);
-          const auto it = voxel.find(ijk);
-          const std::uint8_t* px = img->at(x, y);
-          ASSERT_EQ(px[3] != 0, it != voxel.end()) << axis << " " << k << " " << x << "," << y;
-          if (it == voxel.end()) continue;
-          ++occupied;
-          const std::uint32_t code = EncodeColor(scene.voxels.colors[it->second]);
-          for (int ch = 0; ch < 3; ++ch) {
-            EXPECT_NEAR(px[ch], double(code >> (8 * ch) & 0xff), 1.0) << x << "," << y;
-          }
-        }
-      }
-    }
-  }
-  EXPECT_GT(occupied, 200);
-}
-
-TEST(Slice, ScaleLevelAndBadInput) {
-  const Svo& svo = test::Torus24().svo;
-  const auto& dims = svo.grid.dims();
-  const StatusOr<RgbaImage> big = RenderSlice(svo, {2, 5});
-  ASSERT_TRUE(big.ok());
-  const int scale = 512 / int(std::max(dims[0], dims[1]));
-  EXPECT_EQ(big->width, int(dims[0]) * scale);
-  SliceOptions coarse;
-  coarse.level = svo.depth - 1;
-  coarse.scale = 1;
-  const StatusOr<RgbaImage> half = RenderSlice(svo, {0, 3}, coarse);
-  ASSERT_TRUE(half.ok());
-  EXPECT_EQ(half->width, int((dims[2] + 1) / 2));
-  EXPECT_EQ(RenderSlice(svo, {2, dims[2]}).status().code(), StatusCode::kBadInput);
-  coarse.level = svo.depth + 1;
-  EXPECT_EQ(RenderSlice(svo, {2, 0}, coarse).status().code(), StatusCode::kBadInput);
-  EXPECT_EQ(ParseSlice("Y=17").value().axis, 1);
-  EXPECT_EQ(ParseSlice("z=0").value().index, 0u);
-  for (const char* bad : {"w=3", "z", "z=", "z=-1", "z=3x", "=3", "zz=3", "x:3"}) {
-    EXPECT_EQ(ParseSlice(bad).status().code(), StatusCode::kBadInput) << bad;
-  }
-}
-
-TEST(WriteImage, PngRoundTripsExactlyAndFailuresLeaveNoFile) {
-  test::TempDir dir;
-  const int w = 7, h = 5;
-  std::vector<std::uint8_t> px(w * h * 4);
-  for (std::size_t i = 0; i < px.size(); ++i) px[i] = std::uint8_t(i * 37 % 256);
-  for (std::size_t i = 3; i < px.size(); i += 4) px[i] = 255;  // opaque: colours read back as is
-  ASSERT_TRUE(WriteImage(dir / "a.png", w, h, 4, px).ok());
-  auto bytes = ReadFileBytes(dir / "a.png");
-  ASSERT_TRUE(bytes.ok());
-  ImageHeader header;
-  auto back = DecodeImagePixels("a.png", *bytes, header);
-  ASSERT_TRUE(back.ok()) << back.status().message();
-  EXPECT_EQ(header.format, "png");
-  ASSERT_EQ(header.width, w);
-  ASSERT_EQ(header.height, h);
-  ASSERT_EQ(header.channels, 4);
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    ASSERT_EQ(std::lround((*back)[i] * 255), px[i]) << i;
-  }
-  EXPECT_EQ(WriteImage(dir / "b.notaformat", w, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(WriteImage(dir / "c.png", 0, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(WriteImage(dir / "no-such-dir" / "d.png", w, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.png"});
 }
 
 }  // namespace
