@@ -13,6 +13,7 @@
 #include "svokit/inspect/render_options.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"
+#include "svokit/inspect/stats_report.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
