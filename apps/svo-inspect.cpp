@@ -13,8 +13,10 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/ray_cast.hpp"
+#include "svokit/inspect/render_options.hpp"
 #include "svokit/inspect/slice.hpp"
 #include "svokit/inspect/stats.hpp"
+#include "svokit/inspect/stats_report.hpp"
 #include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {

@@ -1,13 +1,16 @@
 #pragma once
 // Octrees the svo-inspect tests share, each built once per test program through the library
 // chain mesh2svo uses (Voxelize + BuildSvo): a unit icosphere at 128³ with contours, and the
-// sample torus at a small resolution with colours, normals and contours.
+// sample torus at a small resolution with colours, normals and contours; and a tiny octree of
+// three voxels whose statistics are worked out by hand.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
+#include "svokit/core/morton.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/reference_build.hpp"
@@ -63,6 +66,25 @@ inline const TorusScene& Torus24() {
     return s;
   }();
   return scene;
+}
+
+/// Voxels (0,0,0), (1,0,0) and (3,3,3) of a 4³ grid: depth 2; level 1 has the nodes (0,0,0) with
+/// two children and (1,1,1) with one; the root has two children.
+inline Svo TinyOctree() {
+  VoxelSet set;
+  set.grid = GridTransform({-1.0, 2.0, 0.5}, 0.25, {4, 4, 4});
+  set.keys = {MortonEncode(0, 0, 0), MortonEncode(1, 0, 0), MortonEncode(3, 3, 3)};
+  std::sort(set.keys.begin(), set.keys.end());
+  for (std::size_t i = 0; i < set.keys.size(); ++i) {
+    set.colors.push_back({0.25f * float(i + 1), 0.5f, 0.0f, 1});
+    set.normals.push_back(Vec3f{0, 0, 1});
+    set.coverage.push_back(1);
+  }
+  BuildOptions options;
+  options.contours = false;
+  auto svo = BuildReferenceSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
+  EXPECT_TRUE(svo.ok()) << svo.status().message();
+  return svo.ok() ? std::move(*svo) : Svo{};
 }
 
 }  // namespace svokit::test

@@ -1,49 +1,17 @@
-// svo-inspect's statistics: counts worked out by hand on a tiny octree, the JSON keys and their
-// values, contour and brick figures on a real mesh against the octree's own arrays; grid slices
-// against the voxel set; PNG writing through the plugin.
+// svo-inspect's statistics: counts worked out by hand on a tiny octree, contour and brick figures
+// on a real mesh against the octree's own arrays.
 
 #include "svokit/inspect/stats.hpp"
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <nlohmann/json.hpp>
-
-#include "svokit/core/file_io.hpp"
-#include "svokit/core/morton.hpp"
-#include "svokit/inspect/slice.hpp"
-#include "svokit/mesh/image_codec.hpp"
-#include "svokit/svo/build_options.hpp"
-#include "svokit/svo/reference_build.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit {
 namespace {
 
-using nlohmann::json;
-
-// Voxels (0,0,0), (1,0,0) and (3,3,3) of a 4³ grid: depth 2; level 1 has the nodes (0,0,0) with
-// two children and (1,1,1) with one; the root has two children.
-Svo TinyOctree() {
-  VoxelSet set;
-  set.grid = GridTransform({-1.0, 2.0, 0.5}, 0.25, {4, 4, 4});
-  set.keys = {MortonEncode(0, 0, 0), MortonEncode(1, 0, 0), MortonEncode(3, 3, 3)};
-  std::sort(set.keys.begin(), set.keys.end());
-  for (std::size_t i = 0; i < set.keys.size(); ++i) {
-    set.colors.push_back({0.25f * float(i + 1), 0.5f, 0.0f, 1});
-    set.normals.push_back(Vec3f{0, 0, 1});
-    set.coverage.push_back(1);
-  }
-  BuildOptions options;
-  options.contours = false;
-  auto svo =
-      BuildReferenceSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
-  EXPECT_TRUE(svo.ok()) << svo.status().message();
-  return svo.ok() ? std::move(*svo) : Svo{};
-}
-
 TEST(SvoStats, TinyOctreeByHand) {
-  const Svo svo = TinyOctree();
+  const Svo svo = test::TinyOctree();
   ASSERT_EQ(svo.depth, 2u);
   const SvoStats st = ComputeSvoStats(svo);
   EXPECT_EQ(st.loaded_levels, 3u);
@@ -88,63 +56,6 @@ TEST(SvoStats, TinyOctreeByHand) {
   EXPECT_EQ(st.contours, 0u);
 }
 
-TEST(SvoStats, JsonKeysAndValues) {
-  const Svo svo = TinyOctree();
-  const SvoStats st = ComputeSvoStats(svo);
-  InspectReport options;
-  options.file = "tiny.svo";
-  options.file_bytes = 1234;
-  json j = json::parse(FormatStatsJson(st, options));
-  for (const char* key : {"file", "file_bytes", "grid", "bounds", "octree", "voxels", "bytes",
-                          "bricks", "contours", "metadata", "levels", "histograms"}) {
-    EXPECT_TRUE(j.contains(key)) << key;
-  }
-  EXPECT_EQ(j["file"], "tiny.svo");
-  EXPECT_EQ(j["file_bytes"], 1234);
-  EXPECT_TRUE(j["file_layout"].is_null());  // no file stats given
-  EXPECT_EQ(j["grid"]["dims"], json({4, 4, 4}));
-  EXPECT_EQ(j["grid"]["voxel_size"], 0.25);
-  EXPECT_EQ(j["grid"]["origin"], json({-1.0, 2.0, 0.5}));
-  EXPECT_EQ(j["grid"]["mode"], "conservative");
-  EXPECT_EQ(j["bounds"]["max"], json({0.0, 3.0, 1.5}));
-  EXPECT_EQ(j["octree"]["depth"], 2);
-  EXPECT_EQ(j["octree"]["root_size"], 1.0);
-  EXPECT_EQ(j["octree"]["loaded_levels"], 3);
-  EXPECT_EQ(j["voxels"], 3);
-  EXPECT_EQ(j["bytes"]["total"], 36 + 6 * 189);
-  EXPECT_EQ(j["bytes"]["nodes"], 36);
-  EXPECT_EQ(j["bytes"]["color"], 6 * 27 * 4);
-  EXPECT_EQ(j["bricks"]["side"], 3);
-  EXPECT_EQ(j["bricks"]["samples"], 162);
-  EXPECT_EQ(j["bricks"]["color_range"]["min"].size(), 4u);
-  EXPECT_EQ(j["bricks"]["normals"]["count"], st.bricks.with_normal);
-  EXPECT_EQ(j["contours"]["fitted"], false);
-  EXPECT_EQ(j["metadata"]["source"], "tiny.obj");
-  EXPECT_TRUE(j["levels"].is_null());
-  EXPECT_TRUE(j["histograms"].is_null());
-
-  options.levels = options.histograms = true;
-  j = json::parse(FormatStatsJson(st, options));
-  ASSERT_EQ(j["levels"].size(), 3u);
-  EXPECT_EQ(j["levels"][1]["nodes"], 2);
-  EXPECT_EQ(j["levels"][1]["children"], 3);
-  EXPECT_EQ(j["levels"][1]["branching"], 1.5);
-  EXPECT_EQ(j["levels"][2]["leaves"], 3);
-  EXPECT_EQ(j["levels"][2]["bytes"]["total"], 3 * 189);
-  EXPECT_EQ(j["levels"][2]["occupancy"], 3.0 / 64);
-  EXPECT_EQ(j["levels"][0]["contours"]["count"], 0);
-  EXPECT_EQ(j["histograms"]["children"], json({1, 2, 0, 0, 0, 0, 0, 0}));
-  EXPECT_EQ(j["histograms"]["opacity"].size(), 11u);
-
-  const std::string text = FormatStatsText(st, options);
-  for (const char* key :
-       {"file               tiny.svo (1234 bytes, 411.33 bytes per voxel",
-        "grid               4 x 4 x 4", "voxels             3", "contours           none", "source",
-        "children per inner node", "bits/vox"}) {
-    EXPECT_NE(text.find(key), std::string::npos) << key << "\n" << text;
-  }
-}
-
 TEST(SvoStats, ContoursAndBricksOfARealMeshMatchTheArrays) {
   const Svo& svo = test::Torus24().svo;
   const SvoStats st = ComputeSvoStats(svo);
@@ -174,96 +85,6 @@ TEST(SvoStats, ContoursAndBricksOfARealMeshMatchTheArrays) {
     EXPECT_LT(st.bricks.normal[a].min, -0.9) << "a torus faces every way";
     EXPECT_GT(st.bricks.normal[a].max, 0.9);
   }
-}
-
-TEST(Slice, CellsAreTheVoxelsWithTheirColours) {
-  const test::TorusScene& scene = test::Torus24();
-  const Svo& svo = scene.svo;
-  const auto& dims = svo.grid.dims();
-  std::map<std::array<std::uint32_t, 3>, std::size_t> voxel;
-  for (std::size_t i = 0; i < scene.voxels.keys.size(); ++i) {
-    const MortonCoord c = MortonDecode(scene.voxels.keys[i]);
-    voxel[{c.x, c.y, c.z}] = i;
-  }
-  int occupied = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (std::uint32_t k = 0; k < dims[axis]; k += 3) {
-      SliceOptions options;
-      options.scale = 1;
-      const StatusOr<RgbaImage> img = RenderSlice(svo, {axis, k}, options);
-      ASSERT_TRUE(img.ok()) << img.status().message();
-      // Columns and rows as slice.hpp orients them.
-      const int col_axis = axis == 0 ? 2 : 0, row_axis = axis == 1 ? 2 : 1;
-      ASSERT_EQ(img->width, int(dims[col_axis]));
-      ASSERT_EQ(img->height, int(dims[row_axis]));
-      for (int y = 0; y < img->height; ++y) {
-        for (int x = 0; x < img->width; ++x) {
-          std::array<std::uint32_t, 3> ijk{};
-          ijk[axis] = k;
-          ijk[col_axis] = std::uint32_t(x);
-          ijk[row_axis] = axis == 1 ? std::uint32_t(y) : dims[row_axis] - 1 - std::uint32_t(y);
-          const auto it = voxel.find(ijk);
-          const std::uint8_t* px = img->at(x, y);
-          ASSERT_EQ(px[3] != 0, it != voxel.end()) << axis << " " << k << " " << x << "," << y;
-          if (it == voxel.end()) continue;
-          ++occupied;
-          const std::uint32_t code = EncodeColor(scene.voxels.colors[it->second]);
-          for (int ch = 0; ch < 3; ++ch) {
-            EXPECT_NEAR(px[ch], double(code >> (8 * ch) & 0xff), 1.0) << x << "," << y;
-          }
-        }
-      }
-    }
-  }
-  EXPECT_GT(occupied, 200);
-}
-
-TEST(Slice, ScaleLevelAndBadInput) {
-  const Svo& svo = test::Torus24().svo;
-  const auto& dims = svo.grid.dims();
-  const StatusOr<RgbaImage> big = RenderSlice(svo, {2, 5});
-  ASSERT_TRUE(big.ok());
-  const int scale = 512 / int(std::max(dims[0], dims[1]));
-  EXPECT_EQ(big->width, int(dims[0]) * scale);
-  SliceOptions coarse;
-  coarse.level = svo.depth - 1;
-  coarse.scale = 1;
-  const StatusOr<RgbaImage> half = RenderSlice(svo, {0, 3}, coarse);
-  ASSERT_TRUE(half.ok());
-  EXPECT_EQ(half->width, int((dims[2] + 1) / 2));
-  EXPECT_EQ(RenderSlice(svo, {2, dims[2]}).status().code(), StatusCode::kBadInput);
-  coarse.level = svo.depth + 1;
-  EXPECT_EQ(RenderSlice(svo, {2, 0}, coarse).status().code(), StatusCode::kBadInput);
-  EXPECT_EQ(ParseSlice("Y=17").value().axis, 1);
-  EXPECT_EQ(ParseSlice("z=0").value().index, 0u);
-  for (const char* bad : {"w=3", "z", "z=", "z=-1", "z=3x", "=3", "zz=3", "x:3"}) {
-    EXPECT_EQ(ParseSlice(bad).status().code(), StatusCode::kBadInput) << bad;
-  }
-}
-
-TEST(WriteImage, PngRoundTripsExactlyAndFailuresLeaveNoFile) {
-  test::TempDir dir;
-  const int w = 7, h = 5;
-  std::vector<std::uint8_t> px(w * h * 4);
-  for (std::size_t i = 0; i < px.size(); ++i) px[i] = std::uint8_t(i * 37 % 256);
-  for (std::size_t i = 3; i < px.size(); i += 4) px[i] = 255;  // opaque: colours read back as is
-  ASSERT_TRUE(WriteImage(dir / "a.png", w, h, 4, px).ok());
-  auto bytes = ReadFileBytes(dir / "a.png");
-  ASSERT_TRUE(bytes.ok());
-  ImageHeader header;
-  auto back = DecodeImagePixels("a.png", *bytes, header);
-  ASSERT_TRUE(back.ok()) << back.status().message();
-  EXPECT_EQ(header.format, "png");
-  ASSERT_EQ(header.width, w);
-  ASSERT_EQ(header.height, h);
-  ASSERT_EQ(header.channels, 4);
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    ASSERT_EQ(std::lround((*back)[i] * 255), px[i]) << i;
-  }
-  EXPECT_EQ(WriteImage(dir / "b.notaformat", w, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(WriteImage(dir / "c.png", 0, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(WriteImage(dir / "no-such-dir" / "d.png", w, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.png"});
 }
 
 }  // namespace

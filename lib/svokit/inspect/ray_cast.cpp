@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -16,12 +15,7 @@ namespace svokit {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr int kMaxImageSide = 16384;
 constexpr double kMargin = 0.02;  // of the image per side, around the fitted bounds
-
-constexpr std::array<std::string_view, 7> kViewNames = {"front", "back",   "left", "right",
-                                                        "top",   "bottom", "iso"};
-constexpr std::array<std::string_view, 4> kShadeNames = {"color", "normal", "depth", "ao"};
 
 Vec3d Normalized(const Vec3d& v) {
   return v / Length(v);
@@ -313,44 +307,6 @@ std::uint8_t Byte(double v) {
 
 }  // namespace
 
-StatusOr<View> ParseView(std::string_view name) {
-  for (std::size_t i = 0; i < kViewNames.size(); ++i) {
-    if (kViewNames[i] == name) return static_cast<View>(i);
-  }
-  return Status::BadInput("--view '{}' is not front, back, left, right, top, bottom or iso", name);
-}
-
-StatusOr<Shade> ParseShade(std::string_view name) {
-  for (std::size_t i = 0; i < kShadeNames.size(); ++i) {
-    if (kShadeNames[i] == name) return static_cast<Shade>(i);
-  }
-  return Status::BadInput("--shade '{}' is not color, normal, depth or ao", name);
-}
-
-StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {
-  const auto bad = [&] {
-    return Status::BadInput("--size '{}': expected WxH with each side 1 to {}", text,
-                            kMaxImageSide);
-  };
-  const std::size_t x = text.find('x');
-  if (x == std::string_view::npos) return bad();
-  std::array<int, 2> size{};
-  const std::array<std::string_view, 2> parts = {text.substr(0, x), text.substr(x + 1)};
-  for (int i = 0; i < 2; ++i) {
-    const char* end = parts[i].data() + parts[i].size();
-    const auto [ptr, ec] = std::from_chars(parts[i].data(), end, size[i]);
-    if (ec != std::errc() || ptr != end || size[i] < 1 || size[i] > kMaxImageSide) return bad();
-  }
-  return size;
-}
-
-std::string_view ViewName(View view) {
-  return kViewNames[static_cast<std::size_t>(view)];
-}
-std::string_view ShadeName(Shade shade) {
-  return kShadeNames[static_cast<std::size_t>(shade)];
-}
-
 std::array<double, 2> OrthoCamera::Project(const Vec3d& p) const {
   const Vec3d rel = p - top_left;
   return {Dot(rel, right) / pixel_size, -Dot(rel, up) / pixel_size};
@@ -464,10 +420,6 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
     result.node_visits += row_visits[y];
   }
   return result;
-}
-
-Status WriteRgbaImage(const RgbaImage& image, const std::filesystem::path& path) {
-  return WriteImage(path, image.width, image.height, 4, image.pixels);
 }
 
 }  // namespace svokit

@@ -7,32 +7,14 @@
 
 #include <array>
 #include <cstdint>
-#include <optional>
-#include <string>
-#include <string_view>
 
 #include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
 #include "svokit/inspect/image.hpp"
+#include "svokit/inspect/render_options.hpp"
 #include "svokit/svo/svo.hpp"
 
 namespace svokit {
-
-enum class View { kFront, kBack, kLeft, kRight, kTop, kBottom, kIso };
-enum class Shade {
-  kColor,   ///< brick colour (trilinear at the hit), lit from the viewer's upper left
-  kNormal,  ///< shading normal as RGB = (n + 1)/2
-  kDepth,   ///< grey, near bright, over the grid's depth range along the view
-  kAo,      ///< the hit node's baked ambient occlusion (svo-bake), grey: white open, black occluded
-};
-
-/// "front", "back", "left", "right", "top", "bottom", "iso"; anything else is bad input.
-StatusOr<View> ParseView(std::string_view name);
-StatusOr<Shade> ParseShade(std::string_view name);
-std::string_view ViewName(View view);
-/// "WxH" (e.g. "640x480"), each side 1..16384; anything else is bad input.
-StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text);
-std::string_view ShadeName(Shade shade);
 
 /// An orthographic camera: the ray of pixel (x, y) (x right, y down) starts at
 /// top_left + right·(x + ½)·pixel_size − up·(y + ½)·pixel_size and runs along `forward`.
@@ -50,16 +32,6 @@ struct OrthoCamera {
 /// A camera whose image (width × height, square pixels) holds the grid's world bounds with a
 /// margin of 2 % per side, centred.
 OrthoCamera FitCamera(const Svo& svo, View view, int width, int height);
-
-struct RenderOptions {
-  View view = View::kFront;
-  int width = 512, height = 512;
-  /// Nodes of this level are the leaves; default (and at most) the finest loaded level.
-  std::optional<std::uint32_t> level;
-  Shade shade = Shade::kColor;
-  /// Intersect contour slabs; off, leaves are their full cubes (what contours save is visible).
-  bool contours = true;
-};
 
 /// One ray's outcome.
 struct RayHit {

@@ -15,6 +15,7 @@
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/container/mapped_writer.hpp"
 #include "svokit/formats/provenance.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
