@@ -11,7 +11,6 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/export.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
-#include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

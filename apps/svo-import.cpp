@@ -10,7 +10,6 @@
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/mesh_report.hpp"
-#include "svokit/pipeline/stages.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;

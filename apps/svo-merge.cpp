@@ -8,7 +8,6 @@
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
-#include "svokit/pipeline/stages.hpp"
 #include "svokit/pipeline/svo_parts.hpp"
 
 int main(int argc, char** argv) {

@@ -9,8 +9,8 @@
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
-#include "svokit/pipeline/stages.hpp"
 #include "svokit/validate/validate.hpp"
 
 int main(int argc, char** argv) {

@@ -43,7 +43,7 @@ void Build(benchmark::State& state, const Scene* scene, std::uint32_t brick_side
         state.SkipWithError(svo.status().message().c_str());
         return;
       }
-      benchmark::DoNotOptimize(svo->tree.masks.data());
+      benchmark::DoNotOptimize(svo->whole.tree.masks.data());
     }
   }
   state.counters["voxels"] = static_cast<double>(scene->voxels.size());

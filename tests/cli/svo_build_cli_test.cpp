@@ -7,6 +7,7 @@
 #include <functional>
 #include <sstream>
 
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
@@ -57,9 +58,12 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
   EXPECT_EQ(sa->depth, 6u);
   EXPECT_EQ(sa->brick_side, 3u);
   EXPECT_TRUE(sa->has_color && sa->has_normal && sa->has_contours);
-  EXPECT_NE(sa->metadata.find("uv-torus.obj"), std::string::npos) << sa->metadata;
-  EXPECT_NE(sa->metadata.find("--resolution 48"), std::string::npos) << sa->metadata;
-  EXPECT_NE(sa->metadata.find("--bricks 3"), std::string::npos) << sa->metadata;
+  const Provenance meta = ParseProvenance(sa->metadata);
+  EXPECT_EQ(meta.source, "uv-torus.obj") << sa->metadata;
+  EXPECT_EQ(meta.triangles, 2304u);
+  EXPECT_EQ(meta.grid, (GridFit{48, 0, 0})) << sa->metadata;
+  EXPECT_EQ(meta.voxelize, (VoxelizeSettings{VoxelMode::kConservative, true, true, false}));
+  EXPECT_EQ(meta.build, BuildSettings{}) << sa->metadata;
 }
 
 TEST(SvoBuildCli, ChainEqualsMesh2svoWithOtherOptions) {
@@ -95,7 +99,7 @@ TEST(SvoBuildCli, NoContoursNeedsNoMesh) {
   EXPECT_FALSE(svo->has_contours);
   for (const SvoLevel& lv : svo->levels) EXPECT_TRUE(lv.contours.empty());
   EXPECT_EQ(svo->brick_side, 3u);
-  EXPECT_NE(svo->metadata.find("--no-contours"), std::string::npos) << svo->metadata;
+  EXPECT_FALSE(ParseProvenance(svo->metadata).build->contours) << svo->metadata;
   // Without bricks either: nodes only.
   RunOk("svo-build",
         {vfrag, "-o", (dir / "bare.svo").string(), "--bricks", "none", "--no-contours", "-q"});

@@ -109,7 +109,7 @@ TEST(SvoExportCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{svo, "-o", "{dir}/out.obj"}, "output must be a .vdb, .binvox, .vox, .ply, .xyz file"},
       {{svo, "-o", "{dir}/out"}, "output must be a .vdb"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "7"},
-       "torus.svo: --level 7 exceeds the octree's depth 6"},
+       "torus.svo: level 7 exceeds the octree's depth 6"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "-1"}, "--level"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "x"}, "--level"},
       {{svo, "-o", "{dir}/missing/out.binvox"}, "output directory does not exist"},

@@ -10,6 +10,7 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
@@ -87,6 +88,41 @@ Json DumpMeta(const container::Frame& frame) {
   if (!meta) return nullptr;
   Json parsed = Json::parse(meta->begin(), meta->end(), nullptr, false);
   return parsed.is_discarded() ? Json(std::string(meta->begin(), meta->end())) : parsed;
+}
+
+// What ParseProvenance makes of META, typed members or the option text of older files: every
+// member, null where absent.
+Json DumpProvenance(const container::Frame& frame) {
+  const auto meta = SectionBytes(frame, "META");
+  const Provenance p = meta ? ParseProvenance(std::string_view(
+                                  reinterpret_cast<const char*>(meta->data()), meta->size()))
+                            : Provenance{};
+  Json o = {{"source", p.source}, {"triangles", p.triangles}, {"generator", p.generator}};
+  o["grid"] = p.grid ? Json{{"resolution", p.grid->resolution},
+                            {"voxel_size", p.grid->voxel_size},
+                            {"pad", p.grid->pad}}
+                     : Json(nullptr);
+  o["voxelize"] =
+      p.voxelize ? Json{{"mode", p.voxelize->mode == VoxelMode::kThin ? "thin" : "conservative"},
+                        {"color", p.voxelize->colors},
+                        {"normal", p.voxelize->normals},
+                        {"fill", p.voxelize->solid ? "solid" : "surface"}}
+                 : Json(nullptr);
+  o["build"] = p.build ? Json{{"bricks", p.build->brick_side},
+                              {"contours", p.build->contours},
+                              {"compression", p.build->compression.zstd ? "zstd" : "none"},
+                              {"zstd_level", p.build->compression.level}}
+                       : Json(nullptr);
+  o["bake"] =
+      p.bake
+          ? Json{{"cones", p.bake->cones},
+                 {"aperture", p.bake->aperture},
+                 {"distance", p.bake->distance},
+                 {"falloff", p.bake->falloff},
+                 {"offset", p.bake->offset},
+                 {"jitter_seed", p.bake->jitter_seed ? Json(*p.bake->jitter_seed) : Json(nullptr)}}
+          : Json(nullptr);
+  return o;
 }
 
 Json DumpGrid(const GridTransform& grid, VoxelMode mode) {
@@ -184,6 +220,7 @@ StatusOr<Json> DumpVfrag(const std::filesystem::path& path) {
   Json o = {{"container", std::move(*out)}};
   o["grid"] = DumpGrid(set->grid, set->mode);
   o["meta"] = DumpMeta(*frame);
+  o["provenance"] = DumpProvenance(*frame);
   o["voxels"] = set->size();
   o["keys"] = Array(set->keys);
   o["colors_shared"] = set->colors.size() == 1;
@@ -365,6 +402,7 @@ StatusOr<Json> DumpSvo(const std::filesystem::path& path) {
   o["grid"] = DumpGrid(svo->grid, svo->mode);
   o["head"] = *head;
   o["meta"] = DumpMeta(*frame);
+  o["provenance"] = DumpProvenance(*frame);
   if (frame->version() >= 2) {
     StatusOr<SvoReader> reader = SvoReader::Open(path);
     if (!reader.ok()) return reader.status();

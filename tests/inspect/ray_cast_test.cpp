@@ -338,7 +338,9 @@ TEST(Render, OptionsOutOfRangeAreBadInput) {
   options.level = svo.depth + 1;
   const auto r = RenderSvo(svo, options);
   EXPECT_EQ(r.status().code(), StatusCode::kBadInput);
-  EXPECT_NE(r.status().message().find("--level"), std::string::npos);
+  const std::string want = "level " + std::to_string(svo.depth + 1) +
+                           " is beyond the octree's levels 0.." + std::to_string(svo.depth);
+  EXPECT_NE(r.status().message().find(want), std::string::npos) << r.status().message();
 }
 
 }  // namespace

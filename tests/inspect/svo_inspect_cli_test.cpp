@@ -84,8 +84,9 @@ TEST(SvoInspectCli, JsonMatchesTheFile) {
   EXPECT_EQ(j["grid"]["dims"][0], svo->grid.dims()[0]);
   EXPECT_EQ(j["contours"]["fitted"], true);
   EXPECT_EQ(j["metadata"]["source"], "uv-torus.obj");
-  EXPECT_NE(j["metadata"]["voxelize"].get<std::string>().find("--resolution 32"),
-            std::string::npos);
+  EXPECT_EQ(j["metadata"]["grid"]["resolution"], 32);
+  EXPECT_EQ(j["metadata"]["voxelize"]["mode"], "conservative");
+  EXPECT_EQ(j["metadata"]["build"]["bricks"], 3);
   EXPECT_TRUE(j["render"].is_null());
   EXPECT_TRUE(j["slice"].is_null());
   EXPECT_TRUE(j["histograms"].is_null());
@@ -196,7 +197,7 @@ TEST(SvoInspectCli, BadInputIsOneLineExitTwoAndNoPicture) {
       {{TorusSvo(), "--render", png, "--size", "640"}, "--size"},
       {{TorusSvo(), "--render", png, "--level", "9"}, TorusSvo()},
       {{TorusSvo(), "--slice", "w=3", png}, "--slice"},
-      {{TorusSvo(), "--slice", "z=999", png}, "--slice"},
+      {{TorusSvo(), "--slice", "z=999", png}, "slice z=999: the grid has"},
       {{TorusSvo(), "--render", (out / "x.jpg").string()}, "x.jpg"},
       {{TorusSvo(), "--render", (out / "nodir" / "x.png").string()}, "x.png"},
   };

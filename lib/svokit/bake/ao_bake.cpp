@@ -71,8 +71,7 @@ double MeanAo(std::span<const float> ao) {
 StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo) {
   if (!svo.has_normal || svo.brick_side == 0) {
     return Status::BadInput(
-        "the octree's voxels have no normals to bake along (voxelize with "
-        "--attributes normal or color,normal)");
+        "the octree's voxels have no normals to bake along (voxelize it with normals)");
   }
   const std::vector<std::uint64_t> keys = svo.LevelKeys(svo.depth);
   std::vector<AoPoint> points(keys.size());
@@ -166,7 +165,7 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
     return Status::BadInput("the mesh has no texture coordinates to bake a texture over");
   }
   if (size < 1 || size > kMaxTextureSide) {
-    return Status::BadInput("--size {}: must be 1..{}", size, kMaxTextureSide);
+    return Status::BadInput("a texture of {} texels a side: must be 1..{}", size, kMaxTextureSide);
   }
   const std::vector<AoPoint> vertices = VertexPoints(mesh);
   const std::size_t side = static_cast<std::size_t>(size);

@@ -135,7 +135,7 @@ class Baker {
 
 StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r));
-  StatusOr<Svo> svo = RunStage(progress, "read", [&] { return ReadSvo(r.input); });
+  StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt);
   if (!svo.ok()) return svo.status();
   AoBakeReport report;
   report.depth = svo->depth;

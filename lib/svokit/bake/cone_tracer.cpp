@@ -95,23 +95,22 @@ void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b) {
 StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options) {
   if (svo.brick_side == 0) {
     return Status::BadInput(
-        "the octree has no bricks to trace cones through (build it with "
-        "--bricks 3 or 2)");
+        "the octree has no bricks to trace cones through (build it with bricks of 3 or 2)");
   }
   if (Rings(options.cones).empty()) {
-    return Status::BadInput("--cones {}: constellations have 3, 5, 8 or 16 cones", options.cones);
+    return Status::BadInput("{} cones: constellations have 3, 5, 8 or 16 cones", options.cones);
   }
   if (!std::isfinite(options.aperture) || options.aperture <= 0 || options.aperture > 4) {
-    return Status::BadInput("--aperture {}: must be in (0, 4]", options.aperture);
+    return Status::BadInput("cone aperture {}: must be in (0, 4]", options.aperture);
   }
   if (!std::isfinite(options.distance) || options.distance <= 0) {
-    return Status::BadInput("--distance {}: must be > 0", options.distance);
+    return Status::BadInput("occlusion distance {}: must be > 0", options.distance);
   }
   if (!std::isfinite(options.falloff) || options.falloff < 0) {
-    return Status::BadInput("--falloff {}: must be ≥ 0", options.falloff);
+    return Status::BadInput("occlusion falloff {}: must be ≥ 0", options.falloff);
   }
   if (!std::isfinite(options.offset) || options.offset < 0) {
-    return Status::BadInput("--offset {}: must be ≥ 0", options.offset);
+    return Status::BadInput("cone offset {}: must be ≥ 0", options.offset);
   }
   if (svo.levels.size() != svo.depth + 1) {
     return Status::BadInput("the octree's levels are not all loaded");

@@ -73,8 +73,8 @@ inline StatusOr<std::size_t> InFlightWithin(std::uint64_t limit, std::uint64_t f
   if (limit < fixed + least) {
     const std::uint64_t mib = (fixed + least + (1 << 20) - 1) >> 20;
     return Status::BadInput(
-        "a memory limit of {} MiB is too small for this mesh and grid: {} need {} MiB (use "
-        "--memory-limit {}M or more)",
+        "a memory limit of {} MiB is too small for this mesh and grid: {} need {} MiB (give "
+        "{}M or more)",
         limit >> 20, needs, mib, mib);
   }
   return std::clamp<std::size_t>((limit - fixed) / item, 1, most);

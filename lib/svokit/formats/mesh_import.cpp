@@ -57,4 +57,15 @@ StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path
       });
 }
 
+StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path& mesh_path,
+                                const GridTransform& grid, const std::filesystem::path& input,
+                                std::string_view made) {
+  StatusOr<Mesh> mesh = ImportStage(progress, mesh_path);
+  if (mesh.ok() && !grid.GridBounds().Contains(mesh->Bounds())) {
+    return Status::BadInput("{}: the mesh lies outside {}'s grid: not the mesh {}",
+                            mesh_path.string(), input.string(), made);
+  }
+  return mesh;
+}
+
 }  // namespace svokit

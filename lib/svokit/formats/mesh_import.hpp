@@ -7,8 +7,10 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
@@ -23,5 +25,11 @@ StatusOr<Mesh> ImportMesh(const std::filesystem::path& path);
 
 /// ImportMesh as the "import" stage of `progress`, its line giving the triangle count.
 StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path);
+
+/// The same for the mesh `input` was made from (`made` says how, for the message): a mesh
+/// reaching outside `grid` cannot be that mesh and is bad input.
+StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path& mesh_path,
+                                const GridTransform& grid, const std::filesystem::path& input,
+                                std::string_view made);
 
 }  // namespace svokit

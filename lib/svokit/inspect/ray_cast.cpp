@@ -347,7 +347,7 @@ RayHit CastRay(const Svo& svo, const Vec3d& origin, const Vec3d& direction,
 StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
   if (options.width < 1 || options.height < 1 || options.width > kMaxImageSide ||
       options.height > kMaxImageSide) {
-    return Status::BadInput("--size {}x{}: each side must be 1 to {}", options.width,
+    return Status::BadInput("an image of {}x{}: each side must be 1 to {}", options.width,
                             options.height, kMaxImageSide);
   }
   if (svo.levels.empty() || svo.levels[0].node_count != 1) {
@@ -356,11 +356,11 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
   const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
   const std::uint32_t level = options.level.value_or(loaded);
   if (level > loaded) {
-    return Status::BadInput("--level {} is beyond the octree's levels 0..{}", level, loaded);
+    return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
   }
   if (options.shade == Shade::kAo && !svo.has_ao) {
     return Status::BadInput(
-        "--shade ao: the octree has no baked ambient occlusion (svo-bake --ao)");
+        "shading by ambient occlusion: the octree has no baked ambient occlusion (svo-bake)");
   }
   RenderResult result;
   result.level = level;

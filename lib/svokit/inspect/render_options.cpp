@@ -17,20 +17,19 @@ StatusOr<View> ParseView(std::string_view name) {
   for (std::size_t i = 0; i < kViewNames.size(); ++i) {
     if (kViewNames[i] == name) return static_cast<View>(i);
   }
-  return Status::BadInput("--view '{}' is not front, back, left, right, top, bottom or iso", name);
+  return Status::BadInput("view '{}' is not front, back, left, right, top, bottom or iso", name);
 }
 
 StatusOr<Shade> ParseShade(std::string_view name) {
   for (std::size_t i = 0; i < kShadeNames.size(); ++i) {
     if (kShadeNames[i] == name) return static_cast<Shade>(i);
   }
-  return Status::BadInput("--shade '{}' is not color, normal, depth or ao", name);
+  return Status::BadInput("shade '{}' is not color, normal, depth or ao", name);
 }
 
 StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {
   const auto bad = [&] {
-    return Status::BadInput("--size '{}': expected WxH with each side 1 to {}", text,
-                            kMaxImageSide);
+    return Status::BadInput("size '{}': expected WxH with each side 1 to {}", text, kMaxImageSide);
   };
   const std::size_t x = text.find('x');
   if (x == std::string_view::npos) return bad();

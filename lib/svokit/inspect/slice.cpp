@@ -42,7 +42,7 @@ std::array<std::uint8_t, 3> NodeColor(const Svo& svo, std::uint32_t level, std::
 
 StatusOr<SliceSpec> ParseSlice(std::string_view text) {
   const auto bad = [&] {
-    return Status::BadInput("--slice '{}': expected AXIS=K with AXIS x, y or z and K ≥ 0", text);
+    return Status::BadInput("slice '{}': expected AXIS=K with AXIS x, y or z and K ≥ 0", text);
   };
   if (text.size() < 3 || text[1] != '=') return bad();
   SliceSpec s;
@@ -74,7 +74,7 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
   const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
   const std::uint32_t level = options.level.value_or(loaded);
   if (level > loaded) {
-    return Status::BadInput("--level {} is beyond the octree's levels 0..{}", level, loaded);
+    return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
   }
   // The grid at the slice level: voxel dims rounded up to whole nodes.
   const std::uint32_t shift = svo.depth - level;
@@ -84,7 +84,7 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
   }
   static constexpr char kAxes[] = "xyz";
   if (slice.index >= dims[slice.axis]) {
-    return Status::BadInput("--slice {}={}: the grid has {} cells along {} at level {} (0..{})",
+    return Status::BadInput("slice {}={}: the grid has {} cells along {} at level {} (0..{})",
                             kAxes[slice.axis], slice.index, dims[slice.axis], kAxes[slice.axis],
                             level, dims[slice.axis] - 1);
   }

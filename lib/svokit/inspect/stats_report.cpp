@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "svokit/core/utf8.hpp"
+#include "svokit/formats/provenance.hpp"
 
 namespace svokit {
 
@@ -130,15 +131,52 @@ void ContourLines(std::string& out, const SvoStats& st) {
 }
 
 // The provenance: a line per key of a JSON object, else the text as stored.
+// Where the octree came from, read from META (typed members, or the option text of older files).
 void MetadataLines(std::string& out, const SvoStats& st) {
   const Json meta = Json::parse(st.metadata, nullptr, false);
-  if (meta.is_object()) {
-    for (const auto& [key, value] : meta.items()) {
-      Line(out, key, value.is_string() ? value.get<std::string>() : value.dump());
-    }
-  } else if (!st.metadata.empty()) {
-    Line(out, "metadata", st.metadata);
+  if (!meta.is_object()) {
+    if (!st.metadata.empty()) Line(out, "metadata", st.metadata);
+    return;
   }
+  const Provenance p = ParseProvenance(st.metadata);
+  if (!p.source.empty()) {
+    Line(out, "source",
+         p.triangles > 0 ? fmt::format("{} ({} triangles)", p.source, p.triangles) : p.source);
+  }
+  if (p.grid) {
+    Line(out, "grid fit",
+         fmt::format("{}, pad {}",
+                     p.grid->resolution > 0
+                         ? fmt::format("{} voxels along the longest axis", p.grid->resolution)
+                         : fmt::format("voxels of {:.9g}", p.grid->voxel_size),
+                     p.grid->pad));
+  }
+  if (p.voxelize) {
+    const VoxelizeSettings& v = *p.voxelize;
+    Line(out, "voxelize",
+         fmt::format("{}, {}, {}", v.mode == VoxelMode::kThin ? "thin" : "conservative",
+                     v.colors && v.normals ? "colour and normal"
+                     : v.colors            ? "colour"
+                     : v.normals           ? "normal"
+                                           : "geometry only",
+                     v.solid ? "solid" : "surface"));
+  }
+  if (p.build) {
+    const BuildSettings& b = *p.build;
+    Line(out, "build",
+         fmt::format("bricks {}, contours {}, {}", b.brick_side, b.contours ? "on" : "off",
+                     b.compression.zstd ? fmt::format("zstd level {}", b.compression.level)
+                                        : std::string("stored")));
+  }
+  if (p.bake) {
+    const BakeSettings& b = *p.bake;
+    Line(out, "bake",
+         fmt::format("ambient occlusion: {} cones (aperture x{}), distance {:.6g}, falloff {}, "
+                     "offset {}{}",
+                     b.cones, b.aperture, b.distance, b.falloff, b.offset,
+                     b.jitter_seed ? fmt::format(", jitter seed {}", *b.jitter_seed) : ""));
+  }
+  if (!p.generator.empty()) Line(out, "generator", p.generator);
 }
 
 // The file's bytes per voxel by level and kind of array, stored / decoded (SvoFileStats::levels).

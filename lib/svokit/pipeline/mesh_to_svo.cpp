@@ -5,8 +5,8 @@
 
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/pipeline/chain.hpp"
-#include "svokit/pipeline/stages.hpp"
 #include "svokit/pipeline/svo_by_pages.hpp"
 #include "svokit/svo/compact_build.hpp"
 

@@ -5,9 +5,9 @@
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/export/voxel_writers.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/pipeline/chain.hpp"
-#include "svokit/pipeline/stages.hpp"
 #include "svokit/pipeline/vfrag_by_cubes.hpp"
 
 namespace svokit {

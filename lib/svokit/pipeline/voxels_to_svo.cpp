@@ -3,9 +3,9 @@
 #include <memory>
 
 #include "svokit/core/file_io.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/pipeline/chain.hpp"
-#include "svokit/pipeline/stages.hpp"
 #include "svokit/pipeline/svo_by_pages.hpp"
 #include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/svo_chunk.hpp"

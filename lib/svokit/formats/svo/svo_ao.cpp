@@ -42,11 +42,13 @@ std::vector<std::uint8_t> EncodeAoSection(const Svo& svo) {
   const std::size_t n = ZSTD_compress(stored.data(), stored.size(), raw.data(), raw.size(), 9);
   const bool zstd = !ZSTD_isError(n) && n < raw.size();
   stored.resize(zstd ? n : 0);
+  // The header as two arrays: GCC 12 misreads four scalar appends as an overflow.
+  const std::uint32_t head[2] = {static_cast<std::uint32_t>(svo.levels.size()),
+                                 zstd ? kZstd : kStored};
+  const std::uint64_t sizes[2] = {raw.size(), zstd ? n : raw.size()};
   ByteWriter out;
-  out.Put(static_cast<std::uint32_t>(svo.levels.size()));
-  out.Put(zstd ? kZstd : kStored);
-  out.Put(static_cast<std::uint64_t>(raw.size()));
-  out.Put(static_cast<std::uint64_t>(zstd ? n : raw.size()));
+  out.PutArray(std::span<const std::uint32_t>(head));
+  out.PutArray(std::span<const std::uint64_t>(sizes));
   out.PutArray(std::span<const std::uint8_t>(zstd ? stored : raw));
   return std::move(out.bytes());
 }

@@ -97,6 +97,16 @@ StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint
   return DecodeStrict(container::Frame::Open(path, kSvoFormat, &SectionsToLoad, &last), max_level);
 }
 
+StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
+                           std::optional<std::uint32_t> max_level) {
+  StatusOr<Svo> svo = RunStage(progress, "read", [&] { return ReadSvo(path, max_level); });
+  if (svo.ok() && max_level && *max_level > svo->depth) {
+    return Status::BadInput("{}: level {} exceeds the octree's depth {}", path.string(), *max_level,
+                            svo->depth);
+  }
+  return svo;
+}
+
 StatusOr<LenientSvo> DecodeSvoLenient(std::span<const std::uint8_t> bytes,
                                       const std::string& name) {
   return DecodeLenient(container::Frame::FromBytes(bytes, name, kSvoFormat));

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "svokit/core/bytes.hpp"
+#include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/provenance.hpp"
@@ -114,6 +115,10 @@ StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& 
                         std::optional<std::uint32_t> max_level = std::nullopt);
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path,
                       std::optional<std::uint32_t> max_level = std::nullopt);
+/// ReadSvo as the "read" stage of `progress`; a `max_level` below the octree's depth is bad
+/// input.
+StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
+                           std::optional<std::uint32_t> max_level);
 
 /// One violated invariant: `kind` is a stable key (svo-validate's README section lists them),
 /// `message` one line naming the file, the same text the strict readers fail with.
