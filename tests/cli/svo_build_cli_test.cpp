@@ -62,7 +62,7 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
   EXPECT_EQ(meta.source, "uv-torus.obj") << sa->metadata;
   EXPECT_EQ(meta.triangles, 2304u);
   EXPECT_EQ(meta.grid, (GridFit{48, 0, 0})) << sa->metadata;
-  EXPECT_EQ(meta.voxelize, (VoxelizeSettings{VoxelMode::kConservative, true, true, false}));
+  EXPECT_EQ(meta.voxelize, (VoxelSettings{VoxelMode::kConservative, true, true, false}));
   EXPECT_EQ(meta.build, BuildSettings{}) << sa->metadata;
 }
 

@@ -222,7 +222,7 @@ TEST(VfragFill, SolidFileWrittenInPlaceHoldsTheInterior) {
   const Filled f = Fill(test::Icosphere(3), 64);
   test::TempDir dir;
   const Provenance meta{"ico.obj", 1280, GridFit{64},
-                        VoxelizeSettings{VoxelMode::kConservative, true, true, true}};
+                        VoxelSettings{VoxelMode::kConservative, true, true, true}};
   VoxelizeOptions vo;
   vo.colors = vo.normals = true;
   {

@@ -26,7 +26,7 @@ Json GridJson(const GridFit& g) {
   return j;
 }
 
-Json VoxelizeJson(const VoxelizeSettings& v) {
+Json VoxelJson(const VoxelSettings& v) {
   return {{"mode", v.mode == VoxelMode::kThin ? "thin" : "conservative"},
           {"color", v.colors},
           {"normal", v.normals},
@@ -65,23 +65,9 @@ std::optional<T> Member(const Json& j, const char* key) {
   return it->get<T>();
 }
 
-std::optional<GridFit> ParseGrid(const Json& j) {
+std::optional<VoxelSettings> ParseVoxelMember(const Json& j) {
   if (!j.is_object()) return std::nullopt;
-  GridFit g;
-  g.pad = Member<std::uint32_t>(j, "pad").value_or(0);
-  if (const auto r = Member<std::uint32_t>(j, "resolution")) {
-    g.resolution = *r;
-  } else if (const auto s = Member<double>(j, "voxel_size")) {
-    g.voxel_size = *s;
-  } else {
-    return std::nullopt;
-  }
-  return g;
-}
-
-std::optional<VoxelizeSettings> ParseVoxelize(const Json& j) {
-  if (!j.is_object()) return std::nullopt;
-  VoxelizeSettings v;
+  VoxelSettings v;
   v.mode = Member<std::string>(j, "mode") == "thin" ? VoxelMode::kThin : VoxelMode::kConservative;
   v.colors = Member<bool>(j, "color").value_or(false);
   v.normals = Member<bool>(j, "normal").value_or(false);
@@ -96,18 +82,6 @@ std::optional<BuildSettings> ParseBuild(const Json& j) {
   b.contours = Member<bool>(j, "contours").value_or(false);
   b.compression.zstd = Member<std::string>(j, "compression") == "zstd";
   b.compression.level = static_cast<int>(Member<std::uint32_t>(j, "zstd_level").value_or(3));
-  return b;
-}
-
-std::optional<BakeSettings> ParseBake(const Json& j) {
-  if (!j.is_object()) return std::nullopt;
-  BakeSettings b;
-  b.cones = Member<std::uint32_t>(j, "cones").value_or(b.cones);
-  b.aperture = Member<double>(j, "aperture").value_or(b.aperture);
-  b.distance = Member<double>(j, "distance").value_or(b.distance);
-  b.falloff = Member<double>(j, "falloff").value_or(b.falloff);
-  b.offset = Member<double>(j, "offset").value_or(b.offset);
-  b.jitter_seed = Member<std::uint64_t>(j, "jitter_seed");
   return b;
 }
 
@@ -145,18 +119,53 @@ std::optional<T> Number(const std::map<std::string, std::string>& words, const c
   return it == words.end() ? std::nullopt : ParseNumber<T>(it->second);
 }
 
-void ParseVoxelizeText(const std::string& text, Provenance& p) {
-  const auto words = OptionWords(text);
-  GridFit g;
-  g.pad = Number<std::uint32_t>(words, "pad").value_or(0);
-  if (const auto r = Number<std::uint32_t>(words, "resolution")) {
-    g.resolution = *r;
-    p.grid = g;
-  } else if (const auto s = Number<double>(words, "voxel-size")) {
-    g.voxel_size = *s;
-    p.grid = g;
+// A stage's settings by name, from its typed JSON object or its option words: the grid fit and the
+// bake read alike from both (`legacy` names the word where it differs).
+struct JsonFields {
+  const Json& j;
+  template <class T>
+  std::optional<T> Get(const char* key, const char* = nullptr) const {
+    return Member<T>(j, key);
   }
-  VoxelizeSettings v;
+};
+struct WordFields {
+  std::map<std::string, std::string> words;
+  template <class T>
+  std::optional<T> Get(const char* key, const char* legacy = nullptr) const {
+    return Number<T>(words, legacy != nullptr ? legacy : key);
+  }
+};
+
+template <class Fields>
+std::optional<GridFit> GridFrom(const Fields& f) {
+  GridFit g;
+  g.pad = f.template Get<std::uint32_t>("pad").value_or(0);
+  if (const auto r = f.template Get<std::uint32_t>("resolution")) {
+    g.resolution = *r;
+  } else if (const auto s = f.template Get<double>("voxel_size", "voxel-size")) {
+    g.voxel_size = *s;
+  } else {
+    return std::nullopt;
+  }
+  return g;
+}
+
+template <class Fields>
+BakeSettings BakeFrom(const Fields& f) {
+  BakeSettings b;
+  b.cones = f.template Get<std::uint32_t>("cones").value_or(b.cones);
+  b.aperture = f.template Get<double>("aperture").value_or(b.aperture);
+  b.distance = f.template Get<double>("distance").value_or(b.distance);
+  b.falloff = f.template Get<double>("falloff").value_or(b.falloff);
+  b.offset = f.template Get<double>("offset").value_or(b.offset);
+  b.jitter_seed = f.template Get<std::uint64_t>("jitter_seed", "jitter");
+  return b;
+}
+
+void ParseVoxelText(const std::string& text, Provenance& p) {
+  const auto words = OptionWords(text);
+  if (const auto grid = GridFrom(WordFields{words})) p.grid = grid;
+  VoxelSettings v;
   const auto mode = words.find("mode");
   v.mode =
       mode != words.end() && mode->second == "thin" ? VoxelMode::kThin : VoxelMode::kConservative;
@@ -181,18 +190,6 @@ void ParseBuildText(const std::string& text, Provenance& p) {
   p.build = b;
 }
 
-void ParseBakeText(const std::string& text, Provenance& p) {
-  const auto words = OptionWords(text);
-  BakeSettings b;
-  b.cones = Number<std::uint32_t>(words, "cones").value_or(b.cones);
-  b.aperture = Number<double>(words, "aperture").value_or(b.aperture);
-  b.distance = Number<double>(words, "distance").value_or(b.distance);
-  b.falloff = Number<double>(words, "falloff").value_or(b.falloff);
-  b.offset = Number<double>(words, "offset").value_or(b.offset);
-  b.jitter_seed = Number<std::uint64_t>(words, "jitter");
-  p.bake = b;
-}
-
 }  // namespace
 
 std::string ProvenanceJson(const Provenance& p) {
@@ -200,7 +197,7 @@ std::string ProvenanceJson(const Provenance& p) {
   Json j = {{"source", EscapeInvalidUtf8(p.source)}, {"generator", "svokit " SVOKIT_VERSION}};
   if (p.triangles > 0) j["triangles"] = p.triangles;
   if (p.grid) j["grid"] = GridJson(*p.grid);
-  if (p.voxelize) j["voxelize"] = VoxelizeJson(*p.voxelize);
+  if (p.voxelize) j["voxelize"] = VoxelJson(*p.voxelize);
   if (p.build) j["build"] = BuildJson(*p.build);
   if (p.bake) j["bake"] = BakeJson(*p.bake);
   return j.dump();
@@ -213,21 +210,23 @@ Provenance ParseProvenance(std::string_view text) {
   p.source = Member<std::string>(j, "source").value_or("");
   p.generator = Member<std::string>(j, "generator").value_or("");
   p.triangles = Member<std::uint64_t>(j, "triangles").value_or(0);
-  if (const auto grid = j.find("grid"); grid != j.end()) p.grid = ParseGrid(*grid);
+  if (const auto grid = j.find("grid"); grid != j.end() && grid->is_object()) {
+    p.grid = GridFrom(JsonFields{*grid});
+  }
   // Each stage: a typed object, or (files written before) its option text.
   for (const char* key : {"voxelize", "options"}) {
     const auto it = j.find(key);
     if (it == j.end()) continue;
-    if (it->is_object()) p.voxelize = ParseVoxelize(*it);
-    if (it->is_string()) ParseVoxelizeText(it->get<std::string>(), p);
+    if (it->is_object()) p.voxelize = ParseVoxelMember(*it);
+    if (it->is_string()) ParseVoxelText(it->get<std::string>(), p);
   }
   if (const auto it = j.find("build"); it != j.end()) {
     if (it->is_object()) p.build = ParseBuild(*it);
     if (it->is_string()) ParseBuildText(it->get<std::string>(), p);
   }
   if (const auto it = j.find("bake"); it != j.end()) {
-    if (it->is_object()) p.bake = ParseBake(*it);
-    if (it->is_string()) ParseBakeText(it->get<std::string>(), p);
+    if (it->is_object()) p.bake = BakeFrom(JsonFields{*it});
+    if (it->is_string()) p.bake = BakeFrom(WordFields{OptionWords(it->get<std::string>())});
   }
   return p;
 }

@@ -17,11 +17,11 @@ namespace svokit {
 
 /// What shapes the voxels besides the grid (a method or a thread count does not: every one gives
 /// the same voxels).
-struct VoxelizeSettings {
+struct VoxelSettings {
   VoxelMode mode = VoxelMode::kConservative;
   bool colors = true, normals = true;  ///< per-voxel attributes
   bool solid = false;                  ///< the interior filled, not only the surface
-  bool operator==(const VoxelizeSettings&) const = default;
+  bool operator==(const VoxelSettings&) const = default;
 };
 
 /// What shapes the octree built from the voxels.
@@ -44,7 +44,7 @@ struct Provenance {
   std::string source;           ///< the mesh's file name, without directories
   std::uint64_t triangles = 0;  ///< the mesh's triangles (0: not recorded); svo-bake checks it
   std::optional<GridFit> grid;
-  std::optional<VoxelizeSettings> voxelize;
+  std::optional<VoxelSettings> voxelize;
   std::optional<BuildSettings> build;  ///< an octree's
   std::optional<BakeSettings> bake;    ///< an octree's, once baked
   std::string generator;               ///< the tool that wrote the file, as read

@@ -152,7 +152,7 @@ void MetadataLines(std::string& out, const SvoStats& st) {
                      p.grid->pad));
   }
   if (p.voxelize) {
-    const VoxelizeSettings& v = *p.voxelize;
+    const VoxelSettings& v = *p.voxelize;
     Line(out, "voxelize",
          fmt::format("{}, {}, {}", v.mode == VoxelMode::kThin ? "thin" : "conservative",
                      v.colors && v.normals ? "colour and normal"

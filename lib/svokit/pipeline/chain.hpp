@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
@@ -15,6 +16,7 @@
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_part.hpp"
+#include "svokit/mesh/mesh.hpp"
 #include "svokit/pipeline/memory_policy.hpp"
 #include "svokit/pipeline/svo_parts.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
@@ -24,6 +26,16 @@ namespace svokit {
 
 /// Receives each warning (e.g. a texture that does not decode) as it is found.
 using WarningSink = std::function<void(const std::string&)>;
+/// Hands each of `warnings` to `warn` (if set).
+void Warn(const WarningSink& warn, const std::vector<std::string>& warnings);
+
+/// A mesh imported (as the "import" stage) and the grid `fit` gives around its bounds.
+struct FittedMesh {
+  Mesh mesh;
+  GridTransform grid;
+};
+StatusOr<FittedMesh> ImportAndFit(const std::filesystem::path& input, const GridFit& fit,
+                                  Progress& progress);
 
 /// A solid's interior, as a summary reports it.
 struct InteriorSummary {
@@ -36,7 +48,7 @@ struct InteriorSummary {
 /// (VoxelizeOptions' method and cutoff; its attributes follow `settings`).
 struct VoxelizeRequest {
   GridFit grid;
-  VoxelizeSettings settings;
+  VoxelSettings settings;
   VoxelizeOptions split;
   VoxelizeOptions Options() const;
 };

@@ -23,16 +23,11 @@ struct Build {
   MeshToSvoReport& report;
   Progress& progress;
 
-  void Warn(const std::vector<std::string>& warnings) const {
-    if (!request.warn) return;
-    for (const std::string& w : warnings) request.warn(w);
-  }
-
   StatusOr<std::unique_ptr<RegionVoxelizer>> Regions() const {
     StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
         RegionVoxelizer::Create(mesh, grid, request.voxelize.Options());
     if (!regions.ok()) return regions.status().WithContext(request.input.string());
-    Warn((*regions)->warnings());
+    Warn(request.warn, (*regions)->warnings());
     return regions;
   }
 
@@ -71,7 +66,7 @@ struct Build {
   Status Whole(const InteriorFinder* finder) {
     StatusOr<VoxelSet> voxels = Voxelize(mesh, grid, request.voxelize.Options(), progress);
     if (!voxels.ok()) return voxels.status().WithContext(request.input.string());
-    Warn(voxels->warnings);
+    Warn(request.warn, voxels->warnings);
     InteriorCubes interior;
     if (finder != nullptr) {
       if (voxels->keys.empty()) {
@@ -100,10 +95,10 @@ struct Build {
 
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
-  StatusOr<Mesh> mesh = ImportStage(progress, r.input);
-  if (!mesh.ok()) return mesh.status();
-  StatusOr<GridTransform> grid = r.voxelize.grid.Fit(mesh->Bounds());
-  if (!grid.ok()) return grid.status().WithContext(r.input.string());
+  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress);
+  if (!fitted.ok()) return fitted.status();
+  const Mesh* mesh = &fitted->mesh;
+  const GridTransform* grid = &fitted->grid;
   MeshToSvoReport report;
   report.triangles = mesh->triangle_count();
   report.grid = *grid;

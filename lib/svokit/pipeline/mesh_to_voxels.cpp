@@ -18,11 +18,6 @@ InteriorSummary Summarize(const InteriorCubes& interior) {
   return {interior.voxel_count(), interior.cube_count(), interior.method, interior.open_edges};
 }
 
-void Warn(const WarningSink& warn, const std::vector<std::string>& warnings) {
-  if (!warn) return;
-  for (const std::string& w : warnings) warn(w);
-}
-
 // Keys packed as they are found, everything written in place into the file's mapped sections.
 // Methods and thread counts give the same file, byte for byte: they are not recorded.
 Status WriteWholeVfrag(const MeshToVoxelsRequest& r, const Mesh& mesh, const GridTransform& grid,
@@ -61,20 +56,12 @@ Status WriteVoxelCentres(const MeshToVoxelsRequest& r, const Mesh& mesh, const G
 
 }  // namespace
 
-VoxelizeOptions VoxelizeRequest::Options() const {
-  VoxelizeOptions o = split;
-  o.mode = settings.mode;
-  o.colors = settings.colors;
-  o.normals = settings.normals;
-  return o;
-}
-
 StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"vfrag", "xyz", "ply"}, r.input));
-  StatusOr<Mesh> mesh = ImportStage(progress, r.input);
-  if (!mesh.ok()) return mesh.status();
-  StatusOr<GridTransform> grid = r.voxelize.grid.Fit(mesh->Bounds());
-  if (!grid.ok()) return grid.status().WithContext(r.input.string());
+  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress);
+  if (!fitted.ok()) return fitted.status();
+  const Mesh* mesh = &fitted->mesh;
+  const GridTransform* grid = &fitted->grid;
   MeshToVoxelsReport report;
   report.triangles = mesh->triangle_count();
   report.grid = *grid;
@@ -83,7 +70,7 @@ StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress
   const bool vfrag = LowerExtension(r.output) == "vfrag";
   // Only a .vfrag is written cube by cube, of ~8 B a voxel held whole (~16 with attributes).
   if (vfrag) {
-    const VoxelizeSettings& s = r.voxelize.settings;
+    const VoxelSettings& s = r.voxelize.settings;
     const double per_voxel = s.colors || s.normals ? kVoxelizeAttributeBytes : kVoxelizeBytes;
     report.memory = ChooseMemoryPlan(r.memory_limit, per_voxel * EstimateVoxelCount(*mesh, *grid));
   }

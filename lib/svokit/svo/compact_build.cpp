@@ -5,6 +5,8 @@
 #include <utility>
 
 #include "svokit/svo/contour.hpp"
+#include "svokit/svo/sample_filter.hpp"
+#include "svokit/svo/svo_assembler.hpp"
 
 namespace svokit {
 
@@ -110,7 +112,7 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
     for (std::uint32_t l = 0; l < shape.depth; ++l) {
       whole.layouts.push_back(LayOutSamples(whole.tree, l, shape.brick_side));
     }
-    whole.samples = FilterSamples(whole.tree, whole.layouts, shape.brick_side, svo.VoxelSource());
+    whole.samples = FilterSamples(whole.tree, whole.layouts, shape.brick_side, VoxelSamplesOf(whole, shape));
     stage.Advance();
   }
   if (options.contours) {

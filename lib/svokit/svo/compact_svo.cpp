@@ -8,16 +8,6 @@
 
 namespace svokit {
 
-VoxelSamplesSource CompactSvo::VoxelSource() const {
-  VoxelSamplesSource source;
-  const SvoShape& shape = frame.shape;
-  if (shape.has_color) {
-    source.colors = shape.shared_color.empty() ? std::span<const HalfRgba>(whole.colors)
-                                               : std::span<const HalfRgba>(shape.shared_color);
-  }
-  if (shape.has_normal) source.normals = whole.normals;
-  return source;
-}
 
 Svo AssembleSvo(const CompactSvo& in) {
   SvoAssembler assembler(in.frame.shape, in.depth());

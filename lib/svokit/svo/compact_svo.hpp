@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <string>
 
-#include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/svo/svo_chunk.hpp"
 
@@ -24,8 +23,6 @@ struct CompactSvo {
   std::uint32_t depth() const { return frame.shape.depth; }
   std::uint64_t NodeCount(std::uint32_t level) const { return whole.tree.NodeCount(level); }
   std::uint64_t voxel_count() const { return whole.tree.NodeCount(depth()); }
-  /// What the voxel level's bricks are filtered from.
-  VoxelSamplesSource VoxelSource() const;
 };
 
 /// Every node's brick and the node records: the Svo the octree stands for.

@@ -27,13 +27,18 @@ void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
 
 }  // namespace
 
-void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out) {
+VoxelSamplesSource VoxelSamplesOf(const SvoChunk& chunk, const SvoShape& shape) {
   VoxelSamplesSource source;
   if (shape.has_color) {
     source.colors = shape.shared_color.empty() ? std::span<const HalfRgba>(chunk.colors)
                                                : std::span<const HalfRgba>(shape.shared_color);
   }
   if (shape.has_normal) source.normals = chunk.normals;
+  return source;
+}
+
+void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out) {
+  VoxelSamplesSource source = VoxelSamplesOf(chunk, shape);
   if (chunk.halo_keys.empty()) {
     VoxelBricks(chunk.tree, shape.brick_side, source, out);
     return;

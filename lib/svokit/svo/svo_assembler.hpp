@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/svo/svo_chunk.hpp"
 
@@ -34,6 +35,10 @@ class SvoAssembler {
   std::vector<std::vector<std::uint32_t>> words_;
   std::vector<SvoLevel> levels_;
 };
+
+/// What the voxel level's bricks of `chunk` are filtered from: its voxels' colours (or the one
+/// every voxel shares) and normals, as `shape` has them.
+VoxelSamplesSource VoxelSamplesOf(const SvoChunk& chunk, const SvoShape& shape);
 
 /// The voxel bricks of a page (or of a whole tree, `halo` empty): side³ samples per voxel of
 /// `chunk` in its order, computed from its voxels and those of its halo.

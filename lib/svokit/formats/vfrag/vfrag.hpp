@@ -30,22 +30,23 @@ Status WriteVfrag(const VoxelSet& set, const Provenance& meta, const std::filesy
 /// The same file from a set that is consumed: its arrays' memory goes back to the kernel as it is
 /// written, for the file's page cache to reuse (fresh pages are slow on VMs); `set` is left empty.
 Status WriteVfrag(VoxelSet&& set, const Provenance& meta, const std::filesystem::path& path);
-/// The same file from voxels whose keys are packed already (VoxelizePacked).
+/// The same file from voxels whose keys are packed already, as the voxelizer packs them.
 std::vector<std::uint8_t> EncodeVfrag(const PackedVoxelSet& set, const Provenance& meta);
-/// A .vfrag file that VoxelizePacked() writes into directly: its KEYS, COLR, NORM and COVR
-/// sections are regions of a temporary beside `path`, mapped (container::MappedWriter), which the
-/// voxelizer's threads fill in place; Commit() completes the file and renames it into place.
-/// The same bytes as WriteVfrag() of the same voxels, without their copy into the file (a 4096³
-/// armadillo with attributes: 290 MB). Destroyed uncommitted, it leaves nothing behind.
+/// A .vfrag file the voxelizer writes into directly (a PackedVoxelStorage): its KEYS, COLR, NORM
+/// and COVR sections are regions of a temporary beside `path`, mapped (container::MappedWriter),
+/// which the voxelizer's threads fill in place; Commit() completes the file and renames it into
+/// place. The same bytes as WriteVfrag() of the same voxels, without their copy into the file (a
+/// 4096³ armadillo with attributes: 290 MB). Destroyed uncommitted, it leaves nothing behind.
 class VfragFileWriter final : public PackedVoxelStorage {
  public:
   /// `solid`: the file will hold a solid's interior (Commit()'s `interior`).
   VfragFileWriter(std::filesystem::path path, const Provenance& meta, bool solid = false);
   StatusOr<PackedVoxelArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
                                       std::size_t key_bytes) override;
-  /// The keys written so far, as varint gaps (`voxels`: what VoxelizePacked() returned).
+  /// The keys written so far, as varint gaps (`voxels`: what the packed voxelization returned).
   std::span<const std::uint8_t> KeyGaps(const PackedVoxelization& voxels) const;
-  /// `voxels`: what VoxelizePacked() returned for this storage; `interior` for a solid writer.
+  /// `voxels`: what the packed voxelization into this storage returned; `interior` for a solid
+  /// writer.
   Status Commit(const PackedVoxelization& voxels, const InteriorCubes* interior = nullptr);
 
  private:
