@@ -1,5 +1,6 @@
-// Exports re-read independently: OpenVDB reads the .vdb; binvox, .vox, PLY and xyz are read by
-// small parsers written here from the formats' specs, sharing no code with the writers.
+// Exports re-read independently: OpenVDB reads the .vdb; PLY and xyz are read by small parsers
+// written here, binvox and .vox by those of exported_files.hpp, all from the formats' specs and
+// sharing no code with the writers.
 
 #include <gtest/gtest.h>
 
@@ -7,8 +8,6 @@
 #include <openvdb/openvdb.h>
 
 #include <array>
-#include <cstring>
-#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -18,12 +17,12 @@
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/reference_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
+#include "tests/export/exported_files.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit::test {
 namespace {
 
-using Coord = std::array<std::int64_t, 3>;
 using Rgb8 = std::array<int, 3>;
 
 Coord CoordOf(std::uint64_t key) {
@@ -101,13 +100,6 @@ const VoxelSet& TorusVoxels() {
   return set;
 }
 
-Status Export(const Svo& svo, const std::filesystem::path& path,
-              std::optional<std::uint32_t> level = std::nullopt) {
-  ExportOptions options;
-  options.level = level;
-  return ExportSvo(svo, path, options);
-}
-
 // What a node of `level` must export as: its coordinates, world box and brick-centre attributes.
 struct Node {
   Coord ijk;
@@ -158,190 +150,6 @@ VdbGrids ReadVdb(const std::filesystem::path& path) {
   }
   file.close();
   return g;
-}
-
-struct Binvox {
-  std::int64_t dim = 0;
-  Vec3d translate;
-  double scale = 0;
-  std::set<Coord> voxels;
-};
-
-// http://www.patrickmin.com/binvox/binvox.html: text header, then (value, count) byte pairs over
-// the dim³ cube with y running fastest, then z, then x.
-Binvox ReadBinvox(const std::filesystem::path& path) {
-  const std::string bytes = ReadText(path);
-  std::istringstream in(bytes);
-  std::string line;
-  std::getline(in, line);
-  EXPECT_EQ(line, "#binvox 1");
-  Binvox b;
-  while (std::getline(in, line) && line != "data") {
-    std::istringstream words(line);
-    std::string key;
-    words >> key;
-    if (key == "dim") {
-      std::int64_t d1 = 0, d2 = 0, d3 = 0;
-      words >> d1 >> d2 >> d3;
-      EXPECT_TRUE(d1 == d2 && d2 == d3) << line;
-      b.dim = d1;
-    } else if (key == "translate") {
-      words >> b.translate.x >> b.translate.y >> b.translate.z;
-    } else if (key == "scale") {
-      words >> b.scale;
-    }
-  }
-  EXPECT_EQ(line, "data");
-  std::size_t pos = static_cast<std::size_t>(in.tellg());
-  const std::int64_t total = b.dim * b.dim * b.dim;
-  std::int64_t index = 0;
-  for (; pos + 1 < bytes.size(); pos += 2) {
-    const auto value = static_cast<std::uint8_t>(bytes[pos]);
-    const auto count = static_cast<std::uint8_t>(bytes[pos + 1]);
-    EXPECT_TRUE(value <= 1 && count > 0) << "pair at byte " << pos;
-    for (int k = 0; k < count && value == 1; ++k) {
-      const std::int64_t i = index + k;
-      b.voxels.insert({i / (b.dim * b.dim), i % b.dim, i / b.dim % b.dim});  // x, y, z
-    }
-    index += count;
-  }
-  EXPECT_EQ(pos, bytes.size());
-  EXPECT_EQ(index, total);
-  return b;
-}
-
-// MagicaVoxel .vox (github.com/ephtracy/voxel-model): chunks inside MAIN; models SIZE + XYZI;
-// scene graph nTRN → nGRP → nTRN → nSHP; a model voxel v lands at _t + v − floor(size / 2).
-struct VoxFile {
-  std::vector<std::array<std::int32_t, 3>> sizes;
-  std::map<Coord, std::uint32_t> voxels;  ///< world voxel → palette RGBA
-  std::set<std::uint32_t> used_indices;
-};
-
-class Bytes {
- public:
-  explicit Bytes(std::string bytes) : bytes_(std::move(bytes)) {}
-  template <class T>
-  T Get() {
-    T v{};
-    if (pos_ + sizeof(T) > bytes_.size()) throw std::runtime_error("vox: truncated");
-    std::memcpy(&v, bytes_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return v;
-  }
-  std::string Text(std::size_t n) {
-    if (pos_ + n > bytes_.size()) throw std::runtime_error("vox: truncated");
-    std::string s = bytes_.substr(pos_, n);
-    pos_ += n;
-    return s;
-  }
-  std::string String() { return Text(static_cast<std::size_t>(Get<std::int32_t>())); }
-  std::map<std::string, std::string> Dict() {
-    std::map<std::string, std::string> d;
-    for (std::int32_t n = Get<std::int32_t>(); n > 0; --n) {
-      std::string key = String();
-      d[key] = String();
-    }
-    return d;
-  }
-  std::size_t pos() const { return pos_; }
-  std::size_t size() const { return bytes_.size(); }
-
- private:
-  std::string bytes_;
-  std::size_t pos_ = 0;
-};
-
-VoxFile ReadVox(const std::filesystem::path& path) {
-  Bytes in(ReadText(path));
-  EXPECT_EQ(in.Text(4), "VOX ");
-  EXPECT_EQ(in.Get<std::int32_t>(), 150);
-  EXPECT_EQ(in.Text(4), "MAIN");
-  EXPECT_EQ(in.Get<std::int32_t>(), 0);
-  const auto children = static_cast<std::size_t>(in.Get<std::int32_t>());
-  EXPECT_EQ(children, in.size() - in.pos());
-  struct Model {
-    std::array<std::int32_t, 3> size;
-    std::vector<std::array<std::uint8_t, 4>> xyzi;
-  };
-  std::vector<Model> models;
-  struct Transform {
-    std::int32_t child;
-    Coord t;
-  };
-  std::map<std::int32_t, Transform> transforms;
-  std::map<std::int32_t, std::vector<std::int32_t>> groups;
-  std::map<std::int32_t, std::int32_t> shapes;
-  std::array<std::uint32_t, 257> palette{};
-  while (in.pos() < in.size()) {
-    const std::string id = in.Text(4);
-    const auto content = static_cast<std::size_t>(in.Get<std::int32_t>());
-    EXPECT_EQ(in.Get<std::int32_t>(), 0) << id;
-    const std::size_t end = in.pos() + content;
-    if (id == "SIZE") {
-      Model m;
-      for (std::int32_t& s : m.size) s = in.Get<std::int32_t>();
-      models.push_back(m);
-    } else if (id == "XYZI") {
-      for (std::int32_t n = in.Get<std::int32_t>(); n > 0; --n) {
-        models.back().xyzi.push_back(in.Get<std::array<std::uint8_t, 4>>());
-      }
-    } else if (id == "nTRN") {
-      const auto node = in.Get<std::int32_t>();
-      in.Dict();
-      Transform t{in.Get<std::int32_t>(), {0, 0, 0}};
-      in.Get<std::int32_t>();  // reserved
-      in.Get<std::int32_t>();  // layer
-      EXPECT_EQ(in.Get<std::int32_t>(), 1);
-      const auto frame = in.Dict();
-      if (frame.count("_t")) {
-        std::istringstream(frame.at("_t")) >> t.t[0] >> t.t[1] >> t.t[2];
-      }
-      transforms[node] = t;
-    } else if (id == "nGRP") {
-      const auto node = in.Get<std::int32_t>();
-      in.Dict();
-      for (std::int32_t n = in.Get<std::int32_t>(); n > 0; --n) {
-        groups[node].push_back(in.Get<std::int32_t>());
-      }
-    } else if (id == "nSHP") {
-      const auto node = in.Get<std::int32_t>();
-      in.Dict();
-      EXPECT_EQ(in.Get<std::int32_t>(), 1);
-      shapes[node] = in.Get<std::int32_t>();
-      in.Dict();
-    } else if (id == "RGBA") {
-      for (int k = 1; k <= 256; ++k) palette[static_cast<std::size_t>(k)] = in.Get<std::uint32_t>();
-    } else {
-      in.Text(content);  // LAYR, MATL, …: not needed here
-    }
-    EXPECT_EQ(in.pos(), end) << id;
-  }
-
-  VoxFile file;
-  for (const Model& m : models) file.sizes.push_back(m.size);
-  std::function<void(std::int32_t, Coord)> visit = [&](std::int32_t node, Coord offset) {
-    if (transforms.count(node)) {
-      const Transform& t = transforms.at(node);
-      visit(t.child, {offset[0] + t.t[0], offset[1] + t.t[1], offset[2] + t.t[2]});
-    } else if (groups.count(node)) {
-      for (std::int32_t child : groups.at(node)) visit(child, offset);
-    } else {
-      const Model& m = models.at(static_cast<std::size_t>(shapes.at(node)));
-      for (const auto& v : m.xyzi) {
-        Coord world{};
-        for (int a = 0; a < 3; ++a) {
-          EXPECT_LT(v[a], m.size[a]);
-          world[a] = offset[a] + v[a] - m.size[a] / 2;
-        }
-        EXPECT_NE(v[3], 0);
-        EXPECT_TRUE(file.voxels.emplace(world, palette[v[3]]).second) << "voxel twice";
-        file.used_indices.insert(v[3]);
-      }
-    }
-  };
-  visit(0, {0, 0, 0});
-  return file;
 }
 
 Rgb8 RgbOf(std::uint32_t rgba) {
@@ -569,10 +377,10 @@ TEST(Export, VoxExactPaletteForFewColours) {
   for (std::size_t i = 0; i < in.size(); ++i) {
     const auto it = vox.voxels.find(CoordOf(in.keys[i]));
     ASSERT_NE(it, vox.voxels.end());
-    EXPECT_EQ(RgbOf(it->second), ToSrgb8(in.colors[i]));
-    EXPECT_EQ(it->second >> 24, 255u);
+    EXPECT_EQ(RgbOf(vox.palette[it->second]), ToSrgb8(in.colors[i]));
+    EXPECT_EQ(vox.palette[it->second] >> 24, 255u);
   }
-  EXPECT_EQ(vox.used_indices.size(), 5u);
+  EXPECT_EQ(vox.UsedIndices().size(), 5u);
 }
 
 TEST(Export, VoxSplitsGridsLargerThan256IntoPlacedModels) {
@@ -596,16 +404,16 @@ TEST(Export, VoxSplitsGridsLargerThan256IntoPlacedModels) {
     }
   }
   std::set<Coord> expected(coords.begin(), coords.end()), got;
-  for (const auto& [c, rgba] : vox.voxels) got.insert(c);
+  for (const auto& [c, index] : vox.voxels) got.insert(c);
   EXPECT_EQ(got, expected);
-  EXPECT_EQ(vox.used_indices, (std::set<std::uint32_t>{1}));
+  EXPECT_EQ(vox.UsedIndices(), (std::set<std::uint32_t>{1}));
 
   // With colours the same split holds; each voxel keeps its exact colour (8 ≤ 255 colours).
   const Svo colored = Build(in);
   ASSERT_TRUE(Export(colored, dir / "big.vox").ok());
   const VoxFile vox2 = ReadVox(dir / "big.vox");
   for (std::size_t i = 0; i < in.size(); ++i) {
-    EXPECT_EQ(RgbOf(vox2.voxels.at(CoordOf(in.keys[i]))), ToSrgb8(in.colors[i]));
+    EXPECT_EQ(RgbOf(vox2.ColorAt(CoordOf(in.keys[i]))), ToSrgb8(in.colors[i]));
   }
 }
 
@@ -622,7 +430,7 @@ TEST(Export, VoxMedianCutPaletteOnTheTexturedTorus) {
   for (const Node& n : nodes) {
     const Rgb8 want = ToSrgb8(n.color);
     distinct.insert(want);
-    const Rgb8 got = RgbOf(vox.voxels.at(n.ijk));
+    const Rgb8 got = RgbOf(vox.ColorAt(n.ijk));
     for (int ch = 0; ch < 3; ++ch) {
       const int e = std::abs(got[ch] - want[ch]);
       sum += e;
@@ -640,8 +448,8 @@ TEST(Export, VoxMedianCutPaletteOnTheTexturedTorus) {
   RecordProperty("cube_mean_error", std::to_string(cube_mean));
   RecordProperty("max_error", worst);
   EXPECT_GT(distinct.size(), 255u);  // the palette really has to quantize
-  EXPECT_LE(vox.used_indices.size(), 255u);
-  EXPECT_GE(vox.used_indices.size(), 200u);
+  EXPECT_LE(vox.UsedIndices().size(), 255u);
+  EXPECT_GE(vox.UsedIndices().size(), 200u);
   // Measured: 10 778 colours → mean 2.7, max 12 (8-bit sRGB units); the fixed cube 12.3.
   EXPECT_LT(mean, 3.5) << "mean 8-bit error per channel";
   EXPECT_LT(mean, cube_mean / 2);

@@ -8,11 +8,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
-#include <array>
-#include <cstring>
-#include <map>
 #include <set>
-#include <sstream>
 
 #include "svokit/core/morton.hpp"
 #include "svokit/export/export.hpp"
@@ -24,13 +20,12 @@
 #include "svokit/svo/sample_codec.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxelize.hpp"
+#include "tests/export/exported_files.hpp"
 #include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit::test {
 namespace {
-
-using Coord = std::array<std::int64_t, 3>;
 
 Coord CoordOf(std::uint64_t key) {
   const MortonCoord c = MortonDecode(key);
@@ -130,87 +125,6 @@ Expected ExpectedAt(const Solid& s, std::uint32_t level) {
   return e;
 }
 
-Status Export(const Svo& svo, const std::filesystem::path& path,
-              std::optional<std::uint32_t> level = std::nullopt) {
-  ExportOptions options;
-  options.level = level;
-  return ExportSvo(svo, path, options);
-}
-
-// binvox (patrickmin.com/binvox): text header, then (value, count) byte pairs over the dim³ cube
-// with y running fastest, then z, then x.
-std::set<Coord> ReadBinvox(const std::filesystem::path& path) {
-  const std::string bytes = ReadText(path);
-  std::istringstream in(bytes);
-  std::string line;
-  std::getline(in, line);
-  EXPECT_EQ(line, "#binvox 1");
-  std::int64_t dim = 0;
-  while (std::getline(in, line) && line != "data") {
-    if (line.starts_with("dim ")) std::istringstream(line.substr(4)) >> dim;
-  }
-  std::set<Coord> voxels;
-  std::int64_t index = 0;
-  std::size_t pos = static_cast<std::size_t>(in.tellg());
-  for (; pos + 1 < bytes.size(); pos += 2) {
-    const auto value = static_cast<std::uint8_t>(bytes[pos]);
-    const auto count = static_cast<std::uint8_t>(bytes[pos + 1]);
-    EXPECT_TRUE(value <= 1 && count > 0) << "pair at byte " << pos;
-    for (int k = 0; k < count && value == 1; ++k) {
-      const std::int64_t i = index + k;
-      voxels.insert({i / (dim * dim), i % dim, i / dim % dim});
-    }
-    index += count;
-  }
-  EXPECT_EQ(pos, bytes.size());
-  EXPECT_EQ(index, dim * dim * dim);
-  return voxels;
-}
-
-// MagicaVoxel .vox (github.com/ephtracy/voxel-model) of a grid within one 256³ tile: its one
-// model's voxels (SIZE + XYZI) with their palette entries (RGBA).
-struct Vox {
-  std::array<std::int32_t, 3> size{};
-  std::map<Coord, std::uint8_t> voxels;  ///< → palette index
-  std::array<std::uint32_t, 257> palette{};
-};
-
-Vox ReadVox(const std::filesystem::path& path) {
-  const std::string bytes = ReadText(path);
-  Vox vox;
-  EXPECT_EQ(bytes.substr(0, 4), "VOX ");
-  std::size_t p = 20;  // "VOX ", version, "MAIN", its content and children sizes
-  int models = 0;
-  const auto u32 = [&](std::size_t at) {
-    std::uint32_t v = 0;
-    std::memcpy(&v, bytes.data() + at, 4);
-    return v;
-  };
-  while (p + 12 <= bytes.size()) {
-    const std::string id = bytes.substr(p, 4);
-    const std::uint32_t content = u32(p + 4), children = u32(p + 8);
-    const std::size_t body = p + 12;
-    if (id == "SIZE") {
-      ++models;
-      for (int a = 0; a < 3; ++a) vox.size[a] = static_cast<std::int32_t>(u32(body + 4 * a));
-    } else if (id == "XYZI") {
-      const std::uint32_t n = u32(body);
-      EXPECT_EQ(content, 4 + 4 * n);
-      for (std::uint32_t i = 0; i < n; ++i) {
-        const auto* v = reinterpret_cast<const std::uint8_t*>(bytes.data() + body + 4 + 4 * i);
-        EXPECT_TRUE(vox.voxels.emplace(Coord{v[0], v[1], v[2]}, v[3]).second) << "voxel twice";
-        for (int a = 0; a < 3; ++a) EXPECT_LT(v[a], vox.size[a]) << "voxel outside its model";
-      }
-    } else if (id == "RGBA") {
-      for (std::size_t k = 1; k <= 256; ++k) vox.palette[k] = u32(body + 4 * (k - 1));
-    }
-    p = body + content + children;
-  }
-  EXPECT_EQ(p, bytes.size());
-  EXPECT_EQ(models, 1);
-  return vox;
-}
-
 // ---------------------------------------------------------------------------------------------
 
 TEST(SolidExport, BinvoxHoldsTheSurfaceAndTheInterior) {
@@ -225,7 +139,7 @@ TEST(SolidExport, BinvoxHoldsTheSurfaceAndTheInterior) {
       if (up == 0 || s == &Ball64()) {
         ASSERT_FALSE(e.interior.empty());
       }
-      const std::set<Coord> got = ReadBinvox(dir / "s.binvox");
+      const std::set<Coord> got = ReadBinvox(dir / "s.binvox").voxels;
       EXPECT_EQ(got.size(), e.nodes.size() + e.interior.size());
       EXPECT_TRUE(got == e.All());
       if (up == 0) {
@@ -239,7 +153,8 @@ TEST(SolidExport, VoxListsTheInteriorInTheSurfacesMeanColour) {
   TempDir dir;
   for (const Solid* s : {&Ball64(), &Torus(), &Holed()}) {
     ASSERT_TRUE(Export(s->svo, dir / "s.vox").ok());
-    const Vox vox = ReadVox(dir / "s.vox");
+    const VoxFile vox = ReadVox(dir / "s.vox");
+    EXPECT_EQ(vox.sizes.size(), 1u);  // within one 256³ tile: one model
     const Expected e = ExpectedAt(*s, s->svo.depth);
     std::set<Coord> got;
     for (const auto& [c, index] : vox.voxels) got.insert(c);
