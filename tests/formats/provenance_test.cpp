@@ -36,7 +36,7 @@ Provenance Full() {
   p.source = "torus.obj";
   p.triangles = 1200;
   p.grid = GridFit{512, 0, 2};
-  p.voxelize = VoxelizeSettings{VoxelMode::kThin, true, false, true};
+  p.voxelize = VoxelSettings{VoxelMode::kThin, true, false, true};
   p.build = BuildSettings{2, false, SvoCompression{true, 7}};
   p.bake = BakeSettings{5, 1.5, 3.25, 0.5, 2, 9};
   return p;
@@ -56,7 +56,7 @@ TEST(Provenance, EveryMemberRoundTrips) {
       for (const bool normals : {false, true}) {
         for (const bool solid : {false, true}) {
           Provenance p = Full();
-          p.voxelize = VoxelizeSettings{mode, colors, normals, solid};
+          p.voxelize = VoxelSettings{mode, colors, normals, solid};
           SCOPED_TRACE(ProvenanceJson(p));
           ExpectSame(RoundTrip(p), p);
         }
@@ -149,7 +149,7 @@ TEST(Provenance, OptionTextReadsAsTheTypedValues) {
       R"("build":"--bricks 3 --contours --compression none",)"
       R"("bake":"--ao --cones 16 --distance 57.2"})");
   EXPECT_EQ(by_size.grid, (GridFit{0, 0.01, 0}));
-  EXPECT_EQ(by_size.voxelize, (VoxelizeSettings{VoxelMode::kConservative, true, true, false}));
+  EXPECT_EQ(by_size.voxelize, (VoxelSettings{VoxelMode::kConservative, true, true, false}));
   EXPECT_EQ(by_size.build, (BuildSettings{3, true, SvoCompression{false, 3}}));
   EXPECT_EQ(by_size.bake, (BakeSettings{16, 1, 57.2, 1, 1, std::nullopt}));
 
@@ -158,7 +158,7 @@ TEST(Provenance, OptionTextReadsAsTheTypedValues) {
       ParseProvenance(R"({"source":"m.obj","options":"--resolution 64 --mode thin"})");
   EXPECT_EQ(vfrag.source, "m.obj");
   EXPECT_EQ(vfrag.grid, (GridFit{64, 0, 0}));
-  EXPECT_EQ(vfrag.voxelize, (VoxelizeSettings{VoxelMode::kThin, false, false, false}));
+  EXPECT_EQ(vfrag.voxelize, (VoxelSettings{VoxelMode::kThin, false, false, false}));
   EXPECT_FALSE(vfrag.build || vfrag.bake);
 
   // zstd without a level: the default level.
@@ -167,7 +167,7 @@ TEST(Provenance, OptionTextReadsAsTheTypedValues) {
   // Option text with neither resolution nor voxel size: no grid, the voxelization still read.
   const Provenance no_grid = ParseProvenance(R"({"voxelize":"--mode thin --fill solid"})");
   EXPECT_FALSE(no_grid.grid);
-  EXPECT_EQ(no_grid.voxelize, (VoxelizeSettings{VoxelMode::kThin, false, false, true}));
+  EXPECT_EQ(no_grid.voxelize, (VoxelSettings{VoxelMode::kThin, false, false, true}));
 }
 
 TEST(Provenance, MembersOfAnotherTypeAreAbsent) {
@@ -195,7 +195,7 @@ TEST(Provenance, MembersOfAnotherTypeAreAbsent) {
             (BuildSettings{0, false, SvoCompression{false, 3}}));
   EXPECT_EQ(
       ParseProvenance(R"({"voxelize":{"mode":1,"color":"yes","normal":1,"fill":true}})").voxelize,
-      (VoxelizeSettings{VoxelMode::kConservative, false, false, false}));
+      (VoxelSettings{VoxelMode::kConservative, false, false, false}));
   EXPECT_EQ(
       ParseProvenance(R"({"bake":{"cones":"5","aperture":"2","jitter_seed":-1,"offset":null}})")
           .bake,

@@ -125,7 +125,7 @@ TEST(Chain, VoxelsThenOctreeIsTheFileOfMeshToSvo) {
   EXPECT_EQ(meta.source, "uv-torus.obj");
   EXPECT_EQ(meta.triangles, 2304u);
   EXPECT_EQ(meta.grid, Voxelize().grid);
-  EXPECT_EQ(meta.voxelize, VoxelizeSettings{});
+  EXPECT_EQ(meta.voxelize, VoxelSettings{});
   EXPECT_EQ(meta.build, BuildSettings{});
 }
 
