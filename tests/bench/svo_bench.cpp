@@ -1,7 +1,8 @@
 // Octree build stages in one process, on voxels made once (colours and normals): the structure
 // alone, 3³ bricks, contours, and all together, as mesh2svo builds them (BuildCompactSvo: what its
 // "octree", "bricks" and "contours" stages time, without the process, import, voxelization and
-// write around them); and the per-node reference builder (BuildSvo, version 1's octree) in full.
+// write around them); and the per-node reference builder (BuildReferenceSvo, version 1's octree) in
+// full.
 //
 //   svo_bench --resolution N MESH... [benchmark flags]
 

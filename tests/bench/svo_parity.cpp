@@ -1,10 +1,10 @@
-// Version 2 against version 1 at full scale (scripts/bench parity). The reference is BuildSvo,
-// the octree version 1 stores node by node; the version-2 file of the same voxels is written,
-// then read back through SvoReader one page at a time, as a renderer reads it: every level's
-// keys, child masks, contour words and assembled bricks, and the voxels' own colours and normals,
-// must equal the reference byte for byte. Then the time to read each file whole and assemble
-// every brick (ReadSvo), medians of 3, where the version-1 file is written (--v1-limit, default
-// 4 GB).
+// Version 2 against version 1 at full scale (scripts/bench parity). The reference is
+// BuildReferenceSvo, the octree version 1 stores node by node; the version-2 file of the same
+// voxels is written, then read back through SvoReader one page at a time, as a renderer reads it:
+// every level's keys, child masks, contour words and assembled bricks, and the voxels' own colours
+// and normals, must equal the reference byte for byte. Then the time to read each file whole and
+// assemble every brick (ReadSvo), medians of 3, where the version-1 file is written (--v1-limit,
+// default 4 GB).
 //
 //   svo_parity --resolution N MESH... [--v1-limit BYTES]
 // Prints one row per mesh; exits 1 when anything differs.
@@ -173,7 +173,7 @@ int Run(int argc, char** argv) {
   std::filesystem::create_directories(tmp);
   fmt::print(
       "# every level's keys, masks, contour words and bricks, and the voxels' attributes, "
-      "through SvoReader page by page,\n# against BuildSvo (what version 1 stores); "
+      "through SvoReader page by page,\n# against BuildReferenceSvo (what version 1 stores); "
       "read_s: ReadSvo of the whole file, bricks assembled (median of 3; 1024 only)\n");
   fmt::print("{:<10} {:>5} {:>10} {:>11} {:>13} {:>9} {:>11} {:>12} {:>12} {:>9} {:>9}\n", "mesh",
              "N", "voxels", "nodes", "samples", "contours", "differences", "v2_bytes", "v1_bytes",

@@ -1,6 +1,6 @@
 #pragma once
-// Octrees the svo-inspect tests share, each built once per test program through the library
-// chain mesh2svo uses (Voxelize + BuildSvo): a unit icosphere at 128³ with contours, and the
+// Octrees the svo-inspect tests share, each built once per test program by the voxelizer and the
+// reference builder (Voxelize + BuildReferenceSvo): a unit icosphere at 128³ with contours, and the
 // sample torus at a small resolution with colours, normals and contours; and a tiny octree of
 // three voxels whose statistics are worked out by hand.
 

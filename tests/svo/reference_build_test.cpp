@@ -1,6 +1,6 @@
-// The octree structure BuildSvo produces: depth, per-level node counts, child / leaf masks,
-// first-child + popcount addressing and breadth-first Morton order, checked against octrees worked
-// out by hand; rejected inputs; determinism over thread counts on a real voxelized mesh.
+// The octree structure BuildReferenceSvo produces: depth, per-level node counts, child / leaf
+// masks, first-child + popcount addressing and breadth-first Morton order, checked against octrees
+// worked out by hand; rejected inputs; determinism over thread counts on a real voxelized mesh.
 
 #include <gtest/gtest.h>
 
