@@ -4,6 +4,9 @@
 #include <memory>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
+#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/pipeline/page_plan.hpp"
 
@@ -34,6 +37,95 @@ StatusOr<std::vector<SvoPart>> ReadParts(std::span<const std::filesystem::path> 
   return parts;
 }
 
+// Everything the merged file takes from the first part, every part says alike.
+bool SameFrame(const SvoPartHead& a, const SvoPartHead& b) {
+  const SvoShape &x = a.frame.shape, &y = b.frame.shape;
+  return a.frame.grid == b.frame.grid && a.frame.mode == b.frame.mode && x.depth == y.depth &&
+         x.brick_side == y.brick_side && x.has_color == y.has_color &&
+         x.has_normal == y.has_normal && x.has_contours == y.has_contours && x.solid == y.solid &&
+         x.shared_color == y.shared_color && a.compression == b.compression;
+}
+
+// A voxel on a page's faces, or one that a neighbouring page's halo says is there.
+struct FaceVoxel {
+  std::uint64_t key = 0;
+  HalfRgba color;
+  std::uint32_t normal = 0;
+  std::size_t page = 0;  // index among all pages, in key order
+};
+
+// Every page of every part decoded and checked on its own (DecodeSvoPartPage), and across pages:
+// keys ascending over the parts, and each halo voxel a voxel of the page next to it, with its
+// attributes (the merged file's halo check). Pages are decoded in parallel; what the cross-page
+// check keeps of each is its face voxels and halo, a small share of its voxels.
+Status CheckPages(const std::vector<SvoPart>& parts, Progress& progress) {
+  struct Where {
+    const SvoPart* part;
+    const SvoPartPage* page;
+  };
+  std::vector<Where> where;
+  for (const SvoPart& part : parts) {
+    for (const SvoPartPage& page : part.pages) {
+      if (!where.empty() && page.key <= where.back().page->key) {
+        return Status::BadInput("{}: page {:#x} does not follow page {:#x} of {}", part.name,
+                                page.key, where.back().page->key, where.back().part->name);
+      }
+      where.push_back({&part, &page});
+    }
+  }
+  const SvoFrame& frame = parts[0].head.frame;
+  const std::uint32_t shift = frame.depth() - PageLevel(frame.depth());
+  const std::uint32_t last = (std::uint32_t{1} << shift) - 1;
+  std::vector<std::vector<FaceVoxel>> faces(where.size()), halos(where.size());
+  std::vector<Status> checked(where.size(), Status::Ok());
+  Progress::Stage stage(progress, "check parts", where.size());
+  tbb::parallel_for(std::size_t{0}, where.size(), [&](std::size_t i) {
+    StatusOr<SvoChunk> page = DecodeSvoPartPage(*where[i].part, *where[i].page);
+    if (!page.ok()) {
+      checked[i] = page.status();
+      return;
+    }
+    const auto voxel = [&](std::uint64_t key, const auto& colors, const auto& normals,
+                           std::size_t n) {
+      return FaceVoxel{key, colors.empty() ? HalfRgba() : colors[n],
+                       normals.empty() ? 0u : normals[n].bits, i};
+    };
+    const std::vector<std::uint64_t> keys = ChunkVoxelKeys(*page);
+    for (std::size_t n = 0; n < keys.size(); ++n) {
+      const MortonCoord c = MortonDecode(keys[n]);
+      const auto on_face = [&](std::uint32_t v) { return (v & last) == 0 || (v & last) == last; };
+      if (on_face(c.x) || on_face(c.y) || on_face(c.z)) {
+        faces[i].push_back(voxel(keys[n], page->colors, page->normals, n));
+      }
+    }
+    for (std::size_t n = 0; n < page->halo_keys.size(); ++n) {
+      halos[i].push_back(voxel(page->halo_keys[n], page->halo_colors, page->halo_normals, n));
+    }
+    stage.Advance(1);
+  });
+  for (const Status& s : checked) SVOKIT_RETURN_IF_ERROR(s);
+  // Pages ascend and each covers a run of voxel keys: their face voxels are in key order.
+  std::vector<FaceVoxel> all;
+  for (std::vector<FaceVoxel>& f : faces) {
+    all.insert(all.end(), f.begin(), f.end());
+    std::vector<FaceVoxel>().swap(f);
+  }
+  for (const std::vector<FaceVoxel>& page_halo : halos) {
+    for (const FaceVoxel& h : page_halo) {
+      const auto it =
+          std::lower_bound(all.begin(), all.end(), h.key,
+                           [](const FaceVoxel& v, std::uint64_t key) { return v.key < key; });
+      if (it == all.end() || it->key != h.key || !(it->color == h.color) ||
+          it->normal != h.normal) {
+        const Where& w = where[h.page];
+        return Status::BadInput("{}: page {:#x}: halo voxel {} is not the voxel of its neighbour",
+                                w.part->name, w.page->key, h.key);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
 // The parts (sorted by part number) are all of one build: same identity and frame, each part
 // once, their shares of the cells following each other.
 Status CheckOneBuild(const std::vector<SvoPart>& parts) {
@@ -41,7 +133,7 @@ Status CheckOneBuild(const std::vector<SvoPart>& parts) {
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const SvoPartHead& p = parts[i].head;
     if (p.of.identity != head.of.identity || p.of.parts != head.of.parts || p.cells != head.cells ||
-        p.frame.metadata != head.frame.metadata) {
+        p.frame.metadata != head.frame.metadata || !SameFrame(p, head)) {
       return Status::BadInput("{} belongs to another build than {} (another mesh or options)",
                               parts[i].name, parts[0].name);
     }
@@ -191,6 +283,7 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
   StatusOr<std::vector<SvoPart>> parts = ReadParts(paths);
   if (!parts.ok()) return parts.status();
   SVOKIT_RETURN_IF_ERROR(CheckOneBuild(*parts));
+  SVOKIT_RETURN_IF_ERROR(CheckPages(*parts, progress));
   if ((*parts)[0].head.frame.shape.brick_side != 0) return MergeBuiltAlone(*parts, path, progress);
   return MergeFinished(*parts, path, progress);
 }

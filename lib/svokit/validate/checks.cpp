@@ -11,6 +11,7 @@
 
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/bricks.hpp"
+#include "svokit/svo/contour_range.hpp"
 #include "svokit/svo/key_index.hpp"
 #include "svokit/validate/contour_surface.hpp"
 
@@ -233,9 +234,8 @@ CheckResult CheckContourRanges(const Svo& svo) {
       if (words[l][i] == 0) continue;
       ++checked;
       const Contour c = DecodeContour(words[l][i]);
-      // The cube u ∈ [−½, ½]³ spans n·u ∈ [−L1/2, L1/2]; the slab must meet it.
       const double half = 0.5 * (std::abs(c.nx) + std::abs(c.ny) + std::abs(c.nz));
-      if (c.Low() > half || c.High() < -half) {
+      if (!ContourMeetsCube(c)) {
         if (keys.empty()) keys = svo.LevelKeys(l);
         r.Add({"contour_range",
                fmt::format("level {} node {} {}: slab [{}, {}] misses the cube's [{}, {}] along "

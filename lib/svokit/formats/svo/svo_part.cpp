@@ -1,13 +1,19 @@
 #include "svokit/formats/svo/svo_part.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/morton.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
+#include "svokit/svo/contour_range.hpp"
+#include "svokit/svo/page_borders.hpp"
 
 namespace svokit {
 
@@ -78,13 +84,50 @@ Status DecodeHead(std::span<const std::uint8_t> bytes, const std::string& name, 
       (flags & ~kKnownFlags) != 0) {
     return Status::BadInput("{}: the part's header is inconsistent", name);
   }
+  // What no part writer makes: a solid (built in one job), a shared colour without colours or a
+  // colour without the flag, a codec or level the .svo cannot hold.
+  if (shape.depth == 0 || shape.depth > kMaxDepth) {
+    return Status::BadInput("{}: depth {} is not 1 .. {}", name, shape.depth, kMaxDepth);
+  }
+  if (shape.solid)
+    return Status::BadInput("{}: a part of a solid (a solid is built in one job)", name);
+  if (shared > 1 || (shared == 1 && !shape.has_color) ||
+      (shared == 0 && !(color == HalfRgba(0, 0, 0, 0)))) {
+    return Status::BadInput("{}: the part's shared colour is inconsistent", name);
+  }
+  if (zstd > 1) return Status::BadInput("{}: codec {} is not 0 (stored) or 1 (zstd)", name, zstd);
+  // Stored parts carry level 0 (--compression none) or a level they do not use.
+  if (level > 22 || (zstd == 1 && level == 0)) {
+    return Status::BadInput("{}: zstd level {} is not 1 .. 22", name,
+                            static_cast<std::int32_t>(level));
+  }
   return Status::Ok();
+}
+
+// The page table's counts of a page that some octree can have: one root, each level at most 8
+// times the one above, contours only with contours and at most one per node, samples only above
+// the voxels with bricks.
+bool PossibleCounts(const SvoPartPage& page, const SvoShape& shape) {
+  std::uint64_t above = 0;
+  for (std::size_t i = 0; i < page.levels.size(); ++i) {
+    const auto [nodes, contours, samples] = page.levels[i];
+    const bool voxels = i + 1 == page.levels.size();
+    if (nodes == 0 || (i == 0 ? nodes != 1 : nodes > 8 * above) || contours > nodes ||
+        (!shape.has_contours && contours != 0) ||
+        ((shape.brick_side == 0 || voxels) && samples != 0)) {
+      return false;
+    }
+    above = nodes;
+  }
+  return true;
 }
 
 // The page table, checked against the sizes of the page and shell sections.
 Status DecodeTable(std::span<const std::uint8_t> bytes, SvoPart& part) {
   const std::uint32_t depth = part.head.frame.depth();
   const std::size_t held = depth - PageLevel(depth) + 1;
+  const std::uint32_t page_level = PageLevel(depth);
+  const SvoShape& shape = part.head.frame.shape;
   ByteReader t(bytes, part.name + ": PTAB");
   std::uint64_t offset = 0, shell_offset = 0;
   while (t.remaining() > 0) {
@@ -92,16 +135,26 @@ Status DecodeTable(std::span<const std::uint8_t> bytes, SvoPart& part) {
     SVOKIT_RETURN_IF_ERROR(t.Get(page.key));
     SVOKIT_RETURN_IF_ERROR(t.Get(page.size));
     SVOKIT_RETURN_IF_ERROR(t.Get(page.shell_size));
-    page.shell_offset = shell_offset;
-    shell_offset += page.shell_size;
     page.levels.resize(held);
     for (auto& l : page.levels) {
       for (auto& v : l) SVOKIT_RETURN_IF_ERROR(t.Get(v));
     }
+    // Sizes inside their sections (checked before adding, so no sum wraps around).
+    if (page.size > part.page_bytes.size() - offset ||
+        page.shell_size > part.shell_bytes.size() - shell_offset) {
+      return Status::BadInput("{}: the page table does not fill the pages", part.name);
+    }
     page.offset = offset;
     offset += page.size;
+    page.shell_offset = shell_offset;
+    shell_offset += page.shell_size;
     if (part.pages.size() > 1 && page.key <= part.pages[part.pages.size() - 2].key) {
       return Status::BadInput("{}: page keys are not ascending", part.name);
+    }
+    if (page.key >> (3 * page_level) != 0 || page.size == 0 ||
+        (shape.brick_side == 0 && page.shell_size != 0) || !PossibleCounts(page, shape)) {
+      return Status::BadInput("{}: page {:#x}: the page table's entry is impossible", part.name,
+                              page.key);
     }
   }
   if (offset != part.page_bytes.size() || shell_offset != part.shell_bytes.size()) {
@@ -115,7 +168,8 @@ Status DecodeTop(std::span<const std::uint8_t> bytes, SvoPart& part) {
   const SvoShape& shape = part.head.frame.shape;
   if (part.head.of.part == 0 && shape.has_contours) {
     part.top.resize(PageLevel(shape.depth));
-    for (auto& words : part.top) {
+    for (std::uint32_t level = 0; level < part.top.size(); ++level) {
+      auto& words = part.top[level];
       std::uint64_t n = 0;
       SVOKIT_RETURN_IF_ERROR(c.Get(n));
       for (std::uint64_t i = 0; i < n; ++i) {
@@ -123,7 +177,12 @@ Status DecodeTop(std::span<const std::uint8_t> bytes, SvoPart& part) {
         std::uint32_t word = 0;
         SVOKIT_RETURN_IF_ERROR(c.Get(key));
         SVOKIT_RETURN_IF_ERROR(c.Get(word));
-        words.emplace(key, word);
+        // Keys of the level, ascending; a word is 0 (none) or has a normal.
+        if (key >> (3 * level) != 0 || (!words.empty() && key <= words.rbegin()->first) ||
+            (word != 0 && ((word & 0x3ffffu) == 0 || !ContourMeetsCube(DecodeContour(word))))) {
+          return Status::BadInput("{}: the top contours are inconsistent", part.name);
+        }
+        words.emplace_hint(words.end(), key, word);
       }
     }
   }
@@ -198,6 +257,50 @@ StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path) {
   SVOKIT_RETURN_IF_ERROR(DecodeTable(*table, part));
   SVOKIT_RETURN_IF_ERROR(DecodeTop(*top, part));
   return part;
+}
+
+StatusOr<SvoChunk> DecodeSvoPartPage(const SvoPart& part, const SvoPartPage& page) {
+  const SvoFrame& frame = part.head.frame;
+  const std::uint32_t page_level = PageLevel(frame.depth());
+  const std::string name = fmt::format("{}: page {:#x}", part.name, page.key);
+  StatusOr<SvoChunk> chunk =
+      DecodeChunk(part.PageBytes(page), frame.shape,
+                  {page_level, page.key, frame.depth() - page_level + 1, true}, name);
+  if (!chunk.ok()) return chunk.status();
+  // The counts the writer took from this chunk (PagedSvoWriter::Encode): the merged file's
+  // header and page table are their sums.
+  for (std::uint32_t l = page_level; l <= frame.depth(); ++l) {
+    const std::size_t k = l - page_level;
+    const std::uint64_t contours = static_cast<std::uint64_t>(std::count_if(
+        chunk->contours[k].begin(), chunk->contours[k].end(), [](std::uint32_t w) { return w; }));
+    const std::uint64_t samples = k < chunk->layouts.size() ? chunk->layouts[k].size() : 0;
+    if (page.levels[k] !=
+        std::array<std::uint64_t, 3>{chunk->tree.NodeCount(l), contours, samples}) {
+      return Status::BadInput("{}: level {} holds other counts than the page table's", name, l);
+    }
+  }
+  for (const std::vector<std::uint32_t>& words : chunk->contours) {
+    for (const std::uint32_t word : words) {
+      if (word != 0 && !ContourMeetsCube(DecodeContour(word))) {
+        return Status::BadInput("{}: contour {:#010x}'s slab misses its node", name, word);
+      }
+    }
+  }
+  const auto& dims = frame.grid.dims();
+  for (const std::uint64_t key : ChunkVoxelKeys(*chunk)) {
+    const MortonCoord c = MortonDecode(key);
+    if (c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) {
+      return Status::BadInput("{}: a voxel lies outside the grid", name);
+    }
+  }
+  if (frame.shape.brick_side != 0) {
+    const std::vector<std::uint8_t> shell = EncodePageShell(*chunk, frame.shape);
+    const std::span<const std::uint8_t> stored = part.ShellBytes(page);
+    if (!std::equal(shell.begin(), shell.end(), stored.begin(), stored.end())) {
+      return Status::BadInput("{}: its shell is not the one its samples make", name);
+    }
+  }
+  return chunk;
 }
 
 }  // namespace svokit

@@ -79,6 +79,16 @@ struct SvoPart {
     return shell_bytes.subspan(page.shell_offset, page.shell_size);
   }
 };
+/// Reads and checks a part on its own: its header's fields in range (part index, cell share,
+/// depth ≤ 20, brick side, flags, codec, zstd level 1 .. 22), its page table's keys ascending in
+/// the page level, sizes inside their sections and counts possible, its top contours' keys
+/// ascending and words well formed. Pages are checked by DecodeSvoPartPage.
 StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path);
+
+/// Decodes `page` of `part` and checks it against the part: the chunk's own checks (DecodeChunk:
+/// masks, stream sizes, contour words, halo keys), its per-level counts the table's, its voxels
+/// inside the grid, and with bricks its shell the one its samples make (EncodePageShell). What no
+/// writer makes is bad input naming the part file and the page.
+StatusOr<SvoChunk> DecodeSvoPartPage(const SvoPart& part, const SvoPartPage& page);
 
 }  // namespace svokit
