@@ -44,3 +44,6 @@ foreach(format svm vfrag svo)
   svokit_fuzz_target(${format} fuzz/fuzz_container.cpp SVOKIT_FUZZ_FORMAT="${format}")
 endforeach()
 svokit_fuzz_target(image fuzz/fuzz_image.cpp)
+# .svopart: read, every page checked, merged alone and the result validated (svokit_validate).
+svokit_fuzz_target(svopart fuzz/fuzz_svopart.cpp)
+target_link_libraries(fuzz_svopart PRIVATE svokit_validate)

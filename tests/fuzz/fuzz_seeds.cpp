@@ -25,6 +25,7 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/pipeline/svo_parts.hpp"
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/compact_build.hpp"
 #include "svokit/svo/compact_svo.hpp"
@@ -257,6 +258,39 @@ void ChainFiles() {
   }
 }
 
+// Parts of builds by pages (.svopart): whole builds in one part (with bricks, colours, normals
+// and contours, zstd; without bricks, stored), and the two parts of a build of several pages.
+void Parts() {
+  svokit::Mesh mesh;
+  for (const auto& p : kPositions) mesh.positions.push_back({p[0], p[1], p[2]});
+  for (const auto& f : kFaces) mesh.triangles.push_back({f[0], f[1], f[2]});
+  svokit::EnsureDefaultMaterial(mesh);
+  struct Seed {
+    const char* name;
+    std::uint32_t resolution, bricks, part, parts;
+    bool attributes;
+    svokit::SvoCompression compression;
+  };
+  for (const Seed& s : {Seed{"tetra-16-bricks", 16, 3, 0, 1, true, {true, 3}},
+                        Seed{"tetra-16-plain", 16, 0, 0, 1, false, {false, 0}},
+                        Seed{"tetra-12-bricks2", 12, 2, 0, 1, true, {true, 1}},
+                        Seed{"tetra-140-part0", 140, 0, 0, 2, false, {true, 1}},
+                        Seed{"tetra-140-part1", 140, 0, 1, 2, false, {true, 1}}}) {
+    auto grid = svokit::GridTransform::FitResolution(mesh.Bounds(), s.resolution);
+    svokit::VoxelizeOptions options;
+    options.colors = options.normals = s.attributes;
+    auto regions = svokit::RegionVoxelizer::Create(mesh, *grid, options);
+    if (!regions.ok()) continue;
+    svokit::BuildOptions build;
+    build.brick_side = s.bricks;
+    build.contours = true;
+    fs::create_directories(out_dir / "svopart");
+    (void)svokit::BuildSvoPart(**regions, build, R"({"source":"seed"})", {s.part, s.parts, 7},
+                               out_dir / "svopart" / (std::string(s.name) + ".svopart"),
+                               s.compression, 0);
+  }
+}
+
 // One byte picks the format (fuzz_image.cpp's table), the rest is a 4×3 image in it.
 void Images() {
   static constexpr const char* kFormats[] = {"png", "jpg", "tga", "bmp",
@@ -295,6 +329,7 @@ int main(int argc, char** argv) {
   MeshGltf();
   MeshDraco();
   ChainFiles();
+  Parts();
   Images();
   return 0;
 }
