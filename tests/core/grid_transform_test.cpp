@@ -52,6 +52,34 @@ TEST(GridTransform, FitResolutionKeepsBoundsStrictlyInside) {
   }
 }
 
+TEST(GridTransform, FittedBoundsAreEnclosedAtAnyScaleAndOffset) {
+  // World-space rounding of origin + dims·h loses the fitting margin far from the origin (1 ulp of
+  // 1e20 is 16384); the voxel-space test is the voxelizer's and never does.
+  for (const double offset : {0.0, 1e6, 1e15, 1e20, -1e20, 1e300}) {
+    for (const double extent : {1e-30, 1e-3, 1.0, 1e4, 1e20, 1e38}) {
+      Box3d bounds;
+      bounds.Expand(Vec3d{offset, offset, offset});
+      bounds.Expand(Vec3d{offset + extent, offset + 0.5 * extent, offset + 0.25 * extent});
+      if (!(bounds.extent().x > 0)) continue;  // the extent vanished into the offset's ulp
+      for (const std::uint32_t resolution : {1u, 7u, 64u, 1024u}) {
+        StatusOr<GridTransform> g = GridTransform::FitResolution(bounds, resolution);
+        if (!g.ok()) {
+          // Refused only where a voxel is finer than a unit in the last place of the offset.
+          const double ulp = std::nextafter(std::abs(offset), INFINITY) - std::abs(offset);
+          EXPECT_EQ(g.status().code(), StatusCode::kBadInput);
+          EXPECT_LT(extent / resolution, 4 * ulp) << offset << " " << extent << " " << resolution;
+          continue;
+        }
+        EXPECT_TRUE(g->Encloses(bounds)) << offset << " " << extent << " " << resolution;
+        Box3d outside = bounds;
+        outside.Expand(g->VoxelToWorld(Vec3d{-1.0, 0.5, 0.5}));
+        if (!(outside.lo.x < bounds.lo.x)) continue;  // one voxel is below the offset's ulp
+        EXPECT_FALSE(g->Encloses(outside)) << offset << " " << extent << " " << resolution;
+      }
+    }
+  }
+}
+
 TEST(GridTransform, FitRejectsImpossibleInput) {
   Box3d point;
   point.Expand(Vec3d{1, 1, 1});

@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <filesystem>
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "tests/cli/run_tool.hpp"
@@ -92,6 +97,62 @@ TEST(SvoValidateCli, UnusableInputExitsTwoWithOneLine) {
     EXPECT_TRUE(lines[0].starts_with("svo-validate: ")) << lines[0];
     EXPECT_NE(lines[0].find(expect), std::string::npos) << expect << " in " << lines[0];
     EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+// The validator sees the mesh in the voxelizer's frame (the same transform and snapping), so any
+// mesh that builds validates: vanishing and astronomic extents, far offsets, and triangles that
+// snapping collapses to a point or a segment beside ordinary ones.
+TEST(SvoValidateCli, AnyMeshThatBuildsValidates) {
+  const TempDir dir;
+  const auto tetrahedron = [](double size, double offset) {
+    std::string obj;
+    for (const auto& [x, y, z] :
+         {std::array<double, 3>{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}) {
+      obj += fmt::format("v {} {} {}\n", offset + size * x, offset + size * y, offset + size * z);
+    }
+    return obj + "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  };
+  const std::vector<std::pair<std::string, std::string>> meshes = {
+      {"extent-1e-30", tetrahedron(1e-30, 0)},
+      {"extent-1e-300", tetrahedron(1e-300, 0)},
+      {"extent-1e38", tetrahedron(1e38, -5e37)},
+      {"coords-1e38",
+       "v -1e38 -1e38 -1e38\nv 1e38 -1e38 -1e38\nv -1e38 1e38 -1e38\n"
+       "v -1e38 -1e38 1e38\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
+      {"offset-1e20", tetrahedron(1e18, 1e20)},
+      {"offset-minus-1e20", tetrahedron(3e17, -1e20)},
+      // A unit triangle at the origin and one near 1e20: the first snaps to a point.
+      {"point-beside-1e20",
+       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e20 1e20 1e20\n"
+       "v 1.0001e20 1e20 1e20\nv 1e20 1.0001e20 1e20\nf 1 2 3\nf 4 5 6\n"},
+      // A needle 1e-9 wide along a long diagonal: it snaps to a segment.
+      {"segment-beside-tetrahedron",
+       tetrahedron(1, 0) + "v 0 0 0\nv 1 1 1\nv 1 1.000000001 1\nf 5 6 7\n"},
+  };
+  // Where a voxel is finer than the coordinates' precision the mesh does not build (exit 2).
+  dir.Write("below-precision.obj", tetrahedron(1e4, 1e20));
+  const ToolResult refused = RunTool("mesh2svo", {(dir / "below-precision.obj").string(), "-o",
+                                                  (dir / "below.svo").string(), "-r", "100", "-q"});
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("finer than the coordinates' precision"), std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "below.svo"));
+  for (const auto& [name, obj] : meshes) {
+    const std::string mesh = (dir / (name + ".obj")).string();
+    const std::string svo = (dir / (name + ".svo")).string();
+    dir.Write(name + ".obj", obj);
+    for (const char* resolution : {"16", "100"}) {
+      ToolResult r = RunTool("mesh2svo", {mesh, "-o", svo, "-r", resolution, "-q"});
+      ASSERT_EQ(r.exit_code, 0) << name << " at " << resolution << ": " << r.err;
+      r = RunTool("svo-validate", {svo, "--mesh", mesh, "--json", "-q"});
+      ASSERT_EQ(r.exit_code, 0) << name << " at " << resolution << ":\n" << r.out << r.err;
+      const auto j = nlohmann::json::parse(r.out);
+      EXPECT_EQ(j["valid"], true) << name;
+      // Every triangle counts, the collapsed ones too.
+      const auto faces = static_cast<int>(std::count(obj.begin(), obj.end(), 'f'));
+      EXPECT_EQ(j["checks"]["occupancy"]["stats"]["triangles"], faces) << name;
+    }
   }
 }
 

@@ -339,7 +339,7 @@ Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::strin
   const Box3d bounds = mesh.Bounds();
   if (!recorded.grid) {
     // No recorded grid fit: the mesh must at least lie inside the grid.
-    if (svo.grid.GridBounds().Contains(bounds)) return Status::Ok();
+    if (svo.grid.Encloses(bounds)) return Status::Ok();
     return Status::BadInput("{}: the mesh lies outside the octree's grid: not its mesh", mesh_name);
   }
   const StatusOr<GridTransform> fitted = recorded.grid->Fit(bounds);

@@ -35,14 +35,23 @@ StatusOr<GridTransform> FitCentred(const Box3d& bounds, double h, std::uint32_t 
     origin[a] = bounds.center()[a] - 0.5 * dims[a] * h;
   }
   GridTransform grid(origin, h, dims);
-  // Rounding in origin must not push the bounds onto the grid's outer faces; grow if it did.
-  for (int a = 0; a < 3; ++a) {
+  const auto strictly_inside = [&](int a) {
     const double lo = grid.WorldToVoxel(bounds.lo)[a];
     const double hi = grid.WorldToVoxel(bounds.hi)[a];
-    if (!(lo > pad && hi < dims[a] - pad)) {
-      origin[a] -= h;
-      dims[a] += 2;
-      grid = GridTransform(origin, h, dims);
+    return lo > pad && hi < dims[a] - pad;
+  };
+  // Rounding in origin must not push the bounds onto the grid's outer faces; grow if it did.
+  for (int a = 0; a < 3; ++a) {
+    if (strictly_inside(a)) continue;
+    origin[a] -= h;
+    dims[a] += 2;
+    grid = GridTransform(origin, h, dims);
+    // Growing cannot help where a voxel is finer than the coordinates can tell apart.
+    if (!strictly_inside(a)) {
+      return Status::BadInput(
+          "voxels of {:.6g} are finer than the coordinates' precision near {:.6g}: move the mesh "
+          "nearer the origin or lower the resolution",
+          h, bounds.center()[a]);
     }
   }
   return grid;
@@ -91,6 +100,14 @@ Vec3d GridTransform::VoxelCenter(const Vec3i& ijk) const {
 Box3d GridTransform::GridBounds() const {
   return {origin_, VoxelToWorld({static_cast<double>(dims_[0]), static_cast<double>(dims_[1]),
                                  static_cast<double>(dims_[2])})};
+}
+
+bool GridTransform::Encloses(const Box3d& b) const {
+  const Vec3d lo = WorldToVoxel(b.lo), hi = WorldToVoxel(b.hi);
+  for (int a = 0; a < 3; ++a) {
+    if (!(lo[a] >= 0.0 && hi[a] <= static_cast<double>(dims_[a]))) return false;
+  }
+  return true;
 }
 
 IBox3 GridTransform::IndexBox() const {

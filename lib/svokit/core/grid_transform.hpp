@@ -56,6 +56,10 @@ class GridTransform {
   Vec3d VoxelCenter(const Vec3i& ijk) const;
   /// World-space box of the whole grid.
   Box3d GridBounds() const;
+  /// Whether the world box `b` maps into [0, dims] in voxel space: the voxelizer's frame, so a
+  /// mesh fitted to this grid always passes, at any scale or offset (GridBounds() rounds in world
+  /// space, where 1 ulp can exceed the fitting margin).
+  bool Encloses(const Box3d& b) const;
   /// All voxel indices of the grid, [0, dims).
   IBox3 IndexBox() const;
 

@@ -61,7 +61,7 @@ StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path&
                                 const GridTransform& grid, const std::filesystem::path& input,
                                 std::string_view made) {
   StatusOr<Mesh> mesh = ImportStage(progress, mesh_path);
-  if (mesh.ok() && !grid.GridBounds().Contains(mesh->Bounds())) {
+  if (mesh.ok() && !grid.Encloses(mesh->Bounds())) {
     return Status::BadInput("{}: the mesh lies outside {}'s grid: not the mesh {}",
                             mesh_path.string(), input.string(), made);
   }

@@ -21,11 +21,13 @@ namespace svokit::validate {
 namespace {
 
 // The mesh as the voxelizer saw it: vertices snapped to 2⁻¹⁶ voxel (exact doubles), shifted by
-// −½ so OpenVDB's integer index coordinates are voxel centres; triangles that snapping made
-// degenerate are dropped, as the voxelizer drops them.
+// −½ so OpenVDB's integer index coordinates are voxel centres. Triangles that snapping made
+// degenerate are voxelized as what they are, a segment or a point, so they are kept apart:
+// OpenVDB's closest-point query divides by the triangle's area.
 struct SnappedMesh {
   std::vector<openvdb::Vec3d> points;
   std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::array<openvdb::Vec3d, 2>> segments;  // degenerate triangles (a point: p == q)
 
   std::size_t polygonCount() const { return triangles.size(); }
   std::size_t pointCount() const { return points.size(); }
@@ -53,9 +55,53 @@ SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid) {
     const bool degenerate = e0[1] * e1[2] - e0[2] * e1[1] == 0 &&
                             e0[2] * e1[0] - e0[0] * e1[2] == 0 &&
                             e0[0] * e1[1] - e0[1] * e1[0] == 0;
-    if (!degenerate) out.triangles.push_back({t[0], t[1], t[2]});
+    if (!degenerate) {
+      out.triangles.push_back({t[0], t[1], t[2]});
+      continue;
+    }
+    // Collinear corners: the two farthest apart span the others.
+    const openvdb::Vec3d &pa = out.points[t[0]], &pb = out.points[t[1]], &pc = out.points[t[2]];
+    const double ab = (pb - pa).lengthSqr(), ac = (pc - pa).lengthSqr(), bc = (pc - pb).lengthSqr();
+    if (ab >= ac && ab >= bc) {
+      out.segments.push_back({pa, pb});
+    } else if (ac >= bc) {
+      out.segments.push_back({pa, pc});
+    } else {
+      out.segments.push_back({pb, pc});
+    }
   }
   return out;
+}
+
+// Lowers the distance of every voxel centre within `band` of a segment to its exact distance,
+// walking the segment in half-voxel steps (cost linear in its length, not its bounding box).
+void AddSegmentDistances(const SnappedMesh& mesh, float band, openvdb::FloatGrid& distance) {
+  auto acc = distance.getAccessor();
+  const int reach = static_cast<int>(std::ceil(band)) + 1;
+  for (const auto& [p, q] : mesh.segments) {
+    const openvdb::Vec3d pq = q - p;
+    const double length2 = pq.lengthSqr();
+    const auto steps = static_cast<std::int64_t>(std::ceil(2.0 * std::sqrt(length2)));
+    for (std::int64_t s = 0; s <= steps; ++s) {
+      const openvdb::Vec3d at =
+          steps > 0 ? p + pq * (static_cast<double>(s) / static_cast<double>(steps)) : p;
+      const openvdb::Coord base(static_cast<int>(std::lround(at.x())),
+                                static_cast<int>(std::lround(at.y())),
+                                static_cast<int>(std::lround(at.z())));
+      for (int dx = -reach; dx <= reach; ++dx) {
+        for (int dy = -reach; dy <= reach; ++dy) {
+          for (int dz = -reach; dz <= reach; ++dz) {
+            const openvdb::Coord ijk = base.offsetBy(dx, dy, dz);
+            const openvdb::Vec3d centre(ijk.x(), ijk.y(), ijk.z());
+            const double t =
+                length2 > 0 ? std::clamp((centre - p).dot(pq) / length2, 0.0, 1.0) : 0.0;
+            const auto d = static_cast<float>((centre - (p + pq * t)).length());
+            if (d < band && d < acc.getValue(ijk)) acc.setValueOn(ijk, d);
+          }
+        }
+      }
+    }
+  }
 }
 
 struct Located {
@@ -85,16 +131,15 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
                        thin ? "thin" : "conservative", required, allowed, tol);
 
   const SnappedMesh snapped = Snap(mesh, svo.grid);
-  const double h = svo.grid.voxel_size();
-  const Vec3d& o = svo.grid.origin();
-  openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
-  transform->postTranslate(openvdb::Vec3d(o.x + 0.5 * h, o.y + 0.5 * h, o.z + 0.5 * h));
+  // Distances in voxels, in the voxelizer's own frame: a unit index transform, whatever the
+  // world's voxel size (OpenVDB refuses scales near 0, and floats overflow near 1e38).
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
   // A band of 2 voxels: OpenVDB's first pass computes the exact distance (double closest point)
   // of every voxel within √3/2 voxel of a triangle, and everything else reads as ≥ 2 h.
   constexpr float kBand = 2.0f;
   const openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
       snapped, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
-  const double to_voxels = 1.0 / static_cast<double>(static_cast<float>(h));
+  AddSegmentDistances(snapped, kBand, *distance);
 
   // Extra voxels: leaves whose centre is farther than allowed. Chunks in key order, each keeping
   // its first examples, so the reported ones are the first in Morton order for any thread count.
@@ -106,9 +151,8 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
     auto acc = distance->getConstAccessor();
     for (std::size_t i = part * kChunk; i < std::min(leaf_keys.size(), (part + 1) * kChunk); ++i) {
       const MortonCoord c = MortonDecode(leaf_keys[i]);
-      const double d = static_cast<double>(acc.getValue(openvdb::Coord(
-                           static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)))) *
-                       to_voxels;
+      const double d = static_cast<double>(acc.getValue(
+          openvdb::Coord(static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z))));
       if (d > allowed + tol) {
         if (extra_counts[part]++ < r.max_examples) extra[part].push_back({leaf_keys[i], d});
       }
@@ -126,7 +170,7 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
     std::vector<Located> local;
     std::uint64_t local_near = 0;
     for (auto it = leaf.cbeginValueOn(); it; ++it) {
-      const double d = static_cast<double>(*it) * to_voxels;
+      const double d = static_cast<double>(*it);
       if (d > required - tol) continue;
       const openvdb::Coord ijk = it.getCoord();
       // The voxelizer clips to the grid; the mesh lies inside it (the app checks), so voxels
@@ -178,7 +222,7 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
   r.Stat("required", near);
   r.Stat("missing", missing.size());
   r.Stat("extra", extras);
-  r.Stat("triangles", snapped.triangles.size());
+  r.Stat("triangles", snapped.triangles.size() + snapped.segments.size());
   return r;
 }
 
