@@ -98,6 +98,20 @@ inline CLI::Validator NonNegativeOrInfinite() {
       "");
 }
 
+/// A count of at most `max`, the documented bound of an option that sets the amount of work;
+/// more is refused with the value and the maximum.
+inline CLI::Validator AtMost(std::uint64_t max) {
+  return CLI::Validator(
+      [max](std::string& text) -> std::string {
+        std::uint64_t v = 0;
+        if (CLI::detail::lexical_cast(text, v) && v > max) {
+          return fmt::format("{}: the maximum is {}", text, max);
+        }
+        return {};
+      },
+      "");
+}
+
 /// An option naming a file (`flags` "input" for the positional one), shown as FILE in --help.
 inline CLI::Option* AddFile(CLI::App& cli, const std::string& flags, std::filesystem::path& path,
                             const std::string& description) {
@@ -124,16 +138,17 @@ CLI::Option* AddChoice(CLI::App& cli, const std::string& flags, Enum& value,
       ->default_str(NameOf(names, value));
 }
 
-/// --memory-limit SIZE: the bytes it names, or none when not given.
+/// --memory-limit SIZE: the bytes it names, or none when not given (given empty, it is refused).
 struct MemoryLimitOption {
   std::string text;
+  CLI::Option* option = nullptr;
 
   void Add(CLI::App& cli, const std::string& description) {
-    cli.add_option("--memory-limit", text, description)->option_text("SIZE");
+    option = cli.add_option("--memory-limit", text, description)->option_text("SIZE");
   }
-  bool given() const { return !text.empty(); }
+  bool given() const { return option != nullptr && option->count() > 0; }
   StatusOr<std::optional<std::uint64_t>> Bytes() const {
-    if (text.empty()) return std::optional<std::uint64_t>();
+    if (!given()) return std::optional<std::uint64_t>();
     StatusOr<std::uint64_t> bytes = ParseByteSize("--memory-limit", text);
     if (!bytes.ok()) return bytes.status();
     return std::optional<std::uint64_t>(*bytes);

@@ -71,12 +71,14 @@ struct BakeCli {
         ->check(CLI::IsMember({"cones", "rays"}).description(""))
         ->option_text("cones|rays")
         ->capture_default_str();
-    cli.add_option("--rays", rays, "Rays per point of --method rays")
+    cli.add_option("--rays", rays, "Rays per point of --method rays (at most 65536)")
+        ->check(app::AtMost(kMaxAoRays))
         ->option_text("N")
         ->capture_default_str();
     cli.add_option("--reference", request.reference,
                    "Also ray trace the mesh's vertices with N rays (Embree) and print the cones' "
-                   "error against that")
+                   "error against that (at most 65536)")
+        ->check(app::AtMost(kMaxAoRays))
         ->option_text("N");
   }
 

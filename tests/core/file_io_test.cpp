@@ -86,11 +86,11 @@ TEST(AtomicFileWriter, CommitOntoDirectoryFailsAndKeepsIt) {
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"out.bin"});
 }
 
-TEST(AtomicFileWriter, MissingDirectoryIsBadInput) {
+TEST(AtomicFileWriter, MissingDirectoryCannotBeWritten) {
   TempDir dir;
   AtomicFileWriter w(dir / "no" / "such" / "out.bin");
   const Status s = w.Open();
-  EXPECT_EQ(s.code(), StatusCode::kBadInput);
+  EXPECT_EQ(s.code(), StatusCode::kCannotWrite);
   EXPECT_NE(s.message().find("out.bin"), std::string::npos);
 }
 

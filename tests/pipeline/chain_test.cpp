@@ -252,13 +252,14 @@ TEST(Chain, ABadOutputIsRefusedBeforeAnyWork) {
   const fs::path missing = dir / "no-such-dir";
   const fs::path vfrag = dir / "t.vfrag";
   ASSERT_TRUE(MeshToVoxels(ToVoxels(vfrag)).ok());
-  const auto expect_refused = [&](const auto& run, const fs::path& output, const std::string& why) {
+  const auto expect_refused = [&](const auto& run, const fs::path& output, const std::string& why,
+                                  StatusCode code = StatusCode::kBadInput) {
     SCOPED_TRACE(output.string());
     Progress progress(Progress::Style::kQuiet);
     const std::vector<std::string> before = dir.Files();
     const auto result = run(progress);
     ASSERT_FALSE(result.ok());
-    EXPECT_EQ(result.status().code(), StatusCode::kBadInput);
+    EXPECT_EQ(result.status().code(), code);
     const std::string& message = result.status().message();
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     EXPECT_EQ(message.rfind(output.string(), 0), 0u) << message;
@@ -290,11 +291,11 @@ TEST(Chain, ABadOutputIsRefusedBeforeAnyWork) {
   expect_refused(mesh(Torus(), dir / "t"), dir / "t", "output must be a .svo file");
 
   expect_refused(voxels(Torus(), missing / "t.vfrag"), missing / "t.vfrag",
-                 "output directory does not exist");
+                 "output directory does not exist", StatusCode::kCannotWrite);
   expect_refused(build(vfrag, missing / "t.svo"), missing / "t.svo",
-                 "output directory does not exist");
+                 "output directory does not exist", StatusCode::kCannotWrite);
   expect_refused(mesh(Torus(), missing / "t.svo"), missing / "t.svo",
-                 "output directory does not exist");
+                 "output directory does not exist", StatusCode::kCannotWrite);
 
   // The input as its own output: a mesh that imports, kept as it was.
   const fs::path ply = dir / "box-room.ply";

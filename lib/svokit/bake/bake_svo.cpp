@@ -134,6 +134,11 @@ class Baker {
 }  // namespace
 
 StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
+  for (const std::optional<std::uint32_t>& rays : {r.rays, r.reference}) {
+    if (rays && (*rays == 0 || *rays > kMaxAoRays)) {
+      return Status::BadInput("{} rays per point: must be 1 to {}", *rays, kMaxAoRays);
+    }
+  }
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r));
   StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt);
   if (!svo.ok()) return svo.status();

@@ -28,6 +28,10 @@ struct AoBakeRequest {
   std::optional<std::uint32_t> reference;  ///< also the vertices' error against this many rays
 };
 
+/// The most rays per point of `rays` and `reference`: Monte Carlo noise 1/256 of one ray's, while
+/// a billion would trace for days.
+inline constexpr std::uint32_t kMaxAoRays = 65536;
+
 /// How far occluders count by default: this fraction of the diagonal of the octree's grid.
 inline constexpr double kDefaultAoDistance = 0.25;
 
@@ -48,7 +52,8 @@ struct AoBakeReport {
 };
 
 /// Reads the octree, imports the mesh (checked to be the one the octree was made from), bakes
-/// and writes every output asked for. Outputs are checked before any work.
+/// and writes every output asked for. Outputs and ray counts (1 to kMaxAoRays) are checked before
+/// any work.
 StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& request,
                                  Progress& progress = Progress::Silent());
 

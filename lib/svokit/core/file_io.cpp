@@ -221,7 +221,7 @@ Status AtomicFileWriter::Open() {
   dir_fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd_ < 0) {
     if (errno == ENOENT || errno == ENOTDIR) {
-      return Status::BadInput("{}: output directory does not exist", path_.string());
+      return Status::CannotWrite("{}: output directory does not exist", path_.string());
     }
     return Failure("cannot open the output directory", errno);
   }
@@ -441,8 +441,11 @@ Status CheckOutputPath(const std::filesystem::path& path,
   }
   const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    return Status::BadInput("{}: output directory does not exist", path.string());
+  // A directory missing (never made, or removed, also as the working directory) is the
+  // environment's refusal, as one without permission is.
+  struct stat dir_stat {};
+  if (::stat(dir.c_str(), &dir_stat) != 0 || !S_ISDIR(dir_stat.st_mode) || dir_stat.st_nlink == 0) {
+    return Status::CannotWrite("{}: output directory does not exist", path.string());
   }
   // Refused before any work: found at the final rename, these cost the whole run.
   if (std::filesystem::is_directory(path, ec)) {

@@ -142,7 +142,8 @@ class ScratchFile {
 
 /// Checks an output path before any work is done: its extension is one of `extensions`, its
 /// directory exists and is writable, and it is neither a directory nor the file `input`, so a long
-/// run never ends in "cannot write" nor replaces its own input.
+/// run never ends in "cannot write" nor replaces its own input. A directory that is missing (also
+/// removed while it is the working directory) or not writable is kCannotWrite; the rest kBadInput.
 Status CheckOutputPath(const std::filesystem::path& path,
                        const std::vector<std::string>& extensions,
                        const std::filesystem::path& input = {});

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "svokit/core/std_streams.hpp"
+
 namespace svokit {
 
 Progress::Progress(Style style, std::FILE* out) : style_(style), out_(out) {
@@ -30,7 +32,7 @@ Progress::Stage::Stage(Progress& progress, std::string name, std::uint64_t total
 
 Progress::Stage::~Stage() {
   if (cancelled_) {
-    if (progress_.style_ == Style::kBar) fmt::print(progress_.out_, "\r\x1b[K");
+    if (progress_.style_ == Style::kBar) WriteDiagnostic("\r\x1b[K", progress_.out_);
     return;
   }
   done_ = total_;
@@ -88,9 +90,9 @@ void Progress::Stage::Draw(bool final) {
       return;
     case Style::kLines:
       if (final) {
-        fmt::print(out, "{:<12} done in {:.3f} s{}\n", name_, seconds(), tail);
+        WriteDiagnostic(fmt::format("{:<12} done in {:.3f} s{}\n", name_, seconds(), tail), out);
       } else {
-        fmt::print(out, "{:<12} {}\n", name_, Status());
+        WriteDiagnostic(fmt::format("{:<12} {}\n", name_, Status()), out);
       }
       break;
     case Style::kBar: {
@@ -100,14 +102,15 @@ void Progress::Stage::Draw(bool final) {
               ? 1.0
               : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
       const int filled = static_cast<int>(frac * kWidth);
-      fmt::print(out, "\r{:<12} [{}{}] {}{}\x1b[K{}", name_, std::string(filled, '#'),
-                 std::string(kWidth - filled, '.'),
-                 final ? fmt::format("{:3.0f}% {:.1f} s", frac * 100.0, seconds()) : Status(),
-                 final ? tail : "", final ? "\n" : "");
+      WriteDiagnostic(
+          fmt::format("\r{:<12} [{}{}] {}{}\x1b[K{}", name_, std::string(filled, '#'),
+                      std::string(kWidth - filled, '.'),
+                      final ? fmt::format("{:3.0f}% {:.1f} s", frac * 100.0, seconds()) : Status(),
+                      final ? tail : "", final ? "\n" : ""),
+          out);
       break;
     }
   }
-  std::fflush(out);
 }
 
 }  // namespace svokit
