@@ -293,8 +293,8 @@ void Parts() {
 
 // One byte picks the format (fuzz_image.cpp's table), the rest is a 4×3 image in it.
 void Images() {
-  static constexpr const char* kFormats[] = {"png", "jpg", "tga", "bmp",
-                                             "tif", "exr", "hdr", "webp"};
+  static constexpr const char* kFormats[] = {"png", "jpg", "tga",  "bmp", "tif",
+                                             "exr", "hdr", "webp", "gif", "ppm"};
   const float pixels[4 * 3 * 4] = {1, 0, 0, 1, 0,    1,    0,    1, 0, 0, 1, 0.5f,
                                    1, 1, 1, 1, 0.5f, 0.5f, 0.5f, 1, 0, 0, 0, 0};
   for (std::size_t k = 0; k < std::size(kFormats); ++k) {

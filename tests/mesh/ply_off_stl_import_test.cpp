@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/mesh/image_codec.hpp"
 #include "svokit/mesh/importers.hpp"
 #include "tests/test_util.hpp"
 
@@ -465,7 +466,8 @@ TEST(PlyImport, MeshLabTexcoordsAndTextureFile) {
   {  // texture present next to the file
     const test::TempDir dir;
     const fs::path path = dir.Write("textured.ply", ply);
-    dir.Write("checker tex.png", "not decoded on import");
+    const std::vector<std::uint8_t> pixels(2 * 2 * 3, 200);  // only an image is stored
+    ASSERT_TRUE(WriteImage(dir / "checker tex.png", 2, 2, 3, pixels).ok());
     const Mesh mesh = ExpectImports(detail::ImportPly(path));
     ASSERT_EQ(mesh.materials.size(), 1u);
     EXPECT_EQ(mesh.materials[0].texture, 0);

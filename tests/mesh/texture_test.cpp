@@ -10,6 +10,10 @@
 #include <OpenImageIO/imageio.h>
 
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/mesh/image_codec.hpp"
+#include "svokit/mesh/importers.hpp"
+#include "svokit/mesh/texture_budget.hpp"
 #include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
 
@@ -151,8 +155,8 @@ TEST(Texture, HeadersThatAllocateOnOpenAreCheckedFirst) {
   auto bmp_info = Texture("bomb.bmp", bmp).ReadInfo();
   ASSERT_FALSE(bmp_info.ok());
   EXPECT_EQ(bmp_info.status().message(),
-            "texture 'bomb.bmp': cannot decode (BMP header declares 4x268435456 pixels, over the "
-            "limit of 67108864 pixels or 65536 per side)");
+            "texture 'bomb.bmp': 4x268435456 pixels with 1 channels, over the limit of 67108864 "
+            "pixels, 65536 per side and 4 channels");
 
   // An OpenEXR header whose first attribute, of a type OpenEXR keeps opaque, declares 2 GiB - 1.
   std::vector<std::uint8_t> exr;
@@ -165,6 +169,138 @@ TEST(Texture, HeadersThatAllocateOnOpenAreCheckedFirst) {
   EXPECT_EQ(exr_info.status().message(),
             "texture 'bomb.exr': cannot decode (OpenEXR attribute 'bomb' declares 2147483647 "
             "bytes, more than the file holds)");
+}
+
+// stb_image decodes the common formats to the same floats OpenImageIO gives with straight alpha
+// (JPEG, whose decoders round their transforms and upsampling differently, to within 16/255).
+TEST(Texture, CommonFormatsDecodeToOpenImageIOsFloatsWithoutThePlugin) {
+  test::TempDir dir;
+  struct Case {
+    std::string ext;
+    int channels;
+    OIIO::TypeDesc type;
+    float tolerance;
+  };
+  const std::vector<Case> cases = {
+      {"png", 1, OIIO::TypeDesc::UINT8, 0},    {"png", 2, OIIO::TypeDesc::UINT8, 0},
+      {"png", 3, OIIO::TypeDesc::UINT8, 0},    {"png", 4, OIIO::TypeDesc::UINT8, 0},
+      {"png", 4, OIIO::TypeDesc::UINT16, 0},   {"tga", 4, OIIO::TypeDesc::UINT8, 0},
+      {"bmp", 3, OIIO::TypeDesc::UINT8, 0},    {"jpg", 3, OIIO::TypeDesc::UINT8, 16.f / 255},
+      {"hdr", 3, OIIO::TypeDesc::FLOAT, 1e-2f}};
+  for (const Case& c : cases) {
+    const std::string path = (dir / ("img." + c.ext)).string();
+    const int w = 37, h = 23;
+    std::vector<float> source(static_cast<std::size_t>(w) * h * c.channels);
+    for (std::size_t i = 0; i < source.size(); ++i)
+      source[i] = static_cast<float>(i * 37 % 256) / 255;
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(path, OIIO::ImageSpec(w, h, c.channels, c.type)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, source.data()));
+    out->close();
+    // Straight alpha, as svokit keeps it (OpenImageIO premultiplies by default).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    ASSERT_TRUE(in);
+    const int nc = in->spec().nchannels;
+    std::vector<float> expected(static_cast<std::size_t>(w) * h * nc);
+    ASSERT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, expected.data()));
+    const std::vector<std::uint8_t> bytes = *ReadFileBytes(path);
+    ImageHeader header;
+    StatusOr<std::vector<float>> pixels = DecodeImagePixels(path, bytes, header);
+    ASSERT_TRUE(pixels.ok()) << path << ": " << pixels.status().message();
+    EXPECT_FALSE(header.needs_plugin) << c.ext;
+    ASSERT_EQ(header.channels, nc) << c.ext;
+    ASSERT_EQ(pixels->size(), expected.size()) << c.ext;
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      differ += c.tolerance == 0 ? (*pixels)[i] != expected[i]
+                                 : std::abs((*pixels)[i] - expected[i]) > c.tolerance;
+    }
+    float most = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      most = std::max(most, std::abs((*pixels)[i] - expected[i]));
+    }
+    EXPECT_EQ(differ, 0u) << c.ext << " " << c.channels << " channels, " << c.type
+                          << ": largest difference " << most;
+  }
+}
+
+// Formats whose headers svokit does not check are refused by their bytes, whatever the name.
+TEST(Texture, UncheckedFormatsAreUnsupported) {
+  const std::vector<std::uint8_t> sgi = {0x01, 0xda, 1, 1, 0, 3, 0xff, 0xff, 0xff, 0xff, 0, 4};
+  const std::vector<std::uint8_t> webp = {'R', 'I', 'F', 'F', 30, 0, 0, 0, 'W',  'E', 'B', 'P',
+                                          'V', 'P', '8', 'L', 10, 0, 0, 0, 0x2f, 0,   0,   0};
+  for (const auto& [name, bytes] :
+       {std::pair{"bomb.sgi", sgi}, std::pair{"bomb.webp", webp},
+        std::pair{"passwd.png", std::vector<std::uint8_t>{'r', 'o', 'o', 't', ':', 'x'}}}) {
+    auto info = Texture(name, bytes).ReadInfo();
+    ASSERT_FALSE(info.ok()) << name;
+    EXPECT_NE(info.status().message().find("unsupported image format"), std::string::npos)
+        << info.status().message();
+  }
+}
+
+// The budget decides in texture order from the headers: the first texture whole, the second
+// downsampled (a 2 × 2 box filter in linear light, twice), the third refused; the same for one
+// thread and for two.
+TEST(TextureBudget, DownsamplesInTextureOrderTheSameForAnyThreadCount) {
+  test::TempDir dir;
+  std::vector<Texture> textures;
+  for (int t = 0; t < 3; ++t) {
+    std::vector<std::uint8_t> px(1024 * 1024 * 4);
+    for (std::size_t i = 0; i < px.size(); ++i) px[i] = static_cast<std::uint8_t>(i * (t + 3));
+    const auto path = dir / fmt::format("t{}.png", t);
+    ASSERT_TRUE(WriteImage(path, 1024, 1024, 4, px).ok());
+    textures.emplace_back(path.filename().string(), *ReadFileBytes(path));
+  }
+  // What the first needs whole, and about a tenth more.
+  const std::uint64_t working = ImageDecodeBytes(*ReadImageHeader("t0.png", textures[0].encoded()),
+                                                 textures[0].encoded().size());
+  const std::uint64_t budget = DecodedTextureBytes(1024, 1024) + working + (working >> 3);
+  std::vector<std::vector<Image>> runs;
+  for (const std::size_t threads : {1, 2}) {
+    ThreadLimit limit(threads);
+    BudgetedTextures decoded = DecodeTexturesWithinBudget(textures, {0, 1, 2}, budget);
+    EXPECT_EQ(decoded.shrink[0], 0);
+    EXPECT_GT(decoded.shrink[1], 0);
+    EXPECT_TRUE(decoded.errors[1].ok());
+    EXPECT_FALSE(decoded.errors[2].ok());
+    EXPECT_NE(decoded.errors[2].message().find("t2.png"), std::string::npos);
+    ASSERT_EQ(decoded.warnings.size(), 1u);
+    EXPECT_NE(decoded.warnings[0].find("t1.png"), std::string::npos) << decoded.warnings[0];
+    EXPECT_LE(decoded.planned_bytes, budget);
+    runs.push_back(std::move(decoded.images));
+  }
+  for (int t = 0; t < 2; ++t) {
+    EXPECT_EQ(runs[0][t].width, runs[1][t].width);
+    EXPECT_EQ(runs[0][t].rgba, runs[1][t].rgba);
+  }
+  // A downsampled texel is the mean of its block of full-size linear texels.
+  const Image& full = **textures[1].Decoded();
+  const Image& small = runs[0][1];
+  const int step = 1024 / small.width;
+  double mean = 0;
+  for (int y = 0; y < step; ++y)
+    for (int x = 0; x < step; ++x) mean += full.Texel(step + x, y).g;
+  EXPECT_NEAR(small.Texel(1, 0).g, mean / (step * step), 1e-6);
+}
+
+// A texture file that is not an image (any file the model names) is never stored: a warning, the
+// base colour, and no bytes in the mesh.
+TEST(Texture, FilesThatAreNotImagesAreNotStored) {
+  test::TempDir dir;
+  dir.Write("notes.png", std::string("root:x:0:0:root:/root:/bin/bash\n"));
+  Mesh mesh;
+  Material material;
+  material.name = "m";
+  detail::AttachTextureFile(dir.path(), "notes.png", material, mesh);
+  EXPECT_TRUE(mesh.textures.empty());
+  EXPECT_EQ(material.texture, -1);
+  ASSERT_EQ(mesh.warnings.size(), 1u);
+  EXPECT_NE(mesh.warnings[0].find("unsupported image format"), std::string::npos)
+      << mesh.warnings[0];
 }
 
 }  // namespace

@@ -34,6 +34,7 @@
 #include <tiny_gltf.h>
 
 #include "svokit/core/file_io.hpp"
+#include "svokit/mesh/image_codec.hpp"
 #include "svokit/mesh/importers.hpp"
 
 namespace svokit::detail {
@@ -1223,6 +1224,10 @@ class GltfImporter {
       std::string name = image.name.empty() ? fmt::format("image_{}", source) : image.name;
       const std::string ext = ImageExtension(image.mimeType, bytes);
       if (!name.ends_with(ext)) name += ext;
+      // Bytes that are not an image svokit reads are never stored.
+      if (StatusOr<ImageHeader> header = ReadImageHeader(name, bytes); !header.ok()) {
+        return warn(header.status().message());
+      }
       mesh_.textures.emplace_back(std::move(name),
                                   std::vector<std::uint8_t>(bytes.begin(), bytes.end()),
                                   /*srgb=*/true);

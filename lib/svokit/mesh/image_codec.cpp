@@ -1,22 +1,59 @@
 #include "svokit/mesh/image_codec.hpp"
 
 #include <dlfcn.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <climits>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
+#include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 
 #include "svokit/core/file_io.hpp"
+#include "svokit/mesh/image_headers.hpp"
+#include "svokit/mesh/stb_codec.hpp"
 
 namespace svokit {
 
 namespace {
 
 constexpr const char* kPluginName = "libsvokit_oiio.so";
+
+// The address space loading the plugin maps (its ~260 libraries: 440 MB measured with
+// OpenImageIO 2.4 on Debian 12), and a thread stack per hardware thread for OpenImageIO's pool.
+// Below it, a library's static constructors fail with bad_alloc or a segfault, or deadlock.
+constexpr std::uint64_t kPluginAddressSpace = std::uint64_t{512} << 20;
+constexpr std::uint64_t kPluginThreadStack = std::uint64_t{8} << 20;
+
+// The address space left under RLIMIT_AS (`ulimit -v`); none when there is no limit.
+std::optional<std::uint64_t> AddressSpaceLeft() {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return std::nullopt;
+  std::ifstream status("/proc/self/status");
+  std::uint64_t used_kb = 0;
+  for (std::string line; std::getline(status, line);) {
+    if (line.starts_with("VmSize:")) used_kb = std::strtoull(line.c_str() + 7, nullptr, 10);
+  }
+  const std::uint64_t used = used_kb << 10;
+  return limit.rlim_cur > used ? limit.rlim_cur - used : 0;
+}
+
+// Refuses, as out of memory, to load the plugin into less address space than it maps.
+Status CheckPluginHeadroom() {
+  const std::uint64_t needed =
+      kPluginAddressSpace + kPluginThreadStack * std::max(1u, std::thread::hardware_concurrency());
+  const std::optional<std::uint64_t> left = AddressSpaceLeft();
+  if (!left || *left >= needed) return Status::Ok();
+  return Status::OutOfMemory(
+      "cannot load the image plugin for OpenEXR and TIFF: it needs {} MiB of address space, {} "
+      "MiB are left under the limit (ulimit -v)",
+      needed >> 20, *left >> 20);
+}
 
 struct Plugin {
   SvokitDecodeFn decode = nullptr;
@@ -31,6 +68,7 @@ const Plugin& LoadPlugin() {
   static Plugin plugin;
   static std::once_flag once;
   std::call_once(once, [] {
+    if (plugin.error = CheckPluginHeadroom(); !plugin.error.ok()) return;
     std::vector<std::string> candidates;
     if (const char* dir = std::getenv("SVOKIT_PLUGIN_DIR")) {
       candidates.push_back(std::string(dir) + "/" + kPluginName);
@@ -78,8 +116,9 @@ const Plugin& LoadPlugin() {
   return plugin;
 }
 
-Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageHeader& header,
-            float* pixels, std::size_t pixel_count) {
+// Decodes through the plugin: a header only when `pixels` is null.
+Status CallPlugin(const std::string& name, std::span<const std::uint8_t> bytes, ImageHeader& header,
+                  float* pixels, std::size_t pixel_count) {
   const Plugin& plugin = LoadPlugin();
   if (!plugin.decode) return plugin.error.WithContext(fmt::format("texture '{}'", name));
   SvokitImageHeader h{};
@@ -92,7 +131,13 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
     std::replace(message.begin(), message.end(), '\n', ';');
     return Status::BadInput("texture '{}': cannot decode ({})", name, message);
   }
-  header = {h.width, h.height, h.channels, h.is_float != 0, h.format};
+  header = {h.width, h.height, h.channels, h.is_float != 0, h.format, 4, true};
+  return CheckImageSize(name, header);
+}
+
+}  // namespace
+
+Status CheckImageSize(const std::string& name, const ImageHeader& h) {
   if (h.width <= 0 || h.height <= 0 || h.channels <= 0) {
     return Status::BadInput("texture '{}': empty image", name);
   }
@@ -105,22 +150,103 @@ Status Call(const std::string& name, std::span<const std::uint8_t> bytes, ImageH
   return Status::Ok();
 }
 
-}  // namespace
-
 StatusOr<ImageHeader> ReadImageHeader(const std::string& name,
                                       std::span<const std::uint8_t> bytes) {
   ImageHeader header;
-  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, nullptr, 0));
+  if (const std::optional<stb::Header> h = stb::ReadHeader(bytes)) {
+    if (!h->error.empty()) {
+      return Status::BadInput("texture '{}': cannot decode ({} header: {})", name, h->format,
+                              h->error);
+    }
+    header = {h->width,  h->height,           h->channels, h->bytes_per_sample == 4,
+              h->format, h->bytes_per_sample, false};
+  } else {
+    const PluginImageHeader p = ReadPluginImageHeader(bytes);
+    if (*p.format == '\0') {
+      return Status::BadInput(
+          "texture '{}': unsupported image format (svokit reads PNG, JPEG, "
+          "BMP, TGA, GIF, HDR, PSD, PNM, OpenEXR and TIFF)",
+          name);
+    }
+    if (!p.error.empty())
+      return Status::BadInput("texture '{}': cannot decode ({})", name, p.error);
+    // Sizes past int are over the limits: clamp for the message.
+    header = {static_cast<int>(std::min<std::int64_t>(p.width, INT_MAX)),
+              static_cast<int>(std::min<std::int64_t>(p.height, INT_MAX)),
+              p.channels,
+              p.is_float,
+              p.format,
+              4,
+              true};
+  }
+  SVOKIT_RETURN_IF_ERROR(CheckImageSize(name, header));
   return header;
+}
+
+std::uint64_t ImageDecodeBytes(const ImageHeader& h, std::size_t encoded_size) {
+  // Per pixel of the padded image (JPEG decodes whole 16 × 16 blocks), with 4 channels: PNG holds
+  // the inflated rows and the image; JPEG its components, progressive coefficients and the image;
+  // GIF the image, the background and a history; HDR floats; the others the image and a copy;
+  // OpenImageIO a chunk of rows beside the floats it returns (counted by the caller).
+  const std::uint64_t pixels =
+      static_cast<std::uint64_t>(h.width + 16) * static_cast<std::uint64_t>(h.height + 16);
+  const std::string& f = h.format;
+  const std::uint64_t per_pixel = h.needs_plugin ? 4 * 4
+                                  : f == "png"   ? 2 * 4 * h.bytes_per_sample
+                                  : f == "jpeg"  ? 16
+                                  : f == "gif"   ? 12
+                                  : f == "hdr"   ? 20
+                                                 : 2 * 4 * h.bytes_per_sample;
+  // The encoded data gathered (PNG's IDAT chunks) and fixed tables.
+  return pixels * per_pixel + 2 * std::uint64_t{encoded_size} + (std::uint64_t{4} << 20);
+}
+
+StatusOr<ImageSamples> DecodeImageSamples(const std::string& name,
+                                          std::span<const std::uint8_t> bytes) {
+  StatusOr<ImageHeader> header = ReadImageHeader(name, bytes);
+  if (!header.ok()) return header.status();
+  if (header->needs_plugin) {
+    ImageHeader h;
+    SVOKIT_RETURN_IF_ERROR(CallPlugin(name, bytes, h, nullptr, 0));
+    auto pixels = std::make_shared<std::vector<float>>(static_cast<std::size_t>(h.width) *
+                                                       h.height * h.channels);
+    SVOKIT_RETURN_IF_ERROR(CallPlugin(name, bytes, h, pixels->data(), pixels->size()));
+    return ImageSamples{h, std::shared_ptr<const void>(pixels, pixels->data())};
+  }
+  const std::uint64_t cap = ImageDecodeBytes(*header, bytes.size());
+  stb::DecodeResult decoded = stb::Decode(bytes, static_cast<std::size_t>(cap));
+  if (decoded.over_cap) {
+    return Status::BadInput("texture '{}': needs more than {} MiB to decode a {}x{} image", name,
+                            cap >> 20, header->width, header->height);
+  }
+  if (!decoded.samples) {
+    return Status::BadInput("texture '{}': cannot decode ({})", name, decoded.error);
+  }
+  ImageHeader& h = *header;
+  h.channels = decoded.samples->header.channels;
+  SVOKIT_RETURN_IF_ERROR(CheckImageSize(name, h));
+  return ImageSamples{h, std::move(decoded.samples->data)};
 }
 
 StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
                                                std::span<const std::uint8_t> bytes,
                                                ImageHeader& header) {
-  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, nullptr, 0));
-  std::vector<float> pixels(static_cast<std::size_t>(header.width) * header.height *
-                            header.channels);
-  SVOKIT_RETURN_IF_ERROR(Call(name, bytes, header, pixels.data(), pixels.size()));
+  StatusOr<ImageSamples> samples = DecodeImageSamples(name, bytes);
+  if (!samples.ok()) return samples.status();
+  header = samples->header;
+  const std::size_t n = static_cast<std::size_t>(header.width) * header.height * header.channels;
+  std::vector<float> pixels(n);
+  // The scales OpenImageIO converts with, so both decoders give the same floats.
+  if (header.bytes_per_sample == 1) {
+    const auto* s = static_cast<const std::uint8_t*>(samples->data.get());
+    for (std::size_t i = 0; i < n; ++i) pixels[i] = s[i] * (1.f / 255.f);
+  } else if (header.bytes_per_sample == 2) {
+    const auto* s = static_cast<const std::uint16_t*>(samples->data.get());
+    for (std::size_t i = 0; i < n; ++i) pixels[i] = s[i] * (1.f / 65535.f);
+  } else {
+    const auto* s = static_cast<const float*>(samples->data.get());
+    std::copy(s, s + n, pixels.begin());
+  }
   return pixels;
 }
 
@@ -138,6 +264,11 @@ Status WriteImage(const std::filesystem::path& path, int width, int height, int 
   const std::string format = LowerExtension(path);
   if (format.empty()) {
     return Status::BadInput("{}: no extension to choose an image format by", path.string());
+  }
+  if (format == "png") {
+    std::vector<std::uint8_t> png = stb::EncodePng(width, height, channels, pixels.data());
+    if (png.empty()) return Status::Internal("{}: cannot encode the image", path.string());
+    return WriteFileAtomic(path, png);
   }
   const Plugin& plugin = LoadPlugin();
   if (!plugin.decode) return plugin.error.WithContext(path.string());

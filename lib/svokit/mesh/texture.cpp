@@ -27,32 +27,100 @@ StatusOr<Texture::Info> Texture::ReadInfo() const {
   return Info{h->width, h->height, h->channels, h->format};
 }
 
+namespace {
+
+// Linear-light value of each 8-bit code: v/255 as OpenImageIO converts it, then the sRGB curve.
+struct SrgbTable {
+  float linear[256];
+  SrgbTable() {
+    for (int v = 0; v < 256; ++v) linear[v] = SrgbToLinear(static_cast<float>(v) * (1.f / 255.f));
+  }
+};
+
+// Samples of one type as linear RGBA, `shrink` times downsampled; `to_linear(sample, channel)`
+// gives a colour or alpha channel's linear value.
+template <class Sample, class ToLinear>
+Image ToLinearRgba(const Sample* samples, int width, int height, int channels, int shrink,
+                   const ToLinear& to_linear) {
+  Image img;
+  const int step = 1 << shrink;
+  img.width = (width + step - 1) / step;
+  img.height = (height + step - 1) / step;
+  img.rgba.resize(static_cast<std::size_t>(img.width) * img.height * 4);
+  // Grey, grey+alpha, RGB and RGBA all become RGBA; alpha is never sRGB-encoded.
+  const auto texel = [&](std::size_t i, float c[4]) {
+    const Sample* src = samples + i * channels;
+    c[0] = c[1] = c[2] = to_linear(src[0], 0);
+    c[3] = 1.f;
+    if (channels == 2) c[3] = to_linear(src[1], 3);
+    if (channels >= 3) c[1] = to_linear(src[1], 1), c[2] = to_linear(src[2], 2);
+    if (channels >= 4) c[3] = to_linear(src[3], 3);
+  };
+  if (shrink == 0) {
+    const std::size_t n = static_cast<std::size_t>(width) * height;
+    for (std::size_t i = 0; i < n; ++i) texel(i, &img.rgba[i * 4]);
+    return img;
+  }
+  std::vector<double> sum(static_cast<std::size_t>(img.width) * 4);
+  for (int oy = 0; oy < img.height; ++oy) {
+    std::fill(sum.begin(), sum.end(), 0.0);
+    const int y0 = oy * step, y1 = std::min(y0 + step, height);
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < width; ++x) {
+        float c[4];
+        texel(static_cast<std::size_t>(y) * width + x, c);
+        double* s = &sum[static_cast<std::size_t>(x / step) * 4];
+        for (int k = 0; k < 4; ++k) s[k] += c[k];
+      }
+    }
+    for (int ox = 0; ox < img.width; ++ox) {
+      const int count = (std::min(ox * step + step, width) - ox * step) * (y1 - y0);
+      for (int k = 0; k < 4; ++k) {
+        img.rgba[(static_cast<std::size_t>(oy) * img.width + ox) * 4 + k] =
+            static_cast<float>(sum[static_cast<std::size_t>(ox) * 4 + k] / count);
+      }
+    }
+  }
+  return img;
+}
+
+}  // namespace
+
+StatusOr<Image> Texture::Decode(int shrink) const {
+  StatusOr<ImageSamples> decoded = DecodeImageSamples(name_, encoded_);
+  if (!decoded.ok()) return decoded.status();
+  const ImageHeader& h = decoded->header;
+  const bool srgb = srgb_ && !h.is_float;
+  const int w = h.width, ht = h.height, nc = h.channels;
+  shrink = std::clamp(shrink, 0, 30);
+  if (h.bytes_per_sample == 1) {
+    static const SrgbTable table;
+    const auto* s = static_cast<const std::uint8_t*>(decoded->data.get());
+    return ToLinearRgba(s, w, ht, nc, shrink, [&](std::uint8_t v, int channel) {
+      return srgb && channel < 3 ? table.linear[v] : static_cast<float>(v) * (1.f / 255.f);
+    });
+  }
+  if (h.bytes_per_sample == 2) {
+    const auto* s = static_cast<const std::uint16_t*>(decoded->data.get());
+    return ToLinearRgba(s, w, ht, nc, shrink, [&](std::uint16_t v, int channel) {
+      const float f = static_cast<float>(v) * (1.f / 65535.f);
+      return srgb && channel < 3 ? SrgbToLinear(f) : f;
+    });
+  }
+  const auto* s = static_cast<const float*>(decoded->data.get());
+  return ToLinearRgba(s, w, ht, nc, shrink, [&](float v, int channel) {
+    return srgb && channel < 3 ? SrgbToLinear(v) : v;
+  });
+}
+
 StatusOr<const Image*> Texture::Decoded() const {
   if (!cache_) return Status::BadInput("texture '{}' has no data", name_);
   std::call_once(cache_->once, [this] {
-    ImageHeader header;
-    StatusOr<std::vector<float>> decoded = DecodeImagePixels(name_, encoded_, header);
-    if (!decoded.ok()) {
-      cache_->status = decoded.status();
-      return;
-    }
-    const std::vector<float>& pixels = *decoded;
-    const int nc = header.channels;
-    Image& img = cache_->image;
-    img.width = header.width;
-    img.height = header.height;
-    img.rgba.resize(static_cast<std::size_t>(img.width) * img.height * 4);
-    // Grey, grey+alpha, RGB and RGBA all become linear RGBA; alpha is never sRGB-encoded.
-    const bool decode_srgb = srgb_ && !header.is_float;
-    const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
-    for (std::size_t i = 0; i < n; ++i) {
-      const float* src = &pixels[i * nc];
-      float c[4] = {src[0], src[0], src[0], 1.f};
-      if (nc == 2) c[3] = src[1];
-      if (nc >= 3) c[1] = src[1], c[2] = src[2];
-      if (nc >= 4) c[3] = src[3];
-      for (int k = 0; k < 3; ++k) img.rgba[i * 4 + k] = decode_srgb ? SrgbToLinear(c[k]) : c[k];
-      img.rgba[i * 4 + 3] = c[3];
+    StatusOr<Image> image = Decode();
+    if (image.ok()) {
+      cache_->image = std::move(image).value();
+    } else {
+      cache_->status = image.status();
     }
   });
   if (!cache_->status.ok()) return cache_->status;
@@ -77,6 +145,13 @@ void AttachTextureFile(const std::filesystem::path& base_dir, const std::string&
                                   material.name, uri)
                     : fmt::format("material '{}': texture '{}' {}, using base colour",
                                   material.name, uri, why));
+    return;
+  }
+  // Bytes that are not an image svokit reads are never stored (they may be any file at all).
+  if (StatusOr<ImageHeader> header = ReadImageHeader(uri, *bytes); !header.ok()) {
+    material.missing_texture = uri;
+    mesh.warnings.push_back(fmt::format("material '{}': {}; using base colour", material.name,
+                                        header.status().message()));
     return;
   }
   // Several materials often share one image: embed it once.

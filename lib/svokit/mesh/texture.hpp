@@ -1,7 +1,7 @@
 #pragma once
-// Textures are kept as their original encoded bytes (PNG, JPEG, TGA, EXR, ...) and decoded lazily,
-// once, through OpenImageIO: importing never pays for images nobody samples, and a normalized mesh
-// file embeds the exact source bytes.
+// Textures are kept as their original encoded bytes (PNG, JPEG, TGA, EXR, ...) and decoded lazily
+// (image_codec.hpp): importing never pays for images nobody samples, and a normalized mesh file
+// embeds the exact source bytes.
 
 #include <cstdint>
 #include <memory>
@@ -45,6 +45,11 @@ class Texture {
 
   /// Decodes on first use (thread-safe; later calls return the cached image or error).
   StatusOr<const Image*> Decoded() const;
+
+  /// Decodes without caching, `shrink` times downsampled by 2 × 2 (a box filter in linear light
+  /// over each block of 2^shrink × 2^shrink texels; blocks at the right and bottom edges average
+  /// the texels they have).
+  StatusOr<Image> Decode(int shrink = 0) const;
 
  private:
   struct Cache;

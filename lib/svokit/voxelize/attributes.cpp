@@ -6,6 +6,7 @@
 
 #include "svokit/core/parallel.hpp"
 #include "svokit/core/polygon_clip.hpp"
+#include "svokit/mesh/texture_budget.hpp"
 
 namespace svokit {
 
@@ -126,17 +127,16 @@ AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoin
   for (std::size_t t = 0; t < texture_used.size(); ++t) {
     if (texture_used[t]) used.push_back(t);
   }
+  // All the textures within one memory budget, decided in texture order (mesh/texture_budget.hpp).
+  BudgetedTextures decoded = DecodeTexturesWithinBudget(mesh.textures, used);
+  images_ = std::move(decoded.images);
+  std::vector<Status>& errors = decoded.errors;
+  warnings_.insert(warnings_.end(), decoded.warnings.begin(), decoded.warnings.end());
   textures_.resize(mesh.textures.size());
-  std::vector<Status> errors(mesh.textures.size());
   ParallelChunks(used.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::size_t t = used[i];
-      StatusOr<const Image*> image = mesh.textures[t].Decoded();
-      if (image.ok()) {
-        textures_[t] = TextureSampler(**image);
-      } else {
-        errors[t] = image.status();
-      }
+      if (errors[t].ok()) textures_[t] = TextureSampler(images_[t]);
     }
   });
   for (std::size_t t : used) {

@@ -182,6 +182,7 @@ class AttributeSampler {
   const std::vector<FixedPoint3>& vertices_;
   bool want_color_;
   bool want_normal_;
+  std::vector<Image> images_;             // per Mesh::textures entry, as the budget decoded them
   std::vector<TextureSampler> textures_;  // per Mesh::textures entry; invalid when unused/failed
   std::vector<MaterialInfo> materials_;   // per Mesh::materials entry
   std::vector<std::string> warnings_;
