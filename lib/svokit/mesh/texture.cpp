@@ -61,17 +61,23 @@ StatusOr<const Image*> Texture::Decoded() const {
 
 namespace detail {
 
-void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
-                       Material& material, Mesh& mesh) {
-  // Windows exporters write "textures\\wood.jpg"; on POSIX that is one odd file name.
-  std::string portable = uri;
-  std::replace(portable.begin(), portable.end(), '\\', '/');
-  std::filesystem::path file = portable;
-  if (file.is_relative()) file = base_dir / file;
-  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file, kSideFileLimit);
+void AttachTextureFile(const SideFileRule& rule, const std::filesystem::path& folder,
+                       const std::string& reference, SideFileSyntax syntax, Material& material,
+                       Mesh& mesh) {
+  // glTF names its images by URI: the name kept is the decoded one ("my tex.png").
+  const std::string uri = syntax == SideFileSyntax::kUri ? PercentDecode(reference) : reference;
+  StatusOr<std::filesystem::path> file = rule.Resolve(reference, syntax, folder);
+  if (!file.ok()) {
+    material.missing_texture = uri;
+    mesh.warnings.push_back(
+        fmt::format("material '{}': texture '{}' {}: not read, using base colour", material.name,
+                    uri, file.status().message()));
+    return;
+  }
+  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(*file, kSideFileLimit);
   if (!bytes.ok() || bytes->empty()) {
     material.missing_texture = uri;
-    const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), file);
+    const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), *file);
     mesh.warnings.push_back(
         why.empty() ? fmt::format("material '{}': texture '{}' not found, using base colour",
                                   material.name, uri)
@@ -79,6 +85,7 @@ void AttachTextureFile(const std::filesystem::path& base_dir, const std::string&
                                   material.name, uri, why));
     return;
   }
+  mesh.side_files.push_back(*file);
   // Several materials often share one image: embed it once.
   for (std::size_t i = 0; i < mesh.textures.size(); ++i) {
     if (mesh.textures[i].name() == uri && mesh.textures[i].encoded() == *bytes) {
