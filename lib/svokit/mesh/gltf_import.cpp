@@ -182,6 +182,36 @@ Status CheckExternalBuffers(const nlohmann::json& doc, const SideFileRule& rule,
   return Status::Ok();
 }
 
+// A sparse count is read by tinygltf into an int: 2^40 would silently become 0. Each must be a
+// whole number no larger than its accessor's count (nor an int), checked before anything is
+// sized by it.
+Status CheckSparseCounts(const nlohmann::json& doc) {
+  constexpr auto kMaxSparseCount = static_cast<std::uint64_t>(std::numeric_limits<int>::max());
+  const auto accessors = doc.find("accessors");
+  if (accessors == doc.end() || !accessors->is_array()) return Status::Ok();
+  for (std::size_t i = 0; i < accessors->size(); ++i) {
+    const nlohmann::json& accessor = (*accessors)[i];
+    if (!accessor.is_object() || !accessor.contains("sparse")) continue;
+    const nlohmann::json& sparse = accessor["sparse"];
+    // A sparse object without a count is left to tinygltf, which says what is missing.
+    if (!sparse.is_object() || !sparse.contains("count")) continue;
+    const nlohmann::json& count = sparse["count"];
+    const auto elements = accessor.find("count");
+    const std::uint64_t accessor_count =
+        elements != accessor.end() && elements->is_number_unsigned()
+            ? elements->get<std::uint64_t>()
+            : 0;
+    if (!count.is_number_unsigned()) {
+      return Status::BadInput("accessor {} has sparse count {}, not a count", i, count.dump());
+    }
+    if (count.get<std::uint64_t>() > std::min(accessor_count, kMaxSparseCount)) {
+      return Status::BadInput("accessor {} has sparse count {} for {} elements", i,
+                              count.get<std::uint64_t>(), accessor_count);
+    }
+  }
+  return Status::Ok();
+}
+
 // tinygltf's file reader for external buffers. Its own reads a whole file and only then compares
 // the size with byteLength, so a short glTF naming a huge file would read all of it; this reads
 // the declared bytes and no more, and refuses a file that is not regular or shorter than declared.
@@ -278,8 +308,8 @@ bool DropDracoIndices(nlohmann::json& doc) {
 }
 
 // Looks at the JSON before tinygltf does (JsonDepth, CheckVersion, CheckExternalBuffers,
-// CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if it had to change.
-// JSON that does not parse is left to tinygltf, whose message says where.
+// CheckSparseCounts, CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if
+// it had to change. JSON that does not parse is left to tinygltf, whose message says where.
 StatusOr<std::optional<std::string>> Preflight(std::string_view text, const SideFileRule& rule,
                                                std::vector<ExternalBuffer>& buffers) {
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
@@ -289,6 +319,7 @@ StatusOr<std::optional<std::string>> Preflight(std::string_view text, const Side
   }
   SVOKIT_RETURN_IF_ERROR(CheckVersion(doc));
   SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, rule, buffers));
+  SVOKIT_RETURN_IF_ERROR(CheckSparseCounts(doc));
   SVOKIT_RETURN_IF_ERROR(CheckImageViews(doc));
   if (!DropDracoIndices(doc)) return std::optional<std::string>();
   return std::optional<std::string>(doc.dump());
