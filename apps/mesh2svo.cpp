@@ -5,6 +5,7 @@
 
 #include "apps/chain_options.hpp"
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/parallel.hpp"
@@ -15,12 +16,13 @@ namespace {
 using namespace svokit;
 
 void PrintSummary(const MeshToSvoRequest& request, const MeshToSvoReport& report,
-                  const std::string& mode, const Progress& progress) {
+                  const std::string& mode, const Progress& progress, std::size_t warnings) {
   const std::string output = request.output.string();
   if (report.part) {
     fmt::print("part        {} of {}: {} pages ({} cubes), {} voxels\n", request.part->part,
                request.part->parts, report.part->pages, report.part->cells, report.part->voxels);
     app::PrintTimes(progress);
+    fmt::print("warnings    {}\n", warnings);
     fmt::print("output      {}\n", output);
     return;
   }
@@ -31,6 +33,7 @@ void PrintSummary(const MeshToSvoRequest& request, const MeshToSvoReport& report
   if (octree.interior) app::PrintInterior(*octree.interior);
   app::PrintOctreeSummary(octree);
   app::PrintTimes(progress);
+  fmt::print("warnings    {}\n", warnings);
   fmt::print("output      {} ({} bytes)\n", output, octree.file.file_bytes);
 }
 
@@ -47,6 +50,7 @@ int main(int argc, char** argv) {
   app::BuildCli build;
   app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
+  app::ImportCli import;
   std::string pages;
   app::AddFile(cli, "input", request.input,
                "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
@@ -62,6 +66,7 @@ int main(int argc, char** argv) {
                  "Build part K of N (0-based) of a build by pages into OUT.svopart, as one job of "
                  "many; svo-merge joins the parts into the .svo")
       ->option_text("K/N");
+  import.Add(cli);
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, request.input, [&] {
@@ -85,12 +90,14 @@ int main(int argc, char** argv) {
     request.voxelize = *voxels;
     request.build = *settings;
     request.memory_limit = *limit;
-    request.warn = [&](const std::string& w) { app::Warn(tool, {w}); };
+    request.warn = import.Sink(tool);
+    request.import = import.options;
+    request.strict = import.strict;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<MeshToSvoReport> report = MeshToSvo(request, progress);
     if (!report.ok()) return fail(report.status());
-    PrintSummary(request, *report, voxelize.ModeName(), progress);
+    PrintSummary(request, *report, voxelize.ModeName(), progress, import.warnings);
     return 0;
   });
 }

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/bake/bake_svo.hpp"
@@ -113,7 +114,8 @@ struct BakeCli {
   }
 };
 
-void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress& progress) {
+void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress& progress,
+                  std::size_t warnings) {
   const AoBakeRequest& r = cli.request;
   const ConeOptions& c = report.cones;
   fmt::print("octree      {} (depth {}, {} voxels)\n", r.input.string(), report.depth,
@@ -145,6 +147,7 @@ void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress
                report.texels->mean_ao);
   }
   app::PrintTimes(progress);
+  if (!r.mesh.empty()) fmt::print("warnings    {}\n", warnings);
 }
 
 }  // namespace
@@ -158,16 +161,21 @@ int main(int argc, char** argv) {
       tool};
   BakeCli bake;
   app::CommonOptions common;
+  app::ImportCli import;
   bake.Add(cli);
+  import.Add(cli);
   app::AddCommonOptions(cli, common,
                         "svo-bake bunny.svo --ao --mesh bunny.obj --vertex-out ao.ply");
   return app::Run(tool, cli, argc, argv, bake.request.input, [&] {
     if (Status s = bake.Check(); !s.ok()) return app::Fail(tool, s);
+    bake.request.import = import.options;
+    bake.request.warn = import.Sink(tool);
+    bake.request.strict = import.strict;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<AoBakeReport> report = BakeSvoAo(bake.request, progress);
     if (!report.ok()) return app::Fail(tool, report.status());
-    PrintSummary(bake, *report, progress);
+    PrintSummary(bake, *report, progress, import.warnings);
     return 0;
   });
 }

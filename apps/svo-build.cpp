@@ -5,6 +5,7 @@
 
 #include "apps/chain_options.hpp"
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/parallel.hpp"
@@ -15,7 +16,7 @@ namespace {
 using namespace svokit;
 
 void PrintSummary(const VoxelsToSvoRequest& request, const OctreeReport& octree,
-                  const std::string& bricks, const Progress& progress) {
+                  const std::string& bricks, const Progress& progress, std::size_t warnings) {
   fmt::print("input       {} ({} voxels)\n", request.input.string(), octree.voxels);
   if (octree.interior) app::PrintInterior(*octree.interior);
   fmt::print("octree      depth {}, bricks {}, contours {}{}\n", octree.depth, bricks,
@@ -23,6 +24,7 @@ void PrintSummary(const VoxelsToSvoRequest& request, const OctreeReport& octree,
              octree.memory.by_pages() ? ", by pages " + octree.memory.WithinText() : "");
   app::PrintOctreeSummary(octree);
   if (octree.memory.by_pages()) app::PrintTimes(progress);
+  if (!request.mesh.empty()) fmt::print("warnings    {}\n", warnings);
   fmt::print("output      {} ({} bytes)\n", request.output.string(), octree.file.file_bytes);
 }
 
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
   app::BuildCli build;
   app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
+  app::ImportCli import;
   app::AddFile(cli, "input", request.input, "Voxel fragment list (.vfrag from svo-voxelize)")
       ->required();
   app::AddFile(cli, "-o,--output", request.output, "Output .svo")->required();
@@ -49,6 +52,7 @@ int main(int argc, char** argv) {
                    "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
                    "(K, M, G suffixes), reading the .vfrag a page at a time: any size, the same "
                    "file");
+  import.Add(cli);
   app::AddCommonOptions(cli, common, "svo-build bunny.vfrag --mesh bunny.svm -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, request.input, [&] {
@@ -65,11 +69,14 @@ int main(int argc, char** argv) {
     }
     request.build = *settings;
     request.memory_limit = *limit;
+    request.warn = import.Sink(tool);
+    request.import = import.options;
+    request.strict = import.strict;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<OctreeReport> octree = VoxelsToSvo(request, progress);
     if (!octree.ok()) return fail(octree.status());
-    PrintSummary(request, *octree, build.bricks, progress);
+    PrintSummary(request, *octree, build.bricks, progress, import.warnings);
     return 0;
   });
 }

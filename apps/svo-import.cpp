@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
@@ -22,11 +23,13 @@ int main(int argc, char** argv) {
   bool json = false;
   ReportOptions report_options;
   app::CommonOptions common;
+  app::ImportCli import;
   app::AddFile(cli, "input", input, "Mesh file")->required();
   app::AddFile(cli, "-o,--output", output, "Normalized mesh to write (.svm)");
   cli.add_flag("--json", json, "Print the report as JSON (stable keys, see README)");
   cli.add_flag("--self-intersections", report_options.self_intersections,
                "Also count self-intersecting triangle pairs (exact, slower)");
+  import.Add(cli);
   app::AddCommonOptions(cli, common, "svo-import bunny.obj -o bunny.svm");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -36,8 +39,18 @@ int main(int argc, char** argv) {
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
 
-    StatusOr<Mesh> mesh = ImportStage(progress, input);
+    StatusOr<Mesh> mesh = ImportStage(progress, input, import.options);
     if (!mesh.ok()) return app::Fail(tool, mesh.status());
+    const auto warn = import.Sink(tool);
+    for (const std::string& w : mesh->warnings) warn(fmt::format("{}: {}", input.string(), w));
+    if (import.strict && !mesh->warnings.empty()) {
+      return app::Fail(
+          tool, Status::BadInput("{}: {} warning{} and --strict: nothing written", input.string(),
+                                 mesh->warnings.size(), mesh->warnings.size() == 1 ? "" : "s"));
+    }
+    if (!output.empty()) {
+      if (Status s = CheckNotAnInput(output, mesh->side_files); !s.ok()) return app::Fail(tool, s);
+    }
 
     const MeshReport report = AnalyzeMesh(*mesh, input.string(), report_options, progress);
     if (!output.empty()) {

@@ -4,7 +4,10 @@
 
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
@@ -24,11 +27,13 @@ int main(int argc, char** argv) {
   std::filesystem::path input, mesh_path;
   bool json = false;
   app::CommonOptions common;
+  app::ImportCli import;
   app::AddFile(cli, "input", input, "Octree (.svo)")->required();
   app::AddFile(cli, "--mesh", mesh_path,
                "The mesh the octree was built from (.svm or any mesh file): enables the "
                "occupancy and contour-surface checks");
   cli.add_flag("--json", json, "Print the report as one JSON object");
+  import.Add(cli);
   app::AddCommonOptions(cli, common, "svo-validate bunny.svo --mesh bunny.svm");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -39,16 +44,32 @@ int main(int argc, char** argv) {
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
       // A damaged grid cannot vouch for or against the mesh: the checks will say what they can.
-      StatusOr<Mesh> m = file->complete ? ImportSourceMesh(progress, mesh_path, file->svo.grid,
-                                                           input, "the octree was built from")
-                                        : ImportStage(progress, mesh_path);
+      StatusOr<Mesh> m = file->complete
+                             ? ImportSourceMesh(progress, mesh_path, file->svo.grid, input,
+                                                "the octree was built from", import.options)
+                             : ImportStage(progress, mesh_path, import.options);
       if (!m.ok()) return app::Fail(tool, m.status());
+      const auto warn = import.Sink(tool);
+      for (const std::string& w : m->warnings) warn(fmt::format("{}: {}", mesh_path.string(), w));
+      if (import.strict && !m->warnings.empty()) {
+        return app::Fail(tool,
+                         Status::BadInput("{}: {} warning{} and --strict", mesh_path.string(),
+                                          m->warnings.size(), m->warnings.size() == 1 ? "" : "s"));
+      }
       mesh = std::move(*m);
     }
     validate::ValidateOptions options;
     options.mesh = mesh ? &*mesh : nullptr;
     const validate::Report report = validate::Validate(*file, input.string(), options, progress);
-    fmt::print("{}", json ? report.Json() : report.Text());
+    if (json) {
+      // The mesh's import warnings belong to the run, not to the octree's report.
+      nlohmann::ordered_json j = nlohmann::ordered_json::parse(report.Json());
+      if (mesh) j["warnings"] = import.warnings;
+      fmt::print("{}\n", j.dump(2));
+    } else {
+      fmt::print("{}", report.Text());
+      if (mesh) fmt::print("warnings    {} (mesh import)\n", import.warnings);
+    }
     return report.ok() ? 0 : static_cast<int>(StatusCode::kCheckFailed);
   });
 }

@@ -5,6 +5,7 @@
 
 #include "apps/chain_options.hpp"
 #include "apps/cli.hpp"
+#include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
@@ -16,13 +17,14 @@ namespace {
 using namespace svokit;
 
 void PrintSummary(const MeshToVoxelsRequest& request, const MeshToVoxelsReport& report,
-                  const std::string& mode) {
+                  const std::string& mode, std::size_t warnings) {
   app::PrintMeshAndGrid(request.input.string(), report.triangles, report.grid, false);
   if (report.memory.by_pages()) {
     fmt::print("voxelize    by cubes {}\n", report.memory.WithinText());
   }
   fmt::print("voxels      {} ({})\n", report.voxels, mode);
   if (report.interior) app::PrintInterior(*report.interior);
+  fmt::print("warnings    {}\n", warnings);
   fmt::print("output      {}\n", request.output.string());
 }
 
@@ -58,6 +60,7 @@ int main(int argc, char** argv) {
   app::VoxelizeCli voxelize;
   app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
+  app::ImportCli import;
   app::AddFile(cli, "input", request.input, "Mesh (.svm from svo-import, or any mesh file)")
       ->required();
   app::AddFile(cli, "-o,--output", request.output, "Output: .vfrag, .xyz or .ply")->required();
@@ -65,6 +68,7 @@ int main(int argc, char** argv) {
   memory_limit.Add(cli,
                    "Voxelize one 128³-voxel cube at a time within SIZE bytes besides the mesh (K, "
                    "M, G suffixes), streaming the .vfrag: any resolution, the same file");
+  import.Add(cli);
   app::AddCommonOptions(cli, common, "svo-voxelize bunny.svm -r 1024 -o bunny.vfrag");
 
   return app::Run(tool, cli, argc, argv, request.input, [&] {
@@ -76,12 +80,14 @@ int main(int argc, char** argv) {
     StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
     if (!limit.ok()) return fail(limit.status());
     request.memory_limit = *limit;
-    request.warn = [&](const std::string& w) { app::Warn(tool, {w}); };
+    request.warn = import.Sink(tool);
+    request.import = import.options;
+    request.strict = import.strict;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<MeshToVoxelsReport> report = MeshToVoxels(request, progress);
     if (!report.ok()) return fail(report.status());
-    PrintSummary(request, *report, voxelize.ModeName());
+    PrintSummary(request, *report, voxelize.ModeName(), import.warnings);
     return 0;
   });
 }

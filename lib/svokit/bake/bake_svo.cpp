@@ -14,21 +14,51 @@ namespace svokit {
 
 namespace {
 
-Status CheckOutputs(const AoBakeRequest& r) {
-  const std::pair<const std::filesystem::path*, std::vector<std::string>> outputs[] = {
-      {&r.output, {"svo"}},
-      {&r.vertex_out, {"ply"}},
-      {&r.texture_out, {"png", "tif", "tiff", "exr", "tga"}}};
-  for (const auto& [path, extensions] : outputs) {
-    if (!path->empty()) SVOKIT_RETURN_IF_ERROR(CheckOutputPath(*path, extensions, r.input));
+// The outputs asked for, each with the extensions it may have.
+std::vector<std::pair<const std::filesystem::path*, std::vector<std::string>>> OutputsOf(
+    const AoBakeRequest& r) {
+  return {{&r.output, {"svo"}},
+          {&r.vertex_out, {"ply"}},
+          {&r.texture_out, {"png", "tif", "tiff", "exr", "tga"}}};
+}
+
+// No output may be an input (the octree, the mesh, `side_files` its import read) or another
+// output: each would be replaced by what is baked from it.
+Status CheckOutputs(const AoBakeRequest& r, const std::vector<std::filesystem::path>& side_files) {
+  std::vector<std::filesystem::path> inputs = {r.mesh};
+  inputs.insert(inputs.end(), side_files.begin(), side_files.end());
+  std::vector<std::filesystem::path> earlier;
+  for (const auto& [path, extensions] : OutputsOf(r)) {
+    if (path->empty()) continue;
+    SVOKIT_RETURN_IF_ERROR(CheckOutputPath(*path, extensions, r.input));
+    SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(*path, inputs));
+    for (const std::filesystem::path& other : earlier) {
+      std::error_code ec, other_ec;
+      const std::filesystem::path canonical = std::filesystem::weakly_canonical(*path, ec);
+      if (*path == other ||
+          (!ec && canonical == std::filesystem::weakly_canonical(other, other_ec) && !other_ec)) {
+        return Status::BadInput("{}: is given for two outputs; write each elsewhere",
+                                path->string());
+      }
+    }
+    earlier.push_back(*path);
   }
   return Status::Ok();
 }
 
-// The mesh the outputs on it are baked at, checked to be the octree's.
+// The mesh the outputs on it are baked at, checked to be the octree's; its warnings reported
+// and its side files checked against the outputs before anything is written.
 StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const Svo& svo, Progress& progress) {
-  StatusOr<Mesh> mesh = ImportStage(progress, r.mesh);
+  StatusOr<Mesh> mesh = ImportStage(progress, r.mesh, r.import);
   if (!mesh.ok()) return mesh.status();
+  if (r.warn) {
+    for (const std::string& w : mesh->warnings) r.warn(fmt::format("{}: {}", r.mesh.string(), w));
+  }
+  if (r.strict && !mesh->warnings.empty()) {
+    return Status::BadInput("{}: {} warning{} and --strict: nothing written", r.mesh.string(),
+                            mesh->warnings.size(), mesh->warnings.size() == 1 ? "" : "s");
+  }
+  SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, mesh->side_files));
   SVOKIT_RETURN_IF_ERROR(CheckMeshMatchesOctree(*mesh, svo, r.mesh.string()));
   if (!r.texture_out.empty() && !mesh->has_uvs()) {
     return Status::BadInput("{}: the mesh has no texture coordinates for the texture",
@@ -139,7 +169,7 @@ StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
       return Status::BadInput("{} rays per point: must be 1 to {}", *rays, kMaxAoRays);
     }
   }
-  SVOKIT_RETURN_IF_ERROR(CheckOutputs(r));
+  SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, {}));
   StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt);
   if (!svo.ok()) return svo.status();
   AoBakeReport report;

@@ -5,12 +5,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
+#include <string>
 
 #include "svokit/bake/ao_bake.hpp"
 #include "svokit/bake/cone_tracer.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/mesh/side_files.hpp"
 
 namespace svokit {
 
@@ -26,6 +29,10 @@ struct AoBakeRequest {
   /// (Embree on the mesh: the reference).
   std::optional<std::uint32_t> rays;
   std::optional<std::uint32_t> reference;  ///< also the vertices' error against this many rays
+  ImportOptions import;                    ///< where the mesh's side files may be read from
+  /// Receives each of the mesh's import warnings, as "MESH: warning".
+  std::function<void(const std::string&)> warn;
+  bool strict = false;  ///< any warning is an error: nothing is written
 };
 
 /// The most rays per point of `rays` and `reference`: Monte Carlo noise 1/256 of one ray's, while
@@ -53,7 +60,8 @@ struct AoBakeReport {
 
 /// Reads the octree, imports the mesh (checked to be the one the octree was made from), bakes
 /// and writes every output asked for. Outputs and ray counts (1 to kMaxAoRays) are checked before
-/// any work.
+/// any work; an output is refused when it is an input: the octree, the mesh, a side file its
+/// import read, or another output.
 StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& request,
                                  Progress& progress = Progress::Silent());
 

@@ -14,22 +14,26 @@
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/mesh/side_files.hpp"
 
 namespace svokit {
 
 /// Extensions ImportMesh accepts, lower case without the dot.
 const std::vector<std::string>& SupportedMeshExtensions();
 
-/// Reads, triangulates and validates a mesh. Every error message starts with the file name.
-StatusOr<Mesh> ImportMesh(const std::filesystem::path& path);
+/// Reads, triangulates and validates a mesh; its side files (textures, material libraries,
+/// buffers) are read as `options` allow (side_files.hpp). Every error message starts with the
+/// file name. A .svm's materials whose texture was missing when it was made warn again.
+StatusOr<Mesh> ImportMesh(const std::filesystem::path& path, const ImportOptions& options = {});
 
 /// ImportMesh as the "import" stage of `progress`, its line giving the triangle count.
-StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path);
+StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path,
+                           const ImportOptions& options = {});
 
 /// The same for the mesh `input` was made from (`made` says how, for the message): a mesh
 /// reaching outside `grid` cannot be that mesh and is bad input.
 StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path& mesh_path,
                                 const GridTransform& grid, const std::filesystem::path& input,
-                                std::string_view made);
+                                std::string_view made, const ImportOptions& options = {});
 
 }  // namespace svokit

@@ -72,22 +72,6 @@ std::string OneLine(std::string_view text) {
   return out;
 }
 
-// glTF URIs are percent-encoded ("my%20texture.png").
-std::string PercentDecode(const std::string& uri) {
-  std::string out;
-  for (std::size_t i = 0; i < uri.size(); ++i) {
-    if (uri[i] == '%' && i + 2 < uri.size() &&
-        std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
-        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
-      out += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-      i += 2;
-    } else {
-      out += uri[i];
-    }
-  }
-  return out;
-}
-
 // tinygltf hands data-URI images to this callback; they stay encoded and OIIO decodes them lazily.
 // For buffer-view images it passes an unchecked pointer into the buffer, so those are ignored here
 // and read later through the bounds-checked ViewBytes.
@@ -162,25 +146,69 @@ std::size_t JsonDepth(const nlohmann::json& doc) {
   return deepest;
 }
 
-// External buffers are looked up here first: tinygltf would also search the working directory,
-// and its message does not say which buffer is missing. Their declared byteLengths go to
-// `declared`, in order: tinygltf reads them in that order, and BufferReader reads only that much.
-Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::path& base_dir,
-                            std::vector<std::uint64_t>& declared) {
+// An external buffer: the file the side-file rule resolved its URI to, and its declared length.
+struct ExternalBuffer {
+  std::filesystem::path file;
+  std::uint64_t declared = 0;
+};
+
+// External buffers are resolved here first, by the side-file rule: a buffer outside the allowed
+// folders is an error (the mesh cannot be built without it), as is one that does not exist
+// (tinygltf would also search the working directory, and its message does not say which buffer
+// is missing). Their files and declared byteLengths go to `buffers`, in order: tinygltf reads
+// them in that order, and BufferReader reads those files and only that much.
+Status CheckExternalBuffers(const nlohmann::json& doc, const SideFileRule& rule,
+                            std::vector<ExternalBuffer>& external) {
   const auto buffers = doc.find("buffers");
   if (buffers == doc.end() || !buffers->is_array()) return Status::Ok();
   for (std::size_t i = 0; i < buffers->size(); ++i) {
     const nlohmann::json& buffer = (*buffers)[i];
     if (!buffer.is_object() || !buffer.contains("uri") || !buffer["uri"].is_string()) continue;
     const std::string uri = buffer["uri"];
-    if (uri.starts_with("data:")) continue;
+    if (tinygltf::IsDataURI(uri)) continue;
+    StatusOr<std::filesystem::path> file =
+        rule.Resolve(uri, SideFileSyntax::kUri, rule.model_folder());
+    if (!file.ok()) {
+      return Status::BadInput("buffer {} '{}' {}: not read", i, uri, file.status().message());
+    }
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(base_dir / PercentDecode(uri), ec)) {
+    if (!std::filesystem::is_regular_file(*file, ec)) {
       return Status::BadInput("buffer {} '{}' not found", i, uri);
     }
     const auto length = buffer.find("byteLength");
-    declared.push_back(
-        length != buffer.end() && length->is_number_unsigned() ? length->get<std::uint64_t>() : 0);
+    external.push_back({*file, length != buffer.end() && length->is_number_unsigned()
+                                   ? length->get<std::uint64_t>()
+                                   : 0});
+  }
+  return Status::Ok();
+}
+
+// A sparse count is read by tinygltf into an int: 2^40 would silently become 0. Each must be a
+// whole number no larger than its accessor's count (nor an int), checked before anything is
+// sized by it.
+Status CheckSparseCounts(const nlohmann::json& doc) {
+  constexpr auto kMaxSparseCount = static_cast<std::uint64_t>(std::numeric_limits<int>::max());
+  const auto accessors = doc.find("accessors");
+  if (accessors == doc.end() || !accessors->is_array()) return Status::Ok();
+  for (std::size_t i = 0; i < accessors->size(); ++i) {
+    const nlohmann::json& accessor = (*accessors)[i];
+    if (!accessor.is_object() || !accessor.contains("sparse")) continue;
+    const nlohmann::json& sparse = accessor["sparse"];
+    // A sparse object without a count is left to tinygltf, which says what is missing.
+    if (!sparse.is_object() || !sparse.contains("count")) continue;
+    const nlohmann::json& count = sparse["count"];
+    const auto elements = accessor.find("count");
+    const std::uint64_t accessor_count =
+        elements != accessor.end() && elements->is_number_unsigned()
+            ? elements->get<std::uint64_t>()
+            : 0;
+    if (!count.is_number_unsigned()) {
+      return Status::BadInput("accessor {} has sparse count {}, not a count", i, count.dump());
+    }
+    if (count.get<std::uint64_t>() > std::min(accessor_count, kMaxSparseCount)) {
+      return Status::BadInput("accessor {} has sparse count {} for {} elements", i,
+                              count.get<std::uint64_t>(), accessor_count);
+    }
   }
   return Status::Ok();
 }
@@ -189,29 +217,33 @@ Status CheckExternalBuffers(const nlohmann::json& doc, const std::filesystem::pa
 // the size with byteLength, so a short glTF naming a huge file would read all of it; this reads
 // the declared bytes and no more, and refuses a file that is not regular or shorter than declared.
 struct BufferReader {
-  std::vector<std::uint64_t> declared;  // per external buffer, in the order tinygltf reads them
+  std::vector<ExternalBuffer> buffers;  // in the order tinygltf reads them
   std::size_t next = 0;
+  std::vector<std::filesystem::path>* read = nullptr;  // the files read, for Mesh::side_files
 
-  // tinygltf's own check opens the file, which waits forever on a FIFO.
-  static bool Exists(const std::string& path, void* /*user_data*/) {
-    return ::access(path.c_str(), R_OK) == 0;
-  }
+  // Every external buffer was resolved and found before tinygltf runs: its own check opens the
+  // file, which waits forever on a FIFO, and it would search the working directory too.
+  static bool Exists(const std::string& /*path*/, void* /*user_data*/) { return true; }
 
   static bool Read(std::vector<unsigned char>* out, std::string* err, const std::string& path,
                    void* user_data) {
     auto* self = static_cast<BufferReader*>(user_data);
-    if (self->next >= self->declared.size()) {
+    if (self->next >= self->buffers.size()) {
       if (err) *err += "not a buffer this file declares";
       return false;
     }
+    const ExternalBuffer& buffer = self->buffers[self->next++];
     StatusOr<std::vector<std::uint8_t>> bytes =
-        ReadFilePrefix(path, self->declared[self->next++], kInputFileLimit);
+        ReadFilePrefix(buffer.file, buffer.declared, kInputFileLimit);
     if (!bytes.ok()) {
       std::string_view why = bytes.status().message();  // tinygltf names the file itself
+      const std::string prefix = buffer.file.string() + ": ";
+      if (why.starts_with(prefix)) why.remove_prefix(prefix.size());
       if (why.starts_with(path + ": ")) why.remove_prefix(path.size() + 2);
       if (err) *err += why;
       return false;
     }
+    if (self->read != nullptr) self->read->push_back(buffer.file);
     *out = std::move(bytes).value();
     return true;
   }
@@ -277,18 +309,18 @@ bool DropDracoIndices(nlohmann::json& doc) {
 }
 
 // Looks at the JSON before tinygltf does (JsonDepth, CheckVersion, CheckExternalBuffers,
-// CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if it had to change.
-// JSON that does not parse is left to tinygltf, whose message says where.
-StatusOr<std::optional<std::string>> Preflight(std::string_view text,
-                                               const std::filesystem::path& base_dir,
-                                               std::vector<std::uint64_t>& declared_buffers) {
+// CheckSparseCounts, CheckImageViews, DropDracoIndices) and returns the JSON to load instead, if
+// it had to change. JSON that does not parse is left to tinygltf, whose message says where.
+StatusOr<std::optional<std::string>> Preflight(std::string_view text, const SideFileRule& rule,
+                                               std::vector<ExternalBuffer>& buffers) {
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return std::optional<std::string>();
   if (JsonDepth(doc) > kMaxJsonDepth) {
     return Status::BadInput("JSON nested deeper than {} levels", kMaxJsonDepth);
   }
   SVOKIT_RETURN_IF_ERROR(CheckVersion(doc));
-  SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, base_dir, declared_buffers));
+  SVOKIT_RETURN_IF_ERROR(CheckExternalBuffers(doc, rule, buffers));
+  SVOKIT_RETURN_IF_ERROR(CheckSparseCounts(doc));
   SVOKIT_RETURN_IF_ERROR(CheckImageViews(doc));
   if (!DropDracoIndices(doc)) return std::optional<std::string>();
   return std::optional<std::string>(doc.dump());
@@ -313,16 +345,18 @@ std::vector<std::uint8_t> ReplaceJson(std::span<const std::uint8_t> file, bool b
   return out;
 }
 
-// Parses a .gltf or .glb; relative URIs resolve against `base_dir`. tinygltf's non-fatal findings
-// go to `warnings`.
+// Parses a .gltf or .glb; external buffers are the files `rule` allows. tinygltf's non-fatal
+// findings go to mesh.warnings, the buffers read to mesh.side_files.
 StatusOr<tinygltf::Model> LoadModel(std::vector<std::uint8_t> file, bool binary,
-                                    const std::filesystem::path& base_dir,
-                                    std::vector<std::string>& warnings) {
+                                    const SideFileRule& rule, Mesh& mesh) {
+  const std::filesystem::path& base_dir = rule.model_folder();
+  std::vector<std::string>& warnings = mesh.warnings;
   if (file.empty()) return Status::BadInput("empty file");
   StatusOr<std::string_view> json = JsonText(file, binary);
   if (!json.ok()) return json.status();
   BufferReader buffer_reader;
-  StatusOr<std::optional<std::string>> changed = Preflight(*json, base_dir, buffer_reader.declared);
+  buffer_reader.read = &mesh.side_files;
+  StatusOr<std::optional<std::string>> changed = Preflight(*json, rule, buffer_reader.buffers);
   if (!changed.ok()) return changed.status();
   if (*changed) file = ReplaceJson(file, binary, std::move(**changed));
   if (file.size() > std::numeric_limits<std::uint32_t>::max()) {
@@ -931,11 +965,8 @@ std::string ImageExtension(const std::string& mime, std::span<const std::uint8_t
 
 class GltfImporter {
  public:
-  GltfImporter(const tinygltf::Model& model, std::filesystem::path base_dir, Mesh& mesh)
-      : model_(model),
-        base_dir_(std::move(base_dir)),
-        mesh_(mesh),
-        material_slots_(model.materials.size()) {}
+  GltfImporter(const tinygltf::Model& model, const SideFileRule& rule, Mesh& mesh)
+      : model_(model), rule_(rule), mesh_(mesh), material_slots_(model.materials.size()) {}
 
   Status Run() {
     SVOKIT_RETURN_IF_ERROR(CheckRequiredExtensions());
@@ -1212,7 +1243,8 @@ class GltfImporter {
     }
     const tinygltf::Image& image = model_.images[source];
     if (!image.uri.empty()) {
-      AttachTextureFile(base_dir_, PercentDecode(image.uri), material, mesh_);
+      AttachTextureFile(rule_, rule_.model_folder(), image.uri, SideFileSyntax::kUri, material,
+                        mesh_);
     } else {
       std::span<const std::uint8_t> bytes(image.image);
       if (image.bufferView >= 0) {
@@ -1237,7 +1269,7 @@ class GltfImporter {
   }
 
   const tinygltf::Model& model_;
-  const std::filesystem::path base_dir_;
+  const SideFileRule& rule_;
   Mesh& mesh_;
   std::map<std::pair<int, int>, std::unique_ptr<draco::Mesh>> primitives_;
   std::vector<std::optional<std::uint32_t>> material_slots_;  // per glTF material, once converted
@@ -1247,7 +1279,7 @@ class GltfImporter {
 
 }  // namespace
 
-StatusOr<Mesh> ImportGltf(const std::filesystem::path& path) {
+StatusOr<Mesh> ImportGltf(const std::filesystem::path& path, const ImportOptions& options) {
   const std::string name = path.string();
   StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(path);
   if (!bytes.ok()) return bytes.status();
@@ -1255,10 +1287,10 @@ StatusOr<Mesh> ImportGltf(const std::filesystem::path& path) {
   try {
     Mesh mesh;
     const bool binary = LowerExtension(path) == "glb" || IsBinaryGltf(*bytes);
-    StatusOr<tinygltf::Model> model =
-        LoadModel(std::move(bytes).value(), binary, path.parent_path(), mesh.warnings);
+    const SideFileRule rule(path, options);
+    StatusOr<tinygltf::Model> model = LoadModel(std::move(bytes).value(), binary, rule, mesh);
     if (!model.ok()) return model.status().WithContext(name);
-    SVOKIT_RETURN_IF_ERROR(GltfImporter(*model, path.parent_path(), mesh).Run().WithContext(name));
+    SVOKIT_RETURN_IF_ERROR(GltfImporter(*model, rule, mesh).Run().WithContext(name));
     return mesh;
   } catch (const std::bad_alloc&) {
     return Status::OutOfMemory("{}: out of memory while importing", name);

@@ -7,6 +7,7 @@
 
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/mesh/side_files.hpp"
 
 namespace draco {
 class Mesh;
@@ -14,21 +15,34 @@ class Mesh;
 
 namespace svokit::detail {
 
-StatusOr<Mesh> ImportObj(const std::filesystem::path& path);
-StatusOr<Mesh> ImportPly(const std::filesystem::path& path);
+StatusOr<Mesh> ImportObj(const std::filesystem::path& path, const ImportOptions& options);
+StatusOr<Mesh> ImportPly(const std::filesystem::path& path, const ImportOptions& options);
 StatusOr<Mesh> ImportOff(const std::filesystem::path& path);
 StatusOr<Mesh> ImportStl(const std::filesystem::path& path);
-StatusOr<Mesh> ImportGltf(const std::filesystem::path& path);
+StatusOr<Mesh> ImportGltf(const std::filesystem::path& path, const ImportOptions& options);
 StatusOr<Mesh> ImportDracoFile(const std::filesystem::path& path);
+
+/// The same with the default side-file rule: side files from the model's folder only.
+inline StatusOr<Mesh> ImportObj(const std::filesystem::path& path) {
+  return ImportObj(path, {});
+}
+inline StatusOr<Mesh> ImportPly(const std::filesystem::path& path) {
+  return ImportPly(path, {});
+}
+inline StatusOr<Mesh> ImportGltf(const std::filesystem::path& path) {
+  return ImportGltf(path, {});
+}
 
 /// Appends a decoded Draco mesh's triangles (positions, and normals / first texture coordinates /
 /// colours where present) to `mesh` with material `material`. UVs are flipped to v-up when
 /// `flip_v` (glTF convention).
 Status AppendDracoMesh(const draco::Mesh& in, std::uint32_t material, bool flip_v, Mesh& mesh);
 
-/// Loads the texture file `uri` relative to `base_dir` into mesh.textures and points `material`
-/// at it; a file that cannot be read leaves the material untextured with a warning.
-void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
-                       Material& material, Mesh& mesh);
+/// Loads the texture file `reference` names (relative to `folder`, the folder of the file naming
+/// it) into mesh.textures and points `material` at it, if `rule` allows reading it; a file refused
+/// or unreadable leaves the material untextured with a warning.
+void AttachTextureFile(const SideFileRule& rule, const std::filesystem::path& folder,
+                       const std::string& reference, SideFileSyntax syntax, Material& material,
+                       Mesh& mesh);
 
 }  // namespace svokit::detail

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct Mesh {
   std::vector<Texture> textures;
   /// Non-fatal findings of the import (missing textures, dropped attributes, ...).
   std::vector<std::string> warnings;
+  /// The side files the import read (textures, material libraries, buffers), canonical: what
+  /// an output must not overwrite. Not stored in a .svm.
+  std::vector<std::filesystem::path> side_files;
 
   std::size_t triangle_count() const { return triangles.size(); }
   std::size_t vertex_count() const { return positions.size(); }

@@ -23,8 +23,8 @@ struct ObjCorner {
 
 class ObjParser {
  public:
-  ObjParser(const std::filesystem::path& path, std::string_view text)
-      : path_(path), base_dir_(path.parent_path()), scan_(text, path.string()) {}
+  ObjParser(const std::filesystem::path& path, std::string_view text, const ImportOptions& options)
+      : path_(path), rule_(path, options), scan_(text, path.string()) {}
 
   StatusOr<Mesh> Parse() {
     ReserveFromLineCounts();
@@ -211,8 +211,10 @@ class ObjParser {
   Status LoadMaterialLibraries(std::string_view names) {
     // "mtllib a.mtl b.mtl"; a single name with spaces is tried first.
     std::vector<std::string> files;
+    StatusOr<std::filesystem::path> whole =
+        rule_.Resolve(names, SideFileSyntax::kPath, rule_.model_folder());
     std::error_code ec;  // a name too long for a path is simply not one file's name
-    if (std::filesystem::exists(base_dir_ / std::string(names), ec)) {
+    if (whole.ok() && std::filesystem::exists(*whole, ec)) {
       files.emplace_back(names);
     } else {
       TextScanner words(names, "");
@@ -224,7 +226,15 @@ class ObjParser {
   }
 
   Status LoadMaterialLibrary(const std::string& file) {
-    const std::filesystem::path mtl_path = base_dir_ / file;
+    StatusOr<std::filesystem::path> resolved =
+        rule_.Resolve(file, SideFileSyntax::kPath, rule_.model_folder());
+    if (!resolved.ok()) {
+      mesh_.warnings.push_back(
+          fmt::format("material library '{}' {}: not read, its materials are white", file,
+                      resolved.status().message()));
+      return Status::Ok();
+    }
+    const std::filesystem::path& mtl_path = *resolved;
     StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(mtl_path, kSideFileLimit);
     if (!bytes.ok()) {
       const std::string why = UnreadableReason(bytes.status(), mtl_path);
@@ -234,6 +244,7 @@ class ObjParser {
               : fmt::format("material library '{}' {}; its materials are white", file, why));
       return Status::Ok();
     }
+    mesh_.side_files.push_back(mtl_path);
     StatusOr<std::string_view> text = TextOf(*bytes, mtl_path.string());
     if (!text.ok()) return text.status();
     TextScanner mtl(*text, mtl_path.string());
@@ -271,7 +282,9 @@ class ObjParser {
         m->base_color.a = 1.f - tr;
       } else if (key == "map_Kd") {
         const std::string image = TextureFileName(mtl.Rest());
-        if (!image.empty()) AttachTextureFile(mtl_path.parent_path(), image, *m, mesh_);
+        if (!image.empty()) {
+          AttachTextureFile(rule_, mtl_path.parent_path(), image, SideFileSyntax::kPath, *m, mesh_);
+        }
       }
     }
     return Status::Ok();
@@ -303,7 +316,7 @@ class ObjParser {
   }
 
   std::filesystem::path path_;
-  std::filesystem::path base_dir_;
+  SideFileRule rule_;
   TextScanner scan_;
   Mesh mesh_;
   std::vector<Vec2f> uvs_;
@@ -323,12 +336,12 @@ class ObjParser {
 
 }  // namespace
 
-StatusOr<Mesh> ImportObj(const std::filesystem::path& path) {
+StatusOr<Mesh> ImportObj(const std::filesystem::path& path, const ImportOptions& options) {
   StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(path);
   if (!bytes.ok()) return bytes.status();
   StatusOr<std::string_view> text = TextOf(*bytes, path.string());
   if (!text.ok()) return text.status();
-  ObjParser parser(path, *text);
+  ObjParser parser(path, *text, options);
   return parser.Parse();
 }
 

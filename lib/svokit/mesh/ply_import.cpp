@@ -394,8 +394,9 @@ enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
 
 class PlyImporter {
  public:
-  PlyImporter(const std::filesystem::path& path, std::span<const std::uint8_t> bytes)
-      : path_(path), name_(path.string()), bytes_(bytes), scan_(AsText(bytes), name_) {}
+  PlyImporter(const std::filesystem::path& path, std::span<const std::uint8_t> bytes,
+              const ImportOptions& options)
+      : rule_(path, options), name_(path.string()), bytes_(bytes), scan_(AsText(bytes), name_) {}
 
   StatusOr<Mesh> Import() {
     SVOKIT_RETURN_IF_ERROR(ParseHeader());
@@ -812,7 +813,7 @@ class PlyImporter {
     for (const std::string& file : texture_files_) {
       Material& material = mesh_.materials.emplace_back();
       material.name = file;
-      AttachTextureFile(path_.parent_path(), file, material, mesh_);
+      AttachTextureFile(rule_, rule_.model_folder(), file, SideFileSyntax::kPath, material, mesh_);
     }
     // Per-vertex colours carry more detail than per-face ones, so they win when both exist.
     const bool face_colors = !soup_.colors.empty() && vertex_attributes_.colors.empty();
@@ -837,7 +838,7 @@ class PlyImporter {
     return Status::Ok();
   }
 
-  std::filesystem::path path_;
+  SideFileRule rule_;
   std::string name_;
   std::span<const std::uint8_t> bytes_;
   TextScanner scan_;
@@ -857,10 +858,10 @@ class PlyImporter {
 
 }  // namespace
 
-StatusOr<Mesh> ImportPly(const std::filesystem::path& path) {
+StatusOr<Mesh> ImportPly(const std::filesystem::path& path, const ImportOptions& options) {
   StatusOr<std::vector<std::uint8_t>> bytes = ReadMeshFile(path);
   if (!bytes.ok()) return bytes.status();
-  PlyImporter importer(path, *bytes);
+  PlyImporter importer(path, *bytes, options);
   return importer.Import();
 }
 

@@ -129,17 +129,23 @@ StatusOr<const Image*> Texture::Decoded() const {
 
 namespace detail {
 
-void AttachTextureFile(const std::filesystem::path& base_dir, const std::string& uri,
-                       Material& material, Mesh& mesh) {
-  // Windows exporters write "textures\\wood.jpg"; on POSIX that is one odd file name.
-  std::string portable = uri;
-  std::replace(portable.begin(), portable.end(), '\\', '/');
-  std::filesystem::path file = portable;
-  if (file.is_relative()) file = base_dir / file;
-  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(file, kSideFileLimit);
+void AttachTextureFile(const SideFileRule& rule, const std::filesystem::path& folder,
+                       const std::string& reference, SideFileSyntax syntax, Material& material,
+                       Mesh& mesh) {
+  // glTF names its images by URI: the name kept is the decoded one ("my tex.png").
+  const std::string uri = syntax == SideFileSyntax::kUri ? PercentDecode(reference) : reference;
+  StatusOr<std::filesystem::path> file = rule.Resolve(reference, syntax, folder);
+  if (!file.ok()) {
+    material.missing_texture = uri;
+    mesh.warnings.push_back(
+        fmt::format("material '{}': texture '{}' {}: not read, using base colour", material.name,
+                    uri, file.status().message()));
+    return;
+  }
+  StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(*file, kSideFileLimit);
   if (!bytes.ok() || bytes->empty()) {
     material.missing_texture = uri;
-    const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), file);
+    const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), *file);
     mesh.warnings.push_back(
         why.empty() ? fmt::format("material '{}': texture '{}' not found, using base colour",
                                   material.name, uri)
@@ -147,6 +153,7 @@ void AttachTextureFile(const std::filesystem::path& base_dir, const std::string&
                                   material.name, uri, why));
     return;
   }
+  mesh.side_files.push_back(*file);
   // Bytes that are not an image svokit reads are never stored (they may be any file at all).
   if (StatusOr<ImageHeader> header = ReadImageHeader(uri, *bytes); !header.ok()) {
     material.missing_texture = uri;

@@ -9,9 +9,21 @@ void Warn(const WarningSink& warn, const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) warn(w);
 }
 
+Status Warn(const WarningSink& warn, const std::vector<std::string>& warnings, bool strict,
+            const std::filesystem::path& source) {
+  if (warn) {
+    for (const std::string& w : warnings) warn(fmt::format("{}: {}", source.string(), w));
+  }
+  if (strict && !warnings.empty()) {
+    return Status::BadInput("{}: {} warning{} and --strict: nothing written", source.string(),
+                            warnings.size(), warnings.size() == 1 ? "" : "s");
+  }
+  return Status::Ok();
+}
+
 StatusOr<FittedMesh> ImportAndFit(const std::filesystem::path& input, const GridFit& fit,
-                                  Progress& progress) {
-  StatusOr<Mesh> mesh = ImportStage(progress, input);
+                                  Progress& progress, const ImportOptions& options) {
+  StatusOr<Mesh> mesh = ImportStage(progress, input, options);
   if (!mesh.ok()) return mesh.status();
   StatusOr<GridTransform> grid = fit.Fit(mesh->Bounds());
   if (!grid.ok()) return grid.status().WithContext(input.string());

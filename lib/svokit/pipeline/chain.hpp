@@ -17,6 +17,7 @@
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_part.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/mesh/side_files.hpp"
 #include "svokit/pipeline/memory_policy.hpp"
 #include "svokit/pipeline/svo_parts.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
@@ -28,6 +29,10 @@ namespace svokit {
 using WarningSink = std::function<void(const std::string&)>;
 /// Hands each of `warnings` to `warn` (if set).
 void Warn(const WarningSink& warn, const std::vector<std::string>& warnings);
+/// Hands each of `warnings`, as "SOURCE: warning", to `warn` (if set); with `strict` (--strict)
+/// any warning is then bad input, so that nothing is written.
+Status Warn(const WarningSink& warn, const std::vector<std::string>& warnings, bool strict,
+            const std::filesystem::path& source);
 
 /// A mesh imported (as the "import" stage) and the grid `fit` gives around its bounds.
 struct FittedMesh {
@@ -35,7 +40,7 @@ struct FittedMesh {
   GridTransform grid;
 };
 StatusOr<FittedMesh> ImportAndFit(const std::filesystem::path& input, const GridFit& fit,
-                                  Progress& progress);
+                                  Progress& progress, const ImportOptions& options = {});
 
 /// A solid's interior, as a summary reports it.
 struct InteriorSummary {
@@ -59,6 +64,8 @@ struct MeshToVoxelsRequest {
   VoxelizeRequest voxelize;
   std::optional<std::uint64_t> memory_limit;  ///< none: MemoryPlan's default
   WarningSink warn;
+  ImportOptions import;  ///< where the mesh's side files may be read from
+  bool strict = false;   ///< any warning is an error: nothing is written
 };
 struct MeshToVoxelsReport {
   std::uint64_t triangles = 0;
@@ -86,6 +93,9 @@ struct VoxelsToSvoRequest {
   std::filesystem::path output;
   BuildSettings build;
   std::optional<std::uint64_t> memory_limit;
+  WarningSink warn;      ///< the mesh's import warnings
+  ImportOptions import;  ///< where the mesh's side files may be read from
+  bool strict = false;   ///< any warning is an error: nothing is written
 };
 StatusOr<OctreeReport> VoxelsToSvo(const VoxelsToSvoRequest& request,
                                    Progress& progress = Progress::Silent());
@@ -98,6 +108,8 @@ struct MeshToSvoRequest {
   std::optional<std::uint64_t> memory_limit;
   std::optional<SvoPartOf> part;  ///< one job's share of a build by pages (identity: computed)
   WarningSink warn;
+  ImportOptions import;  ///< where the mesh's side files may be read from
+  bool strict = false;   ///< any warning is an error: nothing is written
 };
 struct MeshToSvoReport {
   std::uint64_t triangles = 0;

@@ -27,7 +27,8 @@ struct Build {
     StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
         RegionVoxelizer::Create(mesh, grid, request.voxelize.Options());
     if (!regions.ok()) return regions.status().WithContext(request.input.string());
-    Warn(request.warn, (*regions)->warnings());
+    SVOKIT_RETURN_IF_ERROR(
+        Warn(request.warn, (*regions)->warnings(), request.strict, request.input));
     return regions;
   }
 
@@ -66,7 +67,7 @@ struct Build {
   Status Whole(const InteriorFinder* finder) {
     StatusOr<VoxelSet> voxels = Voxelize(mesh, grid, request.voxelize.Options(), progress);
     if (!voxels.ok()) return voxels.status().WithContext(request.input.string());
-    Warn(request.warn, voxels->warnings);
+    SVOKIT_RETURN_IF_ERROR(Warn(request.warn, voxels->warnings, request.strict, request.input));
     InteriorCubes interior;
     if (finder != nullptr) {
       if (voxels->keys.empty()) {
@@ -95,8 +96,10 @@ struct Build {
 
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
-  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress);
+  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress, r.import);
   if (!fitted.ok()) return fitted.status();
+  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, fitted->mesh.warnings, r.strict, r.input));
+  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, fitted->mesh.side_files));
   const Mesh* mesh = &fitted->mesh;
   const GridTransform* grid = &fitted->grid;
   MeshToSvoReport report;

@@ -27,7 +27,7 @@ Status WriteWholeVfrag(const MeshToVoxelsRequest& r, const Mesh& mesh, const Gri
   StatusOr<PackedVoxelization> voxels =
       VoxelizePacked(mesh, grid, r.voxelize.Options(), file, progress);
   if (!voxels.ok()) return voxels.status().WithContext(r.input.string());
-  Warn(r.warn, voxels->attributes.warnings);
+  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, voxels->attributes.warnings, r.strict, r.input));
   report.voxels = voxels->count;
   std::optional<InteriorCubes> interior;
   if (solid) {
@@ -46,7 +46,7 @@ Status WriteVoxelCentres(const MeshToVoxelsRequest& r, const Mesh& mesh, const G
                          MeshToVoxelsReport& report, Progress& progress) {
   StatusOr<VoxelSet> voxels = Voxelize(mesh, grid, r.voxelize.Options(), progress);
   if (!voxels.ok()) return voxels.status().WithContext(r.input.string());
-  Warn(r.warn, voxels->warnings);
+  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, voxels->warnings, r.strict, r.input));
   report.voxels = voxels->size();
   return RunStage(progress, "write", [&] {
     return LowerExtension(r.output) == "xyz" ? WriteVoxelsXyz(*voxels, r.output)
@@ -58,8 +58,10 @@ Status WriteVoxelCentres(const MeshToVoxelsRequest& r, const Mesh& mesh, const G
 
 StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"vfrag", "xyz", "ply"}, r.input));
-  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress);
+  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress, r.import);
   if (!fitted.ok()) return fitted.status();
+  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, fitted->mesh.warnings, r.strict, r.input));
+  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, fitted->mesh.side_files));
   const Mesh* mesh = &fitted->mesh;
   const GridTransform* grid = &fitted->grid;
   MeshToVoxelsReport report;
@@ -84,7 +86,7 @@ StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress
     StatusOr<std::unique_ptr<RegionVoxelizer>> regions =
         RegionVoxelizer::Create(*mesh, *grid, r.voxelize.Options());
     if (!regions.ok()) return regions.status().WithContext(r.input.string());
-    Warn(r.warn, (*regions)->warnings());
+    SVOKIT_RETURN_IF_ERROR(Warn(r.warn, (*regions)->warnings(), r.strict, r.input));
     StatusOr<std::uint64_t> count =
         WriteVfragByCubes(**regions, meta, r.output, report.memory.limit, progress);
     if (!count.ok()) return count.status().WithContext(r.input.string());

@@ -36,8 +36,11 @@ MemoryPlan PlanOf(const VoxelsToSvoRequest& r, const std::optional<InteriorCubes
 StatusOr<std::optional<Mesh>> ImportMeshOf(const VoxelsToSvoRequest& r, const GridTransform& grid,
                                            Progress& progress) {
   if (r.mesh.empty()) return std::optional<Mesh>();
-  StatusOr<Mesh> mesh = ImportSourceMesh(progress, r.mesh, grid, r.input, "that was voxelized");
+  StatusOr<Mesh> mesh =
+      ImportSourceMesh(progress, r.mesh, grid, r.input, "that was voxelized", r.import);
   if (!mesh.ok()) return mesh.status();
+  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, mesh->warnings, r.strict, r.mesh));
+  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, mesh->side_files));
   return std::optional<Mesh>(std::move(*mesh));
 }
 
@@ -100,6 +103,7 @@ StatusOr<OctreeReport> BuildWhole(const VoxelsToSvoRequest& r, BuildOptions opti
 
 StatusOr<OctreeReport> VoxelsToSvo(const VoxelsToSvoRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"svo"}, r.input));
+  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, {r.mesh}));
   StatusOr<std::optional<InteriorCubes>> interior = ReadVfragInterior(r.input);
   if (!interior.ok()) return interior.status();
   const MemoryPlan plan = PlanOf(r, *interior);
