@@ -1,7 +1,9 @@
 // libsvokit_oiio: the plugin module that decodes and encodes images with OpenImageIO (see
 // image_codec.hpp). svokit_oiio_decode: with `pixels` null it reads the header only; otherwise it
 // decodes all pixels into the caller's buffer of `pixel_count` floats. svokit_oiio_encode_to:
-// encodes 8-bit pixels in a named format and hands the bytes to the caller.
+// encodes 8-bit pixels in a named format and hands the bytes to the caller. svokit calls it only
+// for formats whose headers it has checked first (image_headers.hpp): OIIO's readers allocate what
+// a header declares inside open().
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -17,93 +19,10 @@
 #include <cstring>
 #include <memory>
 #include <string>
-#include <string_view>
 
 #include "svokit/mesh/image_codec.hpp"
 
 namespace {
-
-std::uint32_t LoadLE32(const std::uint8_t* p) {
-  return p[0] | p[1] << 8 | p[2] << 16 | static_cast<std::uint32_t>(p[3]) << 24;
-}
-
-std::string OverLimit(const char* what, std::int64_t width, std::int64_t height) {
-  return std::string(what) + " declares " + std::to_string(width) + "x" + std::to_string(height) +
-         " pixels, over the limit of " + std::to_string(svokit::kImagePixelLimit) + " pixels or " +
-         std::to_string(svokit::kImageSideLimit) + " per side";
-}
-
-// OIIO's BMP reader decodes an RLE image inside open(), sized by the header alone.
-std::string CheckBmpHeader(const std::uint8_t* bytes, std::size_t size) {
-  if (size < 26 || bytes[0] != 'B' || bytes[1] != 'M') return {};
-  std::int64_t width, height;
-  if (LoadLE32(bytes + 14) == 12) {  // OS/2 1.x: 16-bit sizes
-    width = bytes[18] | bytes[19] << 8;
-    height = static_cast<std::int16_t>(bytes[20] | bytes[21] << 8);
-  } else {
-    width = static_cast<std::int32_t>(LoadLE32(bytes + 18));
-    height = static_cast<std::int32_t>(LoadLE32(bytes + 22));
-  }
-  return svokit::OverImageLimits(width, std::abs(height)) ? OverLimit("BMP header", width, height)
-                                                          : std::string();
-}
-
-// OpenEXR allocates each header attribute at its declared size before it reads it: in a header
-// whose attributes are framed as declared, each must fit in the bytes left, the windows and tiles
-// in the pixel limits. (Misframed, OpenEXR fails on a read into at most 2 GiB it never touches.)
-std::string CheckExrHeader(const std::uint8_t* bytes, std::size_t size) {
-  if (size < 8 || LoadLE32(bytes) != 20000630) return {};
-  const bool multipart = (LoadLE32(bytes + 4) & 0x1000) != 0;
-  std::size_t at = 8;
-  const auto read_name = [&](std::string& name) {
-    const auto* end = static_cast<const std::uint8_t*>(std::memchr(bytes + at, 0, size - at));
-    if (!end) return false;
-    name.assign(reinterpret_cast<const char*>(bytes + at), end - (bytes + at));
-    at = static_cast<std::size_t>(end - bytes) + 1;
-    return true;
-  };
-  std::string name, type;
-  for (int empty_names = 0; at < size;) {
-    if (!read_name(name)) return {};
-    if (name.empty()) {
-      // A single-part header ends at its first empty name; a multipart list at two in a row.
-      if (!multipart || ++empty_names == 2) return {};
-      continue;
-    }
-    empty_names = 0;
-    if (!read_name(type) || size - at < 4) return {};
-    const auto value_size = static_cast<std::int32_t>(LoadLE32(bytes + at));
-    at += 4;
-    if (value_size < 0 || static_cast<std::size_t>(value_size) > size - at) {
-      return "OpenEXR attribute '" + name + "' declares " + std::to_string(value_size) +
-             " bytes, more than the file holds";
-    }
-    const std::uint8_t* value = bytes + at;
-    if ((name == "dataWindow" || name == "displayWindow") && type == "box2i" && value_size == 16) {
-      const std::int64_t width = std::int64_t{static_cast<std::int32_t>(LoadLE32(value + 8))} -
-                                 static_cast<std::int32_t>(LoadLE32(value)) + 1;
-      const std::int64_t height = std::int64_t{static_cast<std::int32_t>(LoadLE32(value + 12))} -
-                                  static_cast<std::int32_t>(LoadLE32(value + 4)) + 1;
-      if (svokit::OverImageLimits(width, height))
-        return OverLimit(("OpenEXR " + name).c_str(), width, height);
-    }
-    if (name == "tiles" && type == "tiledesc" && value_size >= 8 &&
-        svokit::OverImageLimits(LoadLE32(value), LoadLE32(value + 4))) {
-      return OverLimit("OpenEXR tile", LoadLE32(value), LoadLE32(value + 4));
-    }
-    at += static_cast<std::size_t>(value_size);
-  }
-  return {};
-}
-
-// The headers whose readers allocate what they declare before OIIO returns the spec that
-// ReadImageHeader checks.
-std::string CheckDeclaredSizes(std::string_view format, const std::uint8_t* bytes,
-                               std::size_t size) {
-  if (format == "bmp") return CheckBmpHeader(bytes, size);
-  if (format == "openexr") return CheckExrHeader(bytes, size);
-  return {};
-}
 
 // OpenImageIO 2.4's IOMemReader bounds its copies by offset + size in wrapping arithmetic, so a
 // damaged file whose offsets point far past its end makes it copy from outside the buffer
@@ -140,8 +59,6 @@ class EncodedImageReader {
     OIIO::ImageSpec spec;
     if (!input_) {
       error_ = "unknown or unsupported image format";
-    } else if (error_ = CheckDeclaredSizes(input_->format_name(), bytes, size); !error_.empty()) {
-      input_.reset();
     } else if (input_->supports("ioproxy")) {
       if (!input_->set_ioproxy(&reader_) || !input_->open(name, spec)) Fail();
     } else {
