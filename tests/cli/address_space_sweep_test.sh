@@ -8,22 +8,10 @@
 set -euo pipefail
 bin="$1" data="$2" kind="$3"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
-cp "$data/uv-torus.obj" "$tmp/"
 if [ "$kind" = png ]; then
-  cp "$data/uv-torus.mtl" "$data/uv-torus.png" "$tmp/"
+  cp "$data/uv-torus.obj" "$data/uv-torus.mtl" "$data/uv-torus.png" "$tmp/"
 else
-  sed 's/uv-torus\.png/uv-torus.tif/' "$data/uv-torus.mtl" >"$tmp/uv-torus.mtl"
-  # A 2 × 2 RGB TIFF, uncompressed: header, one directory of 9 entries, 12 bytes of pixels.
-  python3 - "$tmp/uv-torus.tif" <<'PY'
-import struct, sys
-entries = [(256, 3, 1, 2), (257, 3, 1, 2), (258, 3, 1, 8), (259, 3, 1, 1), (262, 3, 1, 2),
-           (273, 4, 1, 8 + 2 + 9 * 12 + 4), (277, 3, 1, 3), (278, 3, 1, 2), (279, 4, 1, 12)]
-ifd = struct.pack('<H', len(entries))
-for tag, kind, count, value in entries:
-    ifd += struct.pack('<HHI', tag, kind, count) + (struct.pack('<HH', value, 0) if kind == 3 else struct.pack('<I', value))
-open(sys.argv[1], 'wb').write(b'II*\0' + struct.pack('<I', 8) + ifd + struct.pack('<I', 0) +
-                               bytes([255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128]))
-PY
+  bash "$(dirname "$0")/tiff_textured_torus.sh" "$data" "$tmp"
 fi
 failed=0 ok=0 refused=0
 for ((mb = 150; mb <= 800; mb += 50)); do

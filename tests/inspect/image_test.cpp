@@ -34,7 +34,8 @@ TEST(WriteImage, PngRoundTripsExactlyAndFailuresLeaveNoFile) {
   }
   EXPECT_EQ(WriteImage(dir / "b.notaformat", w, h, 4, px).code(), StatusCode::kBadInput);
   EXPECT_EQ(WriteImage(dir / "c.png", 0, h, 4, px).code(), StatusCode::kBadInput);
-  EXPECT_EQ(WriteImage(dir / "no-such-dir" / "d.png", w, h, 4, px).code(), StatusCode::kBadInput);
+  EXPECT_EQ(WriteImage(dir / "no-such-dir" / "d.png", w, h, 4, px).code(),
+            StatusCode::kCannotWrite);
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.png"});
 }
 

@@ -2,7 +2,7 @@
 # Installs a build into a temporary prefix, builds examples/read_svo against that prefix alone
 # (find_package(svokit)), and checks the installed tools and the example against each other:
 # the example's per-level node counts against svo-inspect --json (parsed by python3), and the
-# installed mesh2svo's texture decoding through the installed plugin.
+# installed mesh2svo's TIFF texture decoding through the installed plugin.
 # Usage: install_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
 src="$(cd "$1" && pwd)"
@@ -46,10 +46,13 @@ found="$(sed -n 's/^svokit_DIR:PATH=//p' "$work/example/CMakeCache.txt")"
 cmake --build "$work/example" >"$work/build.log" 2>&1 ||
   { cat "$work/build.log" >&2; fail "building examples/read_svo against $prefix"; }
 
-# The installed tools on the textured torus. LD_DEBUG=files logs every dlopen attempt ("dynamically
-# loaded by") and, for the file that opens, "generating link map".
+# The installed tools on the torus textured with a TIFF, which only the plugin decodes.
+# LD_DEBUG=files logs every dlopen attempt ("dynamically loaded by") and, for the file that opens,
+# "generating link map".
 bin="$prefix/bin"
-LD_DEBUG=files "$bin/mesh2svo" "$src/data/uv-torus.obj" -r 32 -o "$work/torus.svo" -q \
+mkdir "$work/tiff"
+bash "$src/tests/cli/tiff_textured_torus.sh" "$src/data" "$work/tiff"
+LD_DEBUG=files "$bin/mesh2svo" "$work/tiff/uv-torus.obj" -r 32 -o "$work/torus.svo" -q \
   >/dev/null 2>"$work/mesh2svo.err" || { cat "$work/mesh2svo.err" >&2; fail "installed mesh2svo"; }
 grep -F "file=$prefix/lib/libsvokit_oiio.so " "$work/mesh2svo.err" | grep -q "generating link map" ||
   fail "installed mesh2svo did not load $prefix/lib/libsvokit_oiio.so:

@@ -43,7 +43,9 @@ std::string TriangleBin() {
        {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) {
     bin.append(reinterpret_cast<const char*>(&f), 4);
   }
-  for (std::uint16_t i : {0, 1, 2}) bin.append(reinterpret_cast<const char*>(&i), 2);
+  for (const std::uint16_t i : {std::uint16_t{0}, std::uint16_t{1}, std::uint16_t{2}}) {
+    bin.append(reinterpret_cast<const char*>(&i), 2);
+  }
   bin.resize(80, '\0');
   return bin;
 }
@@ -184,7 +186,9 @@ void ExpectRefused(Kind kind, const std::string& reference, const auto& outcome,
   ASSERT_EQ(outcome.warnings.size(), kind == Kind::kObjMtllib ? 2u : 1u);
   const std::string& w = outcome.warnings[0];
   EXPECT_NE(w.find(IsGltf(kind) ? PercentDecode(reference) : reference), std::string::npos) << w;
-  if (names_option) EXPECT_NE(w.find("--asset-path"), std::string::npos) << w;
+  if (names_option) {
+    EXPECT_NE(w.find("--asset-path"), std::string::npos) << w;
+  }
 }
 
 TEST_F(SideFiles, InsideTheModelsFolderIsRead) {
@@ -277,8 +281,8 @@ TEST(SideFileRule, ResolvesOnlyLocalFilesInsideAllowedFolders) {
                          dir / "model")
                 .value(),
             model / "a.png");
-  for (const std::string& uri : {"http://example.com/a.png", "file://host/a.png",
-                                 "data:image/png;base64,AAAA", "a%00.png", "", "..", "/"}) {
+  for (const char* uri : {"http://example.com/a.png", "file://host/a.png",
+                          "data:image/png;base64,AAAA", "a%00.png", "", "..", "/"}) {
     SCOPED_TRACE(uri);
     EXPECT_FALSE(rule.Resolve(uri, SideFileSyntax::kUri, dir / "model").ok());
   }

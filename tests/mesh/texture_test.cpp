@@ -13,6 +13,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "svokit/mesh/importers.hpp"
+#include "svokit/mesh/side_files.hpp"
 #include "svokit/mesh/texture_budget.hpp"
 #include "tests/bounded_run.hpp"
 #include "tests/test_util.hpp"
@@ -295,7 +296,8 @@ TEST(Texture, FilesThatAreNotImagesAreNotStored) {
   Mesh mesh;
   Material material;
   material.name = "m";
-  detail::AttachTextureFile(dir.path(), "notes.png", material, mesh);
+  const SideFileRule rule(dir / "model.obj", {});
+  detail::AttachTextureFile(rule, dir.path(), "notes.png", SideFileSyntax::kPath, material, mesh);
   EXPECT_TRUE(mesh.textures.empty());
   EXPECT_EQ(material.texture, -1);
   ASSERT_EQ(mesh.warnings.size(), 1u);
