@@ -135,6 +135,28 @@ Status CallPlugin(const std::string& name, std::span<const std::uint8_t> bytes, 
   return CheckImageSize(name, header);
 }
 
+// The fewest bytes a file of `h`'s format can hold its pixels in: the format's best compression
+// (zlib 1032:1, a JPEG block in 1 bit, GIF's 12-bit LZW codes of at most 4096 pixels, RLE packets
+// of 128 pixels, uncompressed rows). A shorter file is truncated or crafted, and stb would decode
+// it whole from zeros: a 17-byte PPM declaring 8192² took 1.2 GB and 4 s.
+std::uint64_t FewestEncodedBytes(const ImageHeader& h) {
+  const auto pixels = static_cast<std::uint64_t>(h.width) * static_cast<std::uint64_t>(h.height);
+  const std::string& f = h.format;
+  if (f == "png") {
+    const std::uint64_t raw = static_cast<std::uint64_t>(h.height) *
+                              (1 + static_cast<std::uint64_t>(h.width) * h.channels *
+                                       static_cast<std::uint64_t>(h.bytes_per_sample));
+    return raw / 1032;
+  }
+  if (f == "jpeg") return pixels / 1024;
+  if (f == "gif") return pixels / 16384;
+  if (f == "bmp") return pixels / 8;
+  if (f == "tga" || f == "psd") return pixels / 64;
+  if (f == "hdr") return pixels / 16;
+  if (f == "pnm") return pixels * static_cast<std::uint64_t>(h.channels);
+  return 0;
+}
+
 }  // namespace
 
 Status CheckImageSize(const std::string& name, const ImageHeader& h) {
@@ -160,6 +182,13 @@ StatusOr<ImageHeader> ReadImageHeader(const std::string& name,
     }
     header = {h->width,  h->height,           h->channels, h->bytes_per_sample == 4,
               h->format, h->bytes_per_sample, false};
+    SVOKIT_RETURN_IF_ERROR(CheckImageSize(name, header));
+    if (const std::uint64_t fewest = FewestEncodedBytes(header); bytes.size() < fewest) {
+      return Status::BadInput(
+          "texture '{}': cannot decode ({} header declares {}x{} pixels, which take at least {} "
+          "bytes; the file has {})",
+          name, header.format, header.width, header.height, fewest, bytes.size());
+    }
   } else {
     const PluginImageHeader p = ReadPluginImageHeader(bytes);
     if (*p.format == '\0') {
