@@ -40,7 +40,6 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                                     const SlabSampleOptions& options) {
   std::vector<std::unique_ptr<KeyIndex>> index;
   for (const auto& keys : level_keys) index.push_back(std::make_unique<KeyIndex>(keys));
-  const double h = grid.voxel_size();
   const std::size_t triangles = mesh.triangles.size();
   constexpr std::size_t kChunk = 256;
   std::vector<Partial> parts((triangles + kChunk - 1) / kChunk);
@@ -48,9 +47,11 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
     Partial& r = parts[part];
     std::vector<Vec3d> pts;
     for (std::size_t t = part * kChunk; t < std::min(triangles, (part + 1) * kChunk); ++t) {
+      // Sampled in voxel space, the voxelizer's frame: world areas of a 1e-300 mesh underflow.
       const Triangle& tri = mesh.triangles[t];
-      const Vec3d a = mesh.positions[tri[0]], b = mesh.positions[tri[1]],
-                  c = mesh.positions[tri[2]];
+      const Vec3d a = grid.WorldToVoxel(mesh.positions[tri[0]]),
+                  b = grid.WorldToVoxel(mesh.positions[tri[1]]),
+                  c = grid.WorldToVoxel(mesh.positions[tri[2]]);
       pts = {a, b, c};
       for (int e = 1; e <= 8; ++e) {
         const double w = e / 9.0;
@@ -60,7 +61,7 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
       }
       int interior = options.interior;
       if (interior <= 0) {
-        const double area = 0.5 * Length(Cross(b - a, c - a)) / (h * h);
+        const double area = 0.5 * Length(Cross(b - a, c - a));
         interior = static_cast<int>(std::clamp(std::ceil(2 * area), 4.0, 4096.0));
       }
       std::mt19937_64 rng(options.seed ^ (0x9E3779B97F4A7C15ull * (t + 1)));
@@ -70,9 +71,8 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
         if (u + v > 1) u = 1 - u, v = 1 - v;
         pts.push_back(a * (1 - u - v) + b * u + c * v);
       }
-      for (const Vec3d& p : pts) {
+      for (const Vec3d& q : pts) {
         ++r.points;
-        const Vec3d q = grid.WorldToVoxel(p);
         for (std::uint32_t level = 0; level <= depth; ++level) {
           const double s = std::ldexp(1.0, static_cast<int>(depth - level));
           const std::int64_t limit = std::int64_t{1} << level;
@@ -103,7 +103,7 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                         {level,
                          {static_cast<std::uint32_t>(cx[ix]), static_cast<std::uint32_t>(cy[iy]),
                           static_cast<std::uint32_t>(cz[iz])},
-                         p,
+                         grid.VoxelToWorld(q),
                          d,
                          ct.Low(),
                          ct.High()});
