@@ -155,7 +155,9 @@ std::optional<Header> ReadHeader(std::span<const std::uint8_t> bytes) {
       h.height = static_cast<int>(std::min<std::int64_t>(size_declared->second, INT_MAX));
       // PNG's colour type: grey, -, RGB, palette, grey + alpha, -, RGBA.
       static constexpr int kPngChannels[] = {1, 0, 3, 3, 2, 0, 4};
-      h.channels = is_png && bytes[25] < 7 ? std::max(1, kPngChannels[bytes[25]]) : 1;
+      // (IHDR's width and height may end the file: byte 25 is read only where it is there.)
+      h.channels =
+          is_png && bytes.size() > 25 && bytes[25] < 7 ? std::max(1, kPngChannels[bytes[25]]) : 1;
       return h;
     }
     stbi__context s;
