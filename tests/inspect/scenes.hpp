@@ -82,7 +82,8 @@ inline Svo TinyOctree() {
   }
   BuildOptions options;
   options.contours = false;
-  auto svo = BuildReferenceSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
+  auto svo =
+      BuildReferenceSvo(set, nullptr, options, R"({"source":"tiny.obj","generator":"test"})");
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }

@@ -28,8 +28,8 @@ namespace {
 using Keys = std::vector<std::vector<std::uint64_t>>;
 using Words = std::vector<std::vector<std::uint32_t>>;
 
-// Local equivalents of mask_tree.hpp's LevelKeysFromVoxels / OctreeDepth, so this suite depends only
-// on the voxelizer and the contour fit.
+// Local equivalents of mask_tree.hpp's LevelKeysFromVoxels / OctreeDepth, so this suite depends
+// only on the voxelizer and the contour fit.
 std::uint32_t Depth(const GridTransform& grid) {
   std::uint32_t d = 0;
   while ((std::uint64_t{1} << d) < grid.max_dim()) ++d;

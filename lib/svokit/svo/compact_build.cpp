@@ -112,7 +112,8 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
     for (std::uint32_t l = 0; l < shape.depth; ++l) {
       whole.layouts.push_back(LayOutSamples(whole.tree, l, shape.brick_side));
     }
-    whole.samples = FilterSamples(whole.tree, whole.layouts, shape.brick_side, VoxelSamplesOf(whole, shape));
+    whole.samples =
+        FilterSamples(whole.tree, whole.layouts, shape.brick_side, VoxelSamplesOf(whole, shape));
     stage.Advance();
   }
   if (options.contours) {

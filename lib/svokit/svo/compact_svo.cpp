@@ -8,7 +8,6 @@
 
 namespace svokit {
 
-
 Svo AssembleSvo(const CompactSvo& in) {
   SvoAssembler assembler(in.frame.shape, in.depth());
   assembler.Append(in.whole);
