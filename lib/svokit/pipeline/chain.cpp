@@ -22,11 +22,15 @@ Status Warn(const WarningSink& warn, const std::vector<std::string>& warnings, b
 }
 
 StatusOr<FittedMesh> ImportAndFit(const std::filesystem::path& input, const GridFit& fit,
-                                  Progress& progress, const ImportOptions& options) {
+                                  const ImportOptions& options, const WarningSink& warn,
+                                  bool strict, const std::filesystem::path& output,
+                                  Progress& progress) {
   StatusOr<Mesh> mesh = ImportStage(progress, input, options);
   if (!mesh.ok()) return mesh.status();
   StatusOr<GridTransform> grid = fit.Fit(mesh->Bounds());
   if (!grid.ok()) return grid.status().WithContext(input.string());
+  SVOKIT_RETURN_IF_ERROR(Warn(warn, mesh->warnings, strict, input));
+  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(output, mesh->side_files));
   return FittedMesh{std::move(*mesh), *grid};
 }
 

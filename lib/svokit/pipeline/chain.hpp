@@ -34,13 +34,17 @@ void Warn(const WarningSink& warn, const std::vector<std::string>& warnings);
 Status Warn(const WarningSink& warn, const std::vector<std::string>& warnings, bool strict,
             const std::filesystem::path& source);
 
-/// A mesh imported (as the "import" stage) and the grid `fit` gives around its bounds.
+/// A mesh imported (as the "import" stage) and the grid `fit` gives around its bounds. Its
+/// warnings go to `warn` (with `strict`, any is bad input), and `output` is refused when it is a
+/// file the import read: what every chain tool does before its first stage.
 struct FittedMesh {
   Mesh mesh;
   GridTransform grid;
 };
 StatusOr<FittedMesh> ImportAndFit(const std::filesystem::path& input, const GridFit& fit,
-                                  Progress& progress, const ImportOptions& options = {});
+                                  const ImportOptions& options, const WarningSink& warn,
+                                  bool strict, const std::filesystem::path& output,
+                                  Progress& progress);
 
 /// A solid's interior, as a summary reports it.
 struct InteriorSummary {

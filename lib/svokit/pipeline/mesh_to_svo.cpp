@@ -96,10 +96,9 @@ struct Build {
 
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
-  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress, r.import);
+  StatusOr<FittedMesh> fitted =
+      ImportAndFit(r.input, r.voxelize.grid, r.import, r.warn, r.strict, r.output, progress);
   if (!fitted.ok()) return fitted.status();
-  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, fitted->mesh.warnings, r.strict, r.input));
-  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, fitted->mesh.side_files));
   const Mesh* mesh = &fitted->mesh;
   const GridTransform* grid = &fitted->grid;
   MeshToSvoReport report;

@@ -58,10 +58,9 @@ Status WriteVoxelCentres(const MeshToVoxelsRequest& r, const Mesh& mesh, const G
 
 StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"vfrag", "xyz", "ply"}, r.input));
-  StatusOr<FittedMesh> fitted = ImportAndFit(r.input, r.voxelize.grid, progress, r.import);
+  StatusOr<FittedMesh> fitted =
+      ImportAndFit(r.input, r.voxelize.grid, r.import, r.warn, r.strict, r.output, progress);
   if (!fitted.ok()) return fitted.status();
-  SVOKIT_RETURN_IF_ERROR(Warn(r.warn, fitted->mesh.warnings, r.strict, r.input));
-  SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, fitted->mesh.side_files));
   const Mesh* mesh = &fitted->mesh;
   const GridTransform* grid = &fitted->grid;
   MeshToVoxelsReport report;
