@@ -26,6 +26,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile.description(""))
       ->option_text("PART...");
   app::AddFile(cli, "-o,--output", output, "Output .svo")->required();
+  MergeOptions merge;
+  cli.add_flag("--trust-samples", merge.trust_samples,
+               "Take the parts' brick samples and halos as written (parts your own jobs wrote) "
+               "instead of building every page once more to check them; the other checks still "
+               "run");
   app::AddCommonOptions(cli, common, "svo-merge out/*.svopart -o scene.svo");
 
   return app::Run(tool, cli, argc, argv, parts.empty() ? std::filesystem::path{} : parts[0], [&] {
@@ -34,7 +39,7 @@ int main(int argc, char** argv) {
     }
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-    StatusOr<SvoFileStats> written = MergeSvoParts(parts, output, progress);
+    StatusOr<SvoFileStats> written = MergeSvoParts(parts, output, progress, merge);
     if (!written.ok()) return app::Fail(tool, written.status());
     fmt::print("parts       {}\n", parts.size());
     fmt::print("voxels      {}\n", written->voxels);

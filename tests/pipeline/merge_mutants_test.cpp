@@ -25,6 +25,7 @@
 #include "svokit/formats/svo/svo_part.hpp"
 #include "svokit/pipeline/svo_parts.hpp"
 #include "svokit/svo/build_options.hpp"
+#include "svokit/svo/page_borders.hpp"
 #include "svokit/validate/validate.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
@@ -169,6 +170,7 @@ struct Build {
   std::string name;
   std::vector<fs::path> parts;
   std::vector<PartParts> taken;
+  std::vector<SvoPart> read;
 };
 
 std::unique_ptr<Build> MakeBuild(const test::TempDir& dir, const std::string& name,
@@ -195,13 +197,29 @@ std::unique_ptr<Build> MakeBuild(const test::TempDir& dir, const std::string& na
                      build->parts.back(), compression, 0);
     EXPECT_TRUE(made.ok()) << made.status().message();
     build->taken.push_back(TakeApart(build->parts.back()));
+    StatusOr<SvoPart> read = ReadSvoPart(build->parts.back());
+    EXPECT_TRUE(read.ok()) << read.status().message();
+    build->read.push_back(std::move(*read));
   }
   return build;
 }
 
-// One structured change to `p`; what it changed, for the report. False when it did not apply.
-bool Mutate(PartParts& p, std::uint32_t part, std::mt19937_64& rng, std::string& what,
-            bool& sizes) {
+// Page `i` of `part` decoded, changed by `change` and encoded again with its shell made from it,
+// as a producer that rewrites a page consistently would. False when `change` does not apply.
+template <class Change>
+bool Rewrite(PartParts& p, const SvoPart& part, std::size_t i, Change change) {
+  StatusOr<SvoChunk> chunk = DecodeSvoPartPage(part, part.pages[i]);
+  EXPECT_TRUE(chunk.ok()) << chunk.status().message();
+  if (!chunk.ok() || !change(*chunk)) return false;
+  p.pages[i].chunk = PagedSvoWriter(part.head.frame, {true, 1}).Encode(*chunk).bytes;
+  p.pages[i].shell = EncodePageShell(*chunk, part.head.frame.shape);
+  return true;
+}
+
+// One structured change to `p`, part `part` of its build as read; what it changed, for the
+// report. False when it did not apply.
+bool Mutate(PartParts& p, std::uint32_t part, const SvoPart& read, std::mt19937_64& rng,
+            std::string& what, bool& sizes) {
   const auto pick = [&](std::uint64_t n) { return static_cast<std::size_t>(rng() % n); };
   // A field's new value: off by one, zero, all ones, a bit flipped, or random.
   const auto perturb = [&](std::uint64_t v, int bits) -> std::uint64_t {
@@ -237,7 +255,7 @@ bool Mutate(PartParts& p, std::uint32_t part, std::mt19937_64& rng, std::string&
     return true;
   };
   const std::size_t pages = p.pages.size();
-  switch (pick(12)) {
+  switch (pick(13)) {
     case 0: {  // a PART field
       static constexpr std::pair<std::size_t, int> kFields[] = {
           {0, 32},  {4, 32},  {8, 64},  {16, 64}, {24, 64}, {32, 64}, {40, 32},
@@ -362,6 +380,39 @@ bool Mutate(PartParts& p, std::uint32_t part, std::mt19937_64& rng, std::string&
       }
       return true;
     }
+    case 11: {  // a page rewritten consistently: a sample or a halo voxel, its shell remade
+      if (pages == 0 || read.head.frame.shape.brick_side == 0) return false;
+      const std::size_t i = pick(pages);
+      return Rewrite(p, read, i, [&](SvoChunk& c) {
+        if (pick(3) == 0) {
+          if (c.halo_keys.empty()) return false;
+          const std::size_t h = pick(c.halo_keys.size());
+          if (c.halo_colors.empty() || pick(2) == 0) {
+            c.halo_keys.erase(c.halo_keys.begin() + static_cast<std::ptrdiff_t>(h));
+            if (!c.halo_colors.empty()) c.halo_colors.erase(c.halo_colors.begin() + h);
+            if (!c.halo_normals.empty()) c.halo_normals.erase(c.halo_normals.begin() + h);
+            what = fmt::format("page {} halo voxel {} dropped, shell remade", i, h);
+          } else {
+            const float r = c.halo_colors[h].r;
+            c.halo_colors[h].r = Half(r < 0.5f ? r + 0.25f : r - 0.25f);
+            what = fmt::format("page {} halo voxel {} recoloured, shell remade", i, h);
+          }
+          return true;
+        }
+        if (c.samples.empty()) return false;
+        LevelSamples& level = c.samples[pick(c.samples.size())];
+        if (level.opacity.empty()) return false;
+        const std::size_t at = pick(level.opacity.size());
+        if (!level.color.empty() && pick(2) == 0) {
+          level.color[at] ^= 0x00ff00ffu;
+          what = fmt::format("page {} sample {} recoloured, shell remade", i, at);
+        } else {
+          level.opacity[at] = static_cast<std::uint8_t>(level.opacity[at] ^ 0x5a);
+          what = fmt::format("page {} sample {} opacity changed, shell remade", i, at);
+        }
+        return true;
+      });
+    }
     default: {  // the top contours: a count, a key or a word
       if (part != 0 || p.top.size() < 20) return false;
       // The first level: its count, then entries of 12 bytes.
@@ -383,6 +434,39 @@ bool Mutate(PartParts& p, std::uint32_t part, std::mt19937_64& rng, std::string&
 int MutantCount() {
   const char* n = std::getenv("SVOKIT_MERGE_MUTANTS");
   return n != nullptr ? std::atoi(n) : 100;
+}
+
+// A part whose brick sample was rewritten with its shell made again passes every structural
+// check: only building the page once more refuses it, and --trust-samples takes it as written.
+TEST(MergeMutants, ASampleRewrittenConsistentlyIsRefusedUnlessTrusted) {
+  test::TempDir dir;
+  const std::unique_ptr<Build> build = MakeBuild(dir, "bricks", 3, true, {true, 3}, 2);
+  ASSERT_TRUE(MergeSvoParts(build->parts, dir / "merged.svo").ok());
+  PartParts mutant = build->taken[1];
+  ASSERT_TRUE(Rewrite(mutant, build->read[1], 0, [](SvoChunk& c) {
+    LevelSamples& level = c.samples.back();
+    level.color[level.color.size() / 2] ^= 0x00ff00ffu;
+    return true;
+  }));
+  PutTogether(mutant, dir / "mutant.svopart", true);
+  const std::vector<fs::path> parts = {build->parts[0], dir / "mutant.svopart"};
+  fs::remove(dir / "merged.svo");
+  const StatusOr<SvoFileStats> refused = MergeSvoParts(parts, dir / "merged.svo");
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kBadInput);
+  EXPECT_NE(refused.status().message().find("mutant.svopart: page"), std::string::npos)
+      << refused.status().message();
+  EXPECT_NE(refused.status().message().find("brick samples are not those its voxels make"),
+            std::string::npos)
+      << refused.status().message();
+  EXPECT_FALSE(fs::exists(dir / "merged.svo"));
+
+  MergeOptions trust;
+  trust.trust_samples = true;
+  ASSERT_TRUE(MergeSvoParts(parts, dir / "merged.svo", Progress::Silent(), trust).ok());
+  const StatusOr<LenientSvo> file = ReadSvoLenient(dir / "merged.svo");
+  ASSERT_TRUE(file.ok()) << file.status().message();
+  EXPECT_FALSE(validate::Validate(*file, "merged.svo", {}).ok());
 }
 
 TEST(MergeMutants, EveryMutantIsRefusedOrMergesIntoAValidFile) {
@@ -415,7 +499,7 @@ TEST(MergeMutants, EveryMutantIsRefusedOrMergesIntoAValidFile) {
     PartParts mutant = build.taken[k];
     std::string what;
     bool sizes = true;
-    while (!Mutate(mutant, k, rng, what, sizes)) mutant = build.taken[k];
+    while (!Mutate(mutant, k, build.read[k], rng, what, sizes)) mutant = build.taken[k];
     const std::string label = fmt::format("mutant {} ({} part {}): {}", m, build.name, k, what);
     const fs::path part = dir / "mutant.svopart", output = dir / "merged.svo";
     PutTogether(mutant, part, sizes);

@@ -15,14 +15,6 @@ namespace svokit::pipeline_detail {
 
 namespace {
 
-// The cube of cell `cell` (2^bits voxels a side), grown by `grow` voxels.
-IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
-  const MortonCoord c = MortonDecode(cell);
-  const std::int64_t s = std::int64_t{1} << bits;
-  return {{c.x * s - grow, c.y * s - grow, c.z * s - grow},
-          {c.x * s + s + grow, c.y * s + s + grow, c.z * s + s + grow}};
-}
-
 // A solid's cubes as a build by pages needs them: from the mesh (exact crossings only: the
 // winding numbers may split cubes below the page level outside every page), or cut out of a
 // whole interior read before (a .vfrag's).
@@ -80,6 +72,24 @@ StatusOr<CubesOf> SolidCubes(const BuildOptions& options, std::span<const std::u
 }
 
 }  // namespace
+
+IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow) {
+  const MortonCoord c = MortonDecode(cell);
+  const std::int64_t s = std::int64_t{1} << bits;
+  return {{c.x * s - grow, c.y * s - grow, c.z * s - grow},
+          {c.x * s + s + grow, c.y * s + s + grow, c.z * s + s + grow}};
+}
+
+StatusOr<SvoChunk> BuildPageAlone(VoxelSet voxels, const BuildOptions& options,
+                                  std::uint32_t page_level, std::uint64_t cell) {
+  StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(voxels), nullptr, options);
+  if (!svo.ok()) return svo.status();
+  const std::vector<std::uint64_t> keys = KeysOfLevel(svo->whole.tree, page_level);
+  const std::size_t at =
+      static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), cell) - keys.begin());
+  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->whole.tree, page_level);
+  return PageChunk(*svo, page_level, at, nbs[at], cell);
+}
 
 StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
                               const TopContours* words, std::uint32_t side,
@@ -250,9 +260,7 @@ PagePlan::PagePlan(const BuildOptions& options, const std::string& metadata,
   frame_.metadata = metadata;
   page_level_ = PageLevel(frame_.depth());
   bits_ = frame_.depth() - page_level_;
-  // The halo: the voxels a page's voxel bricks read, one around it; with bricks of side 2 the
-  // samples of its faces above the voxels read one more.
-  grow_ = options.brick_side == 2 ? 2 : 1;
+  grow_ = PageGrow(options.brick_side);
   page_options_.contours = false;    // fitted from each page's triangles instead
   page_options_.interior = nullptr;  // each page's own, from cubes_
   page_options_.interior_finder = nullptr;
@@ -333,13 +341,9 @@ Status PagePlan::MakePage(const PagedSvoWriter& writer, std::size_t i,
     interior.levels.resize(frame_.depth() + 1);
     options.interior = &interior;
   }
-  StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), nullptr, options);
-  if (!svo.ok()) return svo.status();
-  const std::vector<std::uint64_t> keys = KeysOfLevel(svo->whole.tree, page_level_);
-  const std::size_t at =
-      static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), cell) - keys.begin());
-  const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo->whole.tree, page_level_);
-  SvoChunk chunk = PageChunk(*svo, page_level_, at, nbs[at], cell);
+  StatusOr<SvoChunk> built = BuildPageAlone(std::move(*voxels), options, page_level_, cell);
+  if (!built.ok()) return built.status();
+  SvoChunk& chunk = *built;
   if (contours_) {
     chunk.contours = contours_->FitSubtree(
         page_level_, TreeLevelKeys(chunk.tree, cell, frame_.depth()), triangles_(i));

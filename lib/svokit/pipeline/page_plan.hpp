@@ -35,6 +35,20 @@ inline constexpr SvoCompression kAloneCompression{true, 1};
 using CubesOf = std::function<std::vector<std::vector<std::uint64_t>>(
     std::span<const std::uint64_t> keys, std::uint32_t level, std::uint32_t top)>;
 
+/// How far around its cube a page built alone reads voxels: one (its voxel bricks' halo); with
+/// bricks of side 2 the samples of its faces above the voxels read one more.
+constexpr std::int64_t PageGrow(std::uint32_t brick_side) {
+  return brick_side == 2 ? 2 : 1;
+}
+
+/// The cube of page cube `cell` (2^bits voxels a side), grown by `grow` voxels.
+IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow);
+
+/// Page `cell` of `page_level` built alone from `voxels`, its own and those of its cube grown by
+/// PageGrow, at least one its own: the chunk a part stores, without contours.
+StatusOr<SvoChunk> BuildPageAlone(VoxelSet voxels, const BuildOptions& options,
+                                  std::uint32_t page_level, std::uint64_t cell);
+
 /// The top chunk of the pages with these root keys: masks, the contours `words` gives, and with
 /// bricks (side ≠ 0) the samples filtered from the bricks of the pages' roots.
 StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,

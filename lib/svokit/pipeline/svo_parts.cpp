@@ -1,6 +1,7 @@
 #include "svokit/pipeline/svo_parts.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -46,84 +47,150 @@ bool SameFrame(const SvoPartHead& a, const SvoPartHead& b) {
          x.shared_color == y.shared_color && a.compression == b.compression;
 }
 
-// A voxel on a page's faces, or one that a neighbouring page's halo says is there.
-struct FaceVoxel {
+// A voxel of a page that a neighbouring page built alone reads: within PageGrow of its faces.
+struct BandVoxel {
   std::uint64_t key = 0;
   HalfRgba color;
-  std::uint32_t normal = 0;
-  std::size_t page = 0;  // index among all pages, in key order
+  OctNormal normal;
 };
 
-// Every page of every part decoded and checked on its own (DecodeSvoPartPage), and across pages:
-// keys ascending over the parts, and each halo voxel a voxel of the page next to it, with its
-// attributes (the merged file's halo check). Pages are decoded in parallel; what the cross-page
-// check keeps of each is its face voxels and halo, a small share of its voxels.
-Status CheckPages(const std::vector<SvoPart>& parts, Progress& progress) {
-  struct Where {
-    const SvoPart* part;
-    const SvoPartPage* page;
-  };
-  std::vector<Where> where;
-  for (const SvoPart& part : parts) {
-    for (const SvoPartPage& page : part.pages) {
-      if (!where.empty() && page.key <= where.back().page->key) {
-        return Status::BadInput("{}: page {:#x} does not follow page {:#x} of {}", part.name,
-                                page.key, where.back().page->key, where.back().part->name);
+// The voxel set page `page` was built alone from (BuildPageAlone): its own voxels and those of
+// the pages around it within its grown cube, from `bands` (ascending keys, every page's band).
+VoxelSet PageInput(const SvoFrame& frame, const SvoChunk& page, std::span<const BandVoxel> bands) {
+  const std::uint32_t bits = frame.depth() - page.root_level;
+  const IBox3 box = CellBox(page.root_key, bits, PageGrow(frame.shape.brick_side));
+  const bool per_voxel_colors = frame.shape.has_color && frame.shape.shared_color.empty();
+  std::vector<BandVoxel> voxels;
+  const std::vector<std::uint64_t> keys = ChunkVoxelKeys(page);
+  for (std::size_t n = 0; n < keys.size(); ++n) {
+    voxels.push_back({keys[n], per_voxel_colors ? page.colors[n] : HalfRgba(),
+                      frame.shape.has_normal ? page.normals[n] : OctNormal()});
+  }
+  const MortonCoord c = MortonDecode(page.root_key);
+  const std::int64_t cells = std::int64_t{1} << page.root_level;
+  for (std::int64_t dz = -1; dz <= 1; ++dz) {
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const std::int64_t x = c.x + dx, y = c.y + dy, z = c.z + dz;
+        if ((dx == 0 && dy == 0 && dz == 0) || x < 0 || y < 0 || z < 0 || x >= cells ||
+            y >= cells || z >= cells) {
+          continue;
+        }
+        const std::uint64_t cell =
+            MortonEncode(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                         static_cast<std::uint32_t>(z));
+        const auto by_key = [](const BandVoxel& v, std::uint64_t key) { return v.key < key; };
+        auto it = std::lower_bound(bands.begin(), bands.end(), cell << (3 * bits), by_key);
+        const auto end = std::lower_bound(it, bands.end(), (cell + 1) << (3 * bits), by_key);
+        for (; it != end; ++it) {
+          const MortonCoord v = MortonDecode(it->key);
+          if (box.Contains(Vec3i{v.x, v.y, v.z})) voxels.push_back(*it);
+        }
       }
-      where.push_back({&part, &page});
     }
   }
-  const SvoFrame& frame = parts[0].head.frame;
-  const std::uint32_t shift = frame.depth() - PageLevel(frame.depth());
-  const std::uint32_t last = (std::uint32_t{1} << shift) - 1;
-  std::vector<std::vector<FaceVoxel>> faces(where.size()), halos(where.size());
-  std::vector<Status> checked(where.size(), Status::Ok());
-  Progress::Stage stage(progress, "check parts", where.size());
-  tbb::parallel_for(std::size_t{0}, where.size(), [&](std::size_t i) {
-    StatusOr<SvoChunk> page = DecodeSvoPartPage(*where[i].part, *where[i].page);
-    if (!page.ok()) {
-      checked[i] = page.status();
-      return;
-    }
-    const auto voxel = [&](std::uint64_t key, const auto& colors, const auto& normals,
-                           std::size_t n) {
-      return FaceVoxel{key, colors.empty() ? HalfRgba() : colors[n],
-                       normals.empty() ? 0u : normals[n].bits, i};
-    };
-    const std::vector<std::uint64_t> keys = ChunkVoxelKeys(*page);
-    for (std::size_t n = 0; n < keys.size(); ++n) {
-      const MortonCoord c = MortonDecode(keys[n]);
-      const auto on_face = [&](std::uint32_t v) { return (v & last) == 0 || (v & last) == last; };
-      if (on_face(c.x) || on_face(c.y) || on_face(c.z)) {
-        faces[i].push_back(voxel(keys[n], page->colors, page->normals, n));
-      }
-    }
-    for (std::size_t n = 0; n < page->halo_keys.size(); ++n) {
-      halos[i].push_back(voxel(page->halo_keys[n], page->halo_colors, page->halo_normals, n));
-    }
+  std::sort(voxels.begin(), voxels.end(),
+            [](const BandVoxel& a, const BandVoxel& b) { return a.key < b.key; });
+  VoxelSet set;
+  set.grid = frame.grid;
+  set.mode = frame.mode;
+  set.keys.resize(voxels.size());
+  if (per_voxel_colors) set.colors.resize(voxels.size());
+  if (!frame.shape.shared_color.empty()) set.colors.assign(1, frame.shape.shared_color[0]);
+  if (frame.shape.has_normal) set.normals.resize(voxels.size());
+  for (std::size_t n = 0; n < voxels.size(); ++n) {
+    set.keys[n] = voxels[n].key;
+    if (per_voxel_colors) set.colors[n] = voxels[n].color;
+    if (frame.shape.has_normal) set.normals[n] = voxels[n].normal;
+  }
+  return set;
+}
+
+// A page of a part, in the key order of all parts' pages.
+struct PartPage {
+  const SvoPart* part;
+  const SvoPartPage* page;
+};
+
+// `check` of every page decoded (DecodeSvoPartPage), in parallel, as the stage `stage_name`; the
+// first error in page order.
+Status CheckEachPage(std::span<const PartPage> pages, const char* stage_name, Progress& progress,
+                     const std::function<Status(std::size_t, const SvoChunk&)>& check) {
+  std::vector<Status> checked(pages.size(), Status::Ok());
+  Progress::Stage stage(progress, stage_name, pages.size());
+  tbb::parallel_for(std::size_t{0}, pages.size(), [&](std::size_t i) {
+    StatusOr<SvoChunk> page = DecodeSvoPartPage(*pages[i].part, *pages[i].page);
+    checked[i] = page.ok() ? check(i, *page) : page.status();
     stage.Advance(1);
   });
   for (const Status& s : checked) SVOKIT_RETURN_IF_ERROR(s);
-  // Pages ascend and each covers a run of voxel keys: their face voxels are in key order.
-  std::vector<FaceVoxel> all;
-  for (std::vector<FaceVoxel>& f : faces) {
-    all.insert(all.end(), f.begin(), f.end());
-    std::vector<FaceVoxel>().swap(f);
-  }
-  for (const std::vector<FaceVoxel>& page_halo : halos) {
-    for (const FaceVoxel& h : page_halo) {
-      const auto it =
-          std::lower_bound(all.begin(), all.end(), h.key,
-                           [](const FaceVoxel& v, std::uint64_t key) { return v.key < key; });
-      if (it == all.end() || it->key != h.key || !(it->color == h.color) ||
-          it->normal != h.normal) {
-        const Where& w = where[h.page];
-        return Status::BadInput("{}: page {:#x}: halo voxel {} is not the voxel of its neighbour",
-                                w.part->name, w.page->key, h.key);
+  return Status::Ok();
+}
+
+// Every page of every part decoded and checked on its own (DecodeSvoPartPage), and pages' keys
+// ascending over the parts. With bricks, a page's samples and halo are then built once more from
+// its voxels and those of the pages around it, as the part's build made them, and must be the
+// page's: a part cannot bring samples its voxels do not make. What that keeps of each page
+// between the two passes is its band, the voxels a neighbour reads (~5% of them).
+Status CheckPages(const std::vector<SvoPart>& parts, const MergeOptions& options,
+                  Progress& progress) {
+  std::vector<PartPage> pages;
+  for (const SvoPart& part : parts) {
+    for (const SvoPartPage& page : part.pages) {
+      if (!pages.empty() && page.key <= pages.back().page->key) {
+        return Status::BadInput("{}: page {:#x} does not follow page {:#x} of {}", part.name,
+                                page.key, pages.back().page->key, pages.back().part->name);
       }
+      pages.push_back({&part, &page});
     }
   }
-  return Status::Ok();
+  const SvoFrame& frame = parts[0].head.frame;
+  const bool rebuild = frame.shape.brick_side != 0 && !options.trust_samples;
+  const std::uint32_t bits = frame.depth() - PageLevel(frame.depth());
+  const std::uint32_t last = (std::uint32_t{1} << bits) - 1;
+  const std::uint32_t grow = static_cast<std::uint32_t>(PageGrow(frame.shape.brick_side));
+  std::vector<std::vector<BandVoxel>> bands(pages.size());
+  SVOKIT_RETURN_IF_ERROR(
+      CheckEachPage(pages, "check parts", progress, [&](std::size_t i, const SvoChunk& page) {
+        if (!rebuild) return Status::Ok();
+        const std::vector<std::uint64_t> keys = ChunkVoxelKeys(page);
+        const auto in_band = [&](std::uint32_t v) {
+          return (v & last) < grow || (v & last) > last - grow;
+        };
+        for (std::size_t n = 0; n < keys.size(); ++n) {
+          const MortonCoord c = MortonDecode(keys[n]);
+          if (in_band(c.x) || in_band(c.y) || in_band(c.z)) {
+            bands[i].push_back({keys[n], page.colors.empty() ? HalfRgba() : page.colors[n],
+                                page.normals.empty() ? OctNormal() : page.normals[n]});
+          }
+        }
+        return Status::Ok();
+      }));
+  if (!rebuild) return Status::Ok();
+  // Pages ascend and each covers a run of voxel keys: their bands are in key order.
+  std::vector<BandVoxel> all;
+  for (std::vector<BandVoxel>& band : bands) {
+    all.insert(all.end(), band.begin(), band.end());
+    std::vector<BandVoxel>().swap(band);
+  }
+  BuildOptions build;
+  build.brick_side = frame.shape.brick_side;
+  build.contours = false;
+  return CheckEachPage(
+      pages, "rebuild samples", progress, [&](std::size_t i, const SvoChunk& page) {
+        StatusOr<SvoChunk> built =
+            BuildPageAlone(PageInput(frame, page, all), build, page.root_level, page.root_key);
+        const std::string name = fmt::format("{}: page {:#x}", pages[i].part->name, page.root_key);
+        if (!built.ok()) return Status::BadInput("{}: {}", name, built.status().message());
+        if (built->halo_keys != page.halo_keys || built->halo_colors != page.halo_colors ||
+            built->halo_normals != page.halo_normals) {
+          return Status::BadInput("{}: its halo is not the voxels around it", name);
+        }
+        if (built->samples != page.samples) {
+          return Status::BadInput("{}: brick samples are not those its voxels make", name);
+        }
+        return Status::Ok();
+      });
 }
 
 // The parts (sorted by part number) are all of one build: same identity and frame, each part
@@ -162,11 +229,7 @@ Status CheckOneBuild(const std::vector<SvoPart>& parts) {
 StatusOr<SvoFileStats> MergeBuiltAlone(const std::vector<SvoPart>& parts,
                                        const std::filesystem::path& path, Progress& progress) {
   const SvoPartHead& head = parts[0].head;
-  struct Where {
-    const SvoPart* part;
-    const SvoPartPage* page;
-  };
-  std::vector<Where> where;
+  std::vector<PartPage> where;
   BuiltPages built;
   for (const SvoPart& part : parts) {
     for (const SvoPartPage& page : part.pages) {
@@ -279,11 +342,12 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
 }
 
 StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> paths,
-                                     const std::filesystem::path& path, Progress& progress) {
+                                     const std::filesystem::path& path, Progress& progress,
+                                     const MergeOptions& options) {
   StatusOr<std::vector<SvoPart>> parts = ReadParts(paths);
   if (!parts.ok()) return parts.status();
   SVOKIT_RETURN_IF_ERROR(CheckOneBuild(*parts));
-  SVOKIT_RETURN_IF_ERROR(CheckPages(*parts, progress));
+  SVOKIT_RETURN_IF_ERROR(CheckPages(*parts, options, progress));
   if ((*parts)[0].head.frame.shape.brick_side != 0) return MergeBuiltAlone(*parts, path, progress);
   return MergeFinished(*parts, path, progress);
 }

@@ -30,11 +30,20 @@ StatusOr<SvoPartStats> BuildSvoPart(const RegionVoxelizer& voxelizer, const Buil
                                     const SvoCompression& compression, std::uint64_t memory_limit,
                                     Progress& progress = Progress::Silent());
 
+/// What merging takes on trust.
+struct MergeOptions {
+  /// Skip building every page with bricks once more to check its samples and halo (parts that
+  /// one's own jobs wrote): two thirds of the merge's time; the structural checks still run.
+  bool trust_samples = false;
+};
+
 /// Joins the parts of one build, given in any order, into its .svo, after checking that they
 /// belong to the same build and cover its pages exactly once (an error names the missing,
-/// repeated or foreign part). Without bricks the pages' bytes are copied, not recompressed.
+/// repeated or foreign part), and that every page is one the build makes (docs/robustness.md,
+/// "Merging parts"). Without bricks the pages' bytes are copied, not recompressed.
 StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> parts,
                                      const std::filesystem::path& path,
-                                     Progress& progress = Progress::Silent());
+                                     Progress& progress = Progress::Silent(),
+                                     const MergeOptions& options = {});
 
 }  // namespace svokit
