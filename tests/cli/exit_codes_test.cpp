@@ -23,36 +23,14 @@ namespace fs = std::filesystem;
 class ExitCodes : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    inputs_ = new TempDir;
-    for (const char* name : {"uv-torus.obj", "uv-torus.mtl", "uv-torus.png"}) {
-      fs::copy_file(DataDir() / name, *inputs_ / name);
-    }
-    const std::string mesh = Input("uv-torus.obj");
-    ASSERT_EQ(RunTool("svo-import", {mesh, "-o", Input("t.svm"), "-q"}).exit_code, 0);
-    ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", "64", "-o", Input("t.vfrag"), "-q"}).exit_code,
-              0);
-    ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "64", "-o", Input("t.svo"), "-q"}).exit_code, 0);
-    for (const char* k : {"0", "1"}) {
-      ASSERT_EQ(RunTool("mesh2svo",
-                        {mesh, "-r", "300", "--bricks", "none", "--pages", std::string(k) + "/2",
-                         "-o", Input(k + std::string(".svopart")), "-q"})
-                    .exit_code,
-                0);
-      // With bricks: pages as built alone and their shells, which the merge completes.
-      std::string bricked = "b";
-      bricked += k;
-      bricked += ".svopart";
-      ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "300", "--pages", std::string(k) + "/2", "-o",
-                                     Input(bricked), "-q"})
-                    .exit_code,
-                0);
-    }
+    inputs_ = new ChainInputs;
+    inputs_->Make(64, 300, true);
   }
   static void TearDownTestSuite() {
     delete inputs_;
     inputs_ = nullptr;
   }
-  static std::string Input(const std::string& name) { return (*inputs_ / name).string(); }
+  static std::string Input(const std::string& name) { return inputs_->Path(name); }
 
   struct Run {
     std::string tool;
@@ -132,10 +110,10 @@ class ExitCodes : public ::testing::Test {
     EXPECT_TRUE(left.empty()) << what << " left " << left.front();
   }
 
-  static TempDir* inputs_;
+  static ChainInputs* inputs_;
 };
 
-TempDir* ExitCodes::inputs_ = nullptr;
+ChainInputs* ExitCodes::inputs_ = nullptr;
 
 std::vector<std::string> Quiet(std::vector<std::string> args) {
   args.push_back("-q");

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
@@ -44,6 +45,26 @@ struct RunOptions {
   std::uint64_t file_size = 0;
   std::vector<std::string> wrapper;
 };
+
+/// Waits for the tool run as child `pid`, killing it after `seconds` of wall time when > 0; its
+/// exit code, or 128 + the signal that ended it.
+inline int WaitForTool(pid_t pid, int seconds) {
+  int status = 0;
+  if (seconds <= 0) {
+    ::waitpid(pid, &status, 0);
+  } else {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+    while (::waitpid(pid, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
 
 /// Runs `tool` with stdin from /dev/null and its output captured.
 inline ToolResult RunTool(const std::string& tool, const std::vector<std::string>& args,
@@ -81,21 +102,7 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
     ::_exit(127);
   }
   if (pid < 0) return r;
-  int status = 0;
-  if (options.seconds <= 0) {
-    ::waitpid(pid, &status, 0);
-  } else {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options.seconds);
-    while (::waitpid(pid, &status, WNOHANG) == 0) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        ::kill(pid, SIGKILL);
-        ::waitpid(pid, &status, 0);
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.exit_code = WaitForTool(pid, options.seconds);
   r.out = ReadText(out_path);
   r.err = ReadText(err_path);
   return r;
@@ -107,6 +114,37 @@ inline ToolResult RunTool(const std::string& tool, const std::vector<std::string
                           int seconds = 0) {
   return RunTool(tool, args, RunOptions{seconds, seconds > 0 ? std::uint64_t{4} << 30 : 0, 0, {}});
 }
+
+/// What the chain's tools read, made once per suite in a folder of its own: the textured torus
+/// (uv-torus.obj, .mtl, .png), t.svm, t.vfrag and t.svo at `resolution`, and the two parts
+/// 0.svopart and 1.svopart of a build without bricks at `part_resolution` (with `bricked_parts`,
+/// b0.svopart and b1.svopart with bricks too). A tool that fails fails the test.
+struct ChainInputs {
+  TempDir dir;
+
+  std::string Path(const std::string& name) const { return (dir / name).string(); }
+  void Make(int resolution, int part_resolution, bool bricked_parts) {
+    for (const char* name : {"uv-torus.obj", "uv-torus.mtl", "uv-torus.png"}) {
+      std::filesystem::copy_file(DataDir() / name, dir / name);
+    }
+    const std::string mesh = Path("uv-torus.obj"), r = std::to_string(resolution);
+    ASSERT_EQ(RunTool("svo-import", {mesh, "-o", Path("t.svm"), "-q"}).exit_code, 0);
+    ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", r, "-o", Path("t.vfrag"), "-q"}).exit_code, 0);
+    ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", r, "-o", Path("t.svo"), "-q"}).exit_code, 0);
+    for (const std::string k : {"0", "1"}) {
+      const std::vector<std::string> part = {
+          mesh, "-r", std::to_string(part_resolution), "--pages", k + "/2", "-q", "-o"};
+      std::vector<std::string> plain = part;
+      plain.insert(plain.end(), {Path(k + ".svopart"), "--bricks", "none"});
+      ASSERT_EQ(RunTool("mesh2svo", plain).exit_code, 0);
+      if (!bricked_parts) continue;
+      // With bricks: pages as built alone and their shells, which the merge completes.
+      std::vector<std::string> bricked = part;
+      bricked.push_back(Path("b" + k + ".svopart"));
+      ASSERT_EQ(RunTool("mesh2svo", bricked).exit_code, 0);
+    }
+  }
+};
 
 /// Every .svo the suite produces goes through svo-validate (with the mesh it came from, when
 /// given): exit 0, or the report in the failure message.

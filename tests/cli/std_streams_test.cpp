@@ -98,17 +98,7 @@ ToolResult RunWithStreams(const std::string& tool, const std::vector<std::string
   }
   ::close(pipe_fds[1]);
   if (pid < 0) return r;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.exit_code = WaitForTool(pid, 120);
   if (fs::exists(out_path)) r.out = ReadText(out_path);
   if (fs::exists(err_path)) r.err = ReadText(err_path);
   return r;
@@ -118,28 +108,14 @@ ToolResult RunWithStreams(const std::string& tool, const std::vector<std::string
 class HostileEnvironment : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    inputs_ = new TempDir;
-    for (const char* name : {"uv-torus.obj", "uv-torus.mtl", "uv-torus.png"}) {
-      fs::copy_file(DataDir() / name, *inputs_ / name);
-    }
-    const std::string mesh = Input("uv-torus.obj");
-    ASSERT_EQ(RunTool("svo-import", {mesh, "-o", Input("t.svm"), "-q"}).exit_code, 0);
-    ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", "32", "-o", Input("t.vfrag"), "-q"}).exit_code,
-              0);
-    ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "32", "-o", Input("t.svo"), "-q"}).exit_code, 0);
-    for (const char* k : {"0", "1"}) {
-      ASSERT_EQ(RunTool("mesh2svo",
-                        {mesh, "-r", "200", "--bricks", "none", "--pages", std::string(k) + "/2",
-                         "-o", Input(k + std::string(".svopart")), "-q"})
-                    .exit_code,
-                0);
-    }
+    inputs_ = new ChainInputs;
+    inputs_->Make(32, 200, false);
   }
   static void TearDownTestSuite() {
     delete inputs_;
     inputs_ = nullptr;
   }
-  static std::string Input(const std::string& name) { return (*inputs_ / name).string(); }
+  static std::string Input(const std::string& name) { return inputs_->Path(name); }
 
   struct Tool {
     std::string name;
@@ -195,10 +171,10 @@ class HostileEnvironment : public ::testing::Test {
     return names;
   }
 
-  static TempDir* inputs_;
+  static ChainInputs* inputs_;
 };
 
-TempDir* HostileEnvironment::inputs_ = nullptr;
+ChainInputs* HostileEnvironment::inputs_ = nullptr;
 
 std::string Show(const ToolResult& r) {
   return "exit " + std::to_string(r.exit_code) + ": " + r.err;
