@@ -92,6 +92,8 @@ inline int Run(const std::string& tool, CLI::App& cli, int argc, char** argv,
       WriteDiagnostic(fmt::format("{}: {} (see --help)\n", tool, e.what()));
       code = static_cast<int>(StatusCode::kBadInput);
     }
+  } catch (const OutOfMemoryError& e) {
+    code = Fail(tool, Status::OutOfMemory("{}: {}", input.string(), e.what()));
   } catch (const std::bad_alloc&) {
     code = Fail(tool, Status::OutOfMemory("{}: out of memory", input.string()));
   } catch (const std::system_error& e) {

@@ -4,7 +4,8 @@
 # signal, never a hang (a generous 60 s cap per run turns a hang into a failure).
 # Usage: address_space_sweep_test.sh BIN_DIR MESH_DIR png|tiff
 #   The PNG is decoded by svokit's own decoder; the TIFF loads the OpenImageIO plugin, which
-#   refuses (exit 5) when the address space left cannot hold it.
+#   refuses (exit 5, naming the texture, what it needs and what is left) when the address space
+#   left cannot hold it.
 set -euo pipefail
 bin="$1" data="$2" kind="$3"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
@@ -28,6 +29,11 @@ for ((mb = 150; mb <= 800; mb += 50)); do
       refused=$((refused + 1))
       if [ "$lines" != 1 ] || [ -e "$tmp/out.svo" ]; then
         echo "$mb MB: exit 5 with $lines lines on stderr or an output left:"; cat "$tmp/stderr"
+        failed=1
+      fi
+      # The plugin's refusal says what it needs and what is left, not just "out of memory".
+      if [ "$kind" = tiff ] && ! grep -q "MiB of address space, [0-9]* MiB are left" "$tmp/stderr"; then
+        echo "$mb MB: exit 5 without the plugin's needs:"; cat "$tmp/stderr"
         failed=1
       fi ;;
     *) echo "$mb MB: FAILED, exit $status (137 is the 60 s cap)"; failed=1 ;;

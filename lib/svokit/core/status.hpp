@@ -2,6 +2,7 @@
 // Errors are values: a library call returns a Status (or StatusOr<T>) with a one-line message; apps
 // turn it into one line on stderr and an exit code.
 
+#include <new>
 #include <string>
 #include <utility>
 #include <variant>
@@ -59,6 +60,17 @@ class [[nodiscard]] Status {
 
  private:
   StatusCode code_ = StatusCode::kOk;
+  std::string message_;
+};
+
+/// Memory that ran out where a Status cannot be returned (a constructor, a callback), with the
+/// Status's message: a std::bad_alloc, so code that only knows those still releases what it holds.
+class OutOfMemoryError : public std::bad_alloc {
+ public:
+  explicit OutOfMemoryError(std::string message) : message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+
+ private:
   std::string message_;
 };
 

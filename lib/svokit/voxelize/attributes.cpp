@@ -141,7 +141,7 @@ AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoin
   });
   for (std::size_t t : used) {
     // A texture that cannot be decoded is the input's fault; memory running out is not.
-    if (errors[t].code() == StatusCode::kOutOfMemory) throw std::bad_alloc();
+    if (errors[t].code() == StatusCode::kOutOfMemory) throw OutOfMemoryError(errors[t].message());
     if (!errors[t].ok()) {
       warnings_.push_back(errors[t].message() + "; its materials use their base colour");
     } else if (!textures_[t].valid()) {
