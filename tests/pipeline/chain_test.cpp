@@ -246,6 +246,37 @@ TEST(Chain, WarningsReachTheSink) {
   EXPECT_TRUE(octree("t.svo", std::nullopt, std::nullopt, nullptr)().ok());
 }
 
+// The stages that run long on large grids (bricks, contours, write, read) count their units as
+// they go: by the time each finishes it has reported (nearly) all of them, so a bar moves instead
+// of sitting at 0 % and jumping to 100 %.
+TEST(Chain, LongStagesReportTheirUnitsAsTheyGo) {
+  test::TempDir dir;
+  const auto units = [](const Progress& progress, const std::string& name) {
+    for (const Progress::Timing& t : progress.timings()) {
+      if (t.stage == name) return std::pair{t.units_done, t.units};
+    }
+    ADD_FAILURE() << "no stage " << name;
+    return std::pair<std::uint64_t, std::uint64_t>{0, 0};
+  };
+  Progress build(Progress::Style::kQuiet);
+  ASSERT_TRUE(MeshToSvo(MeshTo(dir / "t.svo"), build).ok());
+  const auto [bricks_done, bricks] = units(build, "bricks");
+  EXPECT_GT(bricks, 10'000u);  // every node above the voxels
+  EXPECT_EQ(bricks_done, bricks);
+  // Nodes without a piece of a triangle are not fitted: nearly all are.
+  const auto [contours_done, contours] = units(build, "contours");
+  EXPECT_GT(contours, bricks);
+  EXPECT_LE(contours_done, contours);
+  EXPECT_GE(contours_done, contours * 9 / 10);
+  const auto [written, pages] = units(build, "write");
+  EXPECT_GE(pages, 4u);
+  EXPECT_EQ(written, pages);
+
+  Progress read(Progress::Style::kQuiet);
+  ASSERT_TRUE(ReadSvoStage(read, dir / "t.svo", std::nullopt).ok());
+  EXPECT_EQ(units(read, "read"), std::pair(pages, pages));
+}
+
 // Each call checks its output before it imports anything: no stage runs, no file appears.
 TEST(Chain, ABadOutputIsRefusedBeforeAnyWork) {
   test::TempDir dir;

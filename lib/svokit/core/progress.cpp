@@ -35,11 +35,12 @@ Progress::Stage::~Stage() {
     if (progress_.style_ == Style::kBar) WriteDiagnostic("\r\x1b[K", progress_.out_);
     return;
   }
-  done_ = total_;
+  const std::uint64_t reported = done_.load();
+  done_ = total_.load();
   Draw(true);
   if (progress_.record_) {
     std::lock_guard lock(progress_.timings_mutex_);
-    progress_.timings_.push_back({name_, seconds()});
+    progress_.timings_.push_back({name_, seconds(), reported, total_.load()});
   }
 }
 
@@ -69,15 +70,15 @@ void Progress::Stage::Advance(std::uint64_t units) {
 
 // "45% 12.3 s, 1234/5000, 12.5 MB written, ETA 15 s": what a long stage has done and has left.
 std::string Progress::Stage::Status() const {
-  const std::uint64_t done = std::min(done_.load(), total_);
+  const std::uint64_t total = total_.load(), done = std::min(done_.load(), total);
   const double t = seconds();
-  const double frac = total_ == 0 ? 1.0 : static_cast<double>(done) / static_cast<double>(total_);
+  const double frac = total == 0 ? 1.0 : static_cast<double>(done) / static_cast<double>(total);
   std::string s = fmt::format("{:3.0f}% {:.1f} s", frac * 100.0, t);
-  if (total_ > 1) s += fmt::format(", {}/{}", done, total_);
+  if (total > 1) s += fmt::format(", {}/{}", done, total);
   if (const std::uint64_t b = bytes_.load(); b > 0) {
     s += fmt::format(", {:.1f} MB written", static_cast<double>(b) / 1e6);
   }
-  if (done > 0 && done < total_) s += fmt::format(", ETA {:.0f} s", t * (1.0 - frac) / frac);
+  if (done > 0 && done < total) s += fmt::format(", ETA {:.0f} s", t * (1.0 - frac) / frac);
   return s;
 }
 
@@ -97,10 +98,11 @@ void Progress::Stage::Draw(bool final) {
       break;
     case Style::kBar: {
       constexpr int kWidth = 30;
+      const std::uint64_t total = total_.load();
       const double frac =
-          total_ == 0
+          total == 0
               ? 1.0
-              : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total_));
+              : std::min(1.0, static_cast<double>(done_.load()) / static_cast<double>(total));
       const int filled = static_cast<int>(frac * kWidth);
       WriteDiagnostic(
           fmt::format("\r{:<12} [{}{}] {}{}\x1b[K{}", name_, std::string(filled, '#'),

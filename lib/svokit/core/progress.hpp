@@ -23,10 +23,12 @@ class Progress {
 
   Style style() const { return style_; }
 
-  /// Name and wall time of every stage that finished (not cancelled), in finishing order.
+  /// Name and wall time of every stage that finished (not cancelled), in finishing order, and
+  /// the work units it had reported done of its total when it finished.
   struct Timing {
     std::string stage;
     double seconds;
+    std::uint64_t units_done = 0, units = 0;
   };
   std::vector<Timing> timings() const;
 
@@ -40,6 +42,8 @@ class Progress {
 
     /// Thread-safe; cheap enough to call from parallel loops once per chunk.
     void Advance(std::uint64_t units = 1);
+    /// The stage's work units, once known (a reader learns its page count from the file).
+    void SetTotal(std::uint64_t total) { total_.store(total, std::memory_order_relaxed); }
     /// The stage failed: no "done" line (a bar is erased instead).
     void Cancel() { cancelled_ = true; }
     /// Text appended to the stage's final line (e.g. "1.2 M triangles").
@@ -55,7 +59,7 @@ class Progress {
     Progress& progress_;
     std::string name_;
     std::string summary_;
-    std::uint64_t total_;
+    std::atomic<std::uint64_t> total_;
     bool cancelled_ = false;
     std::atomic<std::uint64_t> done_{0};
     std::atomic<std::uint64_t> bytes_{0};

@@ -80,9 +80,8 @@ struct Build {
     }
     StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), &mesh, options, meta, progress);
     if (!svo.ok()) return svo.status().WithContext(request.input.string());
-    StatusOr<SvoFileStats> written = RunStage(progress, "write", [&] {
-      return WriteSvo(*svo, request.output, request.build.compression);
-    });
+    StatusOr<SvoFileStats> written =
+        WriteSvoStage(progress, *svo, request.output, request.build.compression);
     if (!written.ok()) return written.status();
     report.octree.voxels = svo->voxel_count();
     report.octree.depth = svo->depth();

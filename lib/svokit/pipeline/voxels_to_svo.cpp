@@ -84,8 +84,7 @@ StatusOr<OctreeReport> BuildWhole(const VoxelsToSvoRequest& r, BuildOptions opti
   StatusOr<CompactSvo> svo = BuildCompactSvo(std::move(*voxels), *mesh ? &**mesh : nullptr, options,
                                              ProvenanceJson(provenance), progress);
   if (!svo.ok()) return svo.status().WithContext(r.input.string());
-  StatusOr<SvoFileStats> written =
-      RunStage(progress, "write", [&] { return WriteSvo(*svo, r.output, r.build.compression); });
+  StatusOr<SvoFileStats> written = WriteSvoStage(progress, *svo, r.output, r.build.compression);
   if (!written.ok()) return written.status();
   OctreeReport report;
   report.voxels = svo->voxel_count();

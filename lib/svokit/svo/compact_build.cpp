@@ -108,18 +108,21 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
   }
   if (shape.has_normal) whole.normals = std::move(voxels.normals);
   if (shape.brick_side != 0) {
-    Progress::Stage stage(progress, "bricks", 1);
+    // Units: the nodes filtered, each level's once (the layouts go first).
+    std::uint64_t nodes = 0;
+    for (std::uint32_t l = 0; l < shape.depth; ++l) nodes += whole.tree.NodeCount(l);
+    Progress::Stage stage(progress, "bricks", nodes);
     for (std::uint32_t l = 0; l < shape.depth; ++l) {
       whole.layouts.push_back(LayOutSamples(whole.tree, l, shape.brick_side));
     }
-    whole.samples =
-        FilterSamples(whole.tree, whole.layouts, shape.brick_side, VoxelSamplesOf(whole, shape));
-    stage.Advance();
+    whole.samples = FilterSamples(whole.tree, whole.layouts, shape.brick_side,
+                                  VoxelSamplesOf(whole, shape), &stage);
   }
   if (options.contours) {
-    Progress::Stage stage(progress, "contours", 1);
-    whole.contours = FitContours(*mesh, frame.grid, shape.depth, keys, options.contour);
-    stage.Advance();
+    std::uint64_t nodes = 0;
+    for (const std::vector<std::uint64_t>& level : keys) nodes += level.size();
+    Progress::Stage stage(progress, "contours", nodes);
+    whole.contours = FitContours(*mesh, frame.grid, shape.depth, keys, options.contour, &stage);
   } else {
     whole.contours.assign(shape.depth + 1, {});  // no word per node: 4 B per voxel not touched
   }

@@ -436,9 +436,21 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
 }
 
 struct Workspace {
-  explicit Workspace(std::uint32_t depth) : children(depth + 1) {}
+  Workspace(std::uint32_t depth, Progress::Stage* to) : children(depth + 1), stage(to) {}
+  ~Workspace() { Report(0); }
+  Workspace(const Workspace&) = delete;
+  Workspace& operator=(const Workspace&) = delete;
+  // Nodes fitted are reported to the stage a few thousand at a time.
+  void Report(std::uint64_t at_least) {
+    if (stage != nullptr && fitted > at_least) {
+      stage->Advance(fitted);
+      fitted = 0;
+    }
+  }
   std::vector<std::array<Pieces, 8>> children;  // per level: buffers for a node's children
   Scratch scratch;
+  Progress::Stage* stage;
+  std::uint64_t fitted = 0;
 };
 
 void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const Pieces& pieces,
@@ -449,6 +461,8 @@ void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const
   const Vec3d lo{mc.x * size, mc.y * size, mc.z * size};
   const Vec3d center = lo + Vec3d{size, size, size} * 0.5;
   (*ctx.out)[level - ctx.first][index] = FitNode(ctx, pieces, center, size, ws.scratch);
+  ++ws.fitted;
+  ws.Report(4096);
   if (level == ctx.last) return;
 
   const auto& next = ctx.keys[level + 1 - ctx.first];
@@ -475,7 +489,7 @@ void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const
   if (pieces.pieces.size() >= kParallelPieces) {
     // Each child writes only its own subtree's fixed indices: the result is thread-independent.
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      Workspace w(ctx.depth);
+      Workspace w(ctx.depth, ws.stage);
       visit(i, w);
     });
   } else {
@@ -499,7 +513,7 @@ ContourFitter::ContourFitter(const Mesh& mesh, const GridTransform& grid, std::u
 
 std::vector<std::vector<std::uint32_t>> ContourFitter::FitSubtree(
     std::uint32_t first, std::span<const std::vector<std::uint64_t>> level_keys,
-    std::span<const std::uint32_t> triangles) const {
+    std::span<const std::uint32_t> triangles, Progress::Stage* stage) const {
   std::vector<std::vector<std::uint32_t>> out(level_keys.size());
   for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
   if (level_keys.empty() || level_keys[0].size() != 1 ||
@@ -558,14 +572,15 @@ std::vector<std::vector<std::uint32_t>> ContourFitter::FitSubtree(
     std::swap(pieces, next);
   }
   if (pieces.pieces.empty()) return out;
-  Workspace ws(depth_);
+  Workspace ws(depth_, stage);
   VisitNode(ctx, first, 0, pieces, ws);
   return out;
 }
 
 std::vector<std::vector<std::uint32_t>> FitContours(
     const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
-    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options) {
+    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options,
+    Progress::Stage* stage) {
   if (level_keys.size() != std::size_t{depth} + 1 || level_keys[0].empty()) {
     std::vector<std::vector<std::uint32_t>> out(level_keys.size());
     for (std::size_t l = 0; l < level_keys.size(); ++l) out[l].assign(level_keys[l].size(), 0);
@@ -573,7 +588,7 @@ std::vector<std::vector<std::uint32_t>> FitContours(
   }
   std::vector<std::uint32_t> all(mesh.triangles.size());
   for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<std::uint32_t>(t);
-  return ContourFitter(mesh, grid, depth, options).FitSubtree(0, level_keys, all);
+  return ContourFitter(mesh, grid, depth, options).FitSubtree(0, level_keys, all, stage);
 }
 
 }  // namespace svokit

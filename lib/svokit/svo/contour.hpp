@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "svokit/core/grid_transform.hpp"
+#include "svokit/core/progress.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/svo/svo.hpp"
 
@@ -40,9 +41,11 @@ struct ContourOptions {
 /// node, the contour word or 0 where the node keeps none (no geometry, or the slab fails the
 /// storage rule). A node at level L with key k covers the closed voxel-space cube
 /// MortonDecode(k)·2^(depth−L) + [0, 2^(depth−L)]³. Deterministic for any thread count.
+/// `stage`, when given, advances by each node fitted.
 std::vector<std::vector<std::uint32_t>> FitContours(
     const Mesh& mesh, const GridTransform& grid, std::uint32_t depth,
-    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options = {});
+    std::span<const std::vector<std::uint64_t>> level_keys, const ContourOptions& options = {},
+    Progress::Stage* stage = nullptr);
 
 /// FitContours for any subtree of the octree of one mesh, e.g. one page at a time: the mesh is
 /// mapped to voxel space once.
@@ -57,7 +60,7 @@ class ContourFitter {
   /// a function of the triangle and the node's path alone.
   std::vector<std::vector<std::uint32_t>> FitSubtree(
       std::uint32_t first, std::span<const std::vector<std::uint64_t>> level_keys,
-      std::span<const std::uint32_t> triangles) const;
+      std::span<const std::uint32_t> triangles, Progress::Stage* stage = nullptr) const;
 
  private:
   const Mesh& mesh_;

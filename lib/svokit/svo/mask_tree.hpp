@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "svokit/core/bit_count.hpp"
+#include "svokit/core/progress.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -82,30 +83,36 @@ Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
 std::vector<Neighbourhood> LevelNeighbourhoods(const MaskTree& tree, std::uint32_t level);
 
 /// Calls body(i, neighbourhood) for every node i of `level`, in parallel over subtrees (in no
-/// particular order). Neighbourhoods are carried down from a level of at most a few thousand
-/// nodes, so no node is looked up by key.
+/// particular order), advancing `stage` (when given) by the nodes visited. Neighbourhoods are
+/// carried down from a level of at most a few thousand nodes, so no node is looked up by key.
 template <class Body>
-void ForEachNeighbourhood(const MaskTree& tree, std::uint32_t level, const Body& body) {
+void ForEachNeighbourhood(const MaskTree& tree, std::uint32_t level, const Body& body,
+                          Progress::Stage* stage = nullptr) {
   std::uint32_t top = tree.first_level;
   while (top < level && tree.NodeCount(top) < 1024) ++top;
   const std::vector<Neighbourhood> start = LevelNeighbourhoods(tree, top);
-  const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t i,
-                         const Neighbourhood& nb) -> void {
-    if (l == level) {
-      body(i, nb);
-      return;
-    }
-    const std::uint8_t m = tree.masks[l - tree.first_level][i];
-    std::uint64_t child = tree.first_child[l - tree.first_level][i];
-    for (unsigned c = 0; c < 8; ++c) {
-      if (m >> c & 1u) self(self, l + 1, child++, ChildNeighbourhood(tree, l, nb, c));
-    }
-  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size(), 16),
                     [&](const tbb::blocked_range<std::size_t>& r) {
+                      std::uint64_t visited = 0;
+                      const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t i,
+                                             const Neighbourhood& nb) -> void {
+                        if (l == level) {
+                          body(i, nb);
+                          ++visited;
+                          return;
+                        }
+                        const std::uint8_t m = tree.masks[l - tree.first_level][i];
+                        std::uint64_t child = tree.first_child[l - tree.first_level][i];
+                        for (unsigned c = 0; c < 8; ++c) {
+                          if (m >> c & 1u) {
+                            self(self, l + 1, child++, ChildNeighbourhood(tree, l, nb, c));
+                          }
+                        }
+                      };
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         visit(visit, top, i, start[i]);
                       }
+                      if (stage != nullptr) stage->Advance(visited);
                     });
 }
 

@@ -243,7 +243,7 @@ class VoxelTile {
 // by tile: the nodes below one node up to four levels higher, which `tile` gathers the voxels of.
 template <class Body>
 void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, Flags f,
-                        const Body& body) {
+                        const Body& body, Progress::Stage* stage = nullptr) {
   const std::uint32_t voxels = tree.last_level(), above = voxels - 1;
   const std::uint32_t tile_level = std::max(tree.first_level, voxels >= 4 ? voxels - 4 : 0u);
   const std::uint32_t width = 1u << (voxels - tile_level);
@@ -295,6 +295,7 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
     };
     descend(descend, tile_level, t, tile_nb, 0, 0, 0);
     for (const Node& n : nodes) body(tile, n.i, n.corner);
+    if (stage != nullptr) stage->Advance(nodes.size());
   });
 }
 
@@ -404,82 +405,90 @@ LevelSamples Allocate(std::uint64_t n, Flags f) {
 // The level above the voxels: each node's samples from the voxel-level samples around it (encoded,
 // as the voxel bricks would store them, then decoded), which its tile computes once.
 void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::uint32_t side,
-                       const VoxelSamplesSource& source, Flags f, LevelSamples& out) {
-  ForEachAboveVoxels(tree, source, f, [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
-    // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
-    // voxels.
-    int origin[3];
-    for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
-    const int step = side == 3 ? 1 : 2;
-    const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
-      return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
-                          origin[2] + step * (z - 1));
-    };
-    // No per-node cache of taps: the tile holds each point's decoded sample once already.
-    StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
-  });
+                       const VoxelSamplesSource& source, Flags f, LevelSamples& out,
+                       Progress::Stage* stage) {
+  ForEachAboveVoxels(
+      tree, source, f,
+      [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
+        // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
+        // voxels.
+        int origin[3];
+        for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
+        const int step = side == 3 ? 1 : 2;
+        const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
+          return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
+                              origin[2] + step * (z - 1));
+        };
+        // No per-node cache of taps: the tile holds each point's decoded sample once already.
+        StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
+      },
+      stage);
 }
 
 // An inner level's samples from the stored samples of the level below.
 void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
                  const SampleLayout& finer_layout, const LevelSamples& finer, std::uint32_t side,
-                 Flags f, LevelSamples& out) {
-  ForEachNeighbourhood(tree, level, [&](std::uint64_t i, const Neighbourhood& nb) {
-    const ChildBlock block = ChildrenOf(tree, level, nb);
-    const auto finer_sample = [&](int x, int y, int z) {
-      // Finer lattice point 2k + d − 1: its home node's block coordinate and home sample.
-      const int t[3] = {x, y, z};
-      int home[3], k[3];
-      for (int a = 0; a < 3; ++a) {
-        if (side == 3) {
-          const int r = t[a] - 1;  // −1..5
-          const int half = r < 0 ? -1 : r / 2;
-          home[a] = half + 2;
-          k[a] = r - 2 * half;
-        } else {
-          home[a] = t[a] + 1;
-          k[a] = 0;
-        }
-      }
-      const std::uint64_t at =
-          PointIndex(finer_layout, static_cast<unsigned>(k[0] + side * (k[1] + side * k[2])),
-                     [&](unsigned fb) {
-                       return block[BlockIndex(home[0] - static_cast<int>(fb & 1),
-                                               home[1] - static_cast<int>(fb >> 1 & 1),
-                                               home[2] - static_cast<int>(fb >> 2 & 1))];
-                     });
-      if (at == ~std::uint64_t{0}) return PremultipliedSample{};
-      const EncodedSample e = LoadSample(finer, at);
-      return e.opacity == 0 ? PremultipliedSample{} : DecodePremultiplied(e, f.color, f.normal);
-    };
-    TapCache taps(finer_sample);
-    StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
-  });
+                 Flags f, LevelSamples& out, Progress::Stage* stage) {
+  ForEachNeighbourhood(
+      tree, level,
+      [&](std::uint64_t i, const Neighbourhood& nb) {
+        const ChildBlock block = ChildrenOf(tree, level, nb);
+        const auto finer_sample = [&](int x, int y, int z) {
+          // Finer lattice point 2k + d − 1: its home node's block coordinate and home sample.
+          const int t[3] = {x, y, z};
+          int home[3], k[3];
+          for (int a = 0; a < 3; ++a) {
+            if (side == 3) {
+              const int r = t[a] - 1;  // −1..5
+              const int half = r < 0 ? -1 : r / 2;
+              home[a] = half + 2;
+              k[a] = r - 2 * half;
+            } else {
+              home[a] = t[a] + 1;
+              k[a] = 0;
+            }
+          }
+          const std::uint64_t at =
+              PointIndex(finer_layout, static_cast<unsigned>(k[0] + side * (k[1] + side * k[2])),
+                         [&](unsigned fb) {
+                           return block[BlockIndex(home[0] - static_cast<int>(fb & 1),
+                                                   home[1] - static_cast<int>(fb >> 1 & 1),
+                                                   home[2] - static_cast<int>(fb >> 2 & 1))];
+                         });
+          if (at == ~std::uint64_t{0}) return PremultipliedSample{};
+          const EncodedSample e = LoadSample(finer, at);
+          return e.opacity == 0 ? PremultipliedSample{} : DecodePremultiplied(e, f.color, f.normal);
+        };
+        TapCache taps(finer_sample);
+        StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
+      },
+      stage);
 }
 
 // Levels from − 1 .. first_level of `out` (indexed from first_level), each filtered from the one
 // below it; level `from`'s samples are in.
 void FilterLevelsAbove(const MaskTree& tree, std::span<const SampleLayout> layouts,
                        std::uint32_t side, Flags f, std::uint32_t from,
-                       std::vector<LevelSamples>& out) {
+                       std::vector<LevelSamples>& out, Progress::Stage* stage = nullptr) {
   for (std::uint32_t level = from; level-- > tree.first_level;) {
     const std::size_t k = level - tree.first_level;
     out[k] = Allocate(layouts[k].size(), f);
-    FilterInner(tree, level, layouts[k], layouts[k + 1], out[k + 1], side, f, out[k]);
+    FilterInner(tree, level, layouts[k], layouts[k + 1], out[k + 1], side, f, out[k], stage);
   }
 }
 
 }  // namespace
 
 std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
-                                        std::uint32_t side, const VoxelSamplesSource& source) {
+                                        std::uint32_t side, const VoxelSamplesSource& source,
+                                        Progress::Stage* stage) {
   const Flags f{!source.colors.empty(), !source.normals.empty()};
   const std::uint32_t voxels = tree.last_level();
   std::vector<LevelSamples> out(voxels - tree.first_level);
   if (out.empty()) return out;
   out.back() = Allocate(layouts.back().size(), f);
-  FilterAboveVoxels(tree, layouts.back(), side, source, f, out.back());
-  FilterLevelsAbove(tree, layouts, side, f, voxels - 1, out);
+  FilterAboveVoxels(tree, layouts.back(), side, source, f, out.back(), stage);
+  FilterLevelsAbove(tree, layouts, side, f, voxels - 1, out, stage);
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/svo/mask_tree.hpp"
 #include "svokit/svo/sample_layout.hpp"
 #include "svokit/svo/svo.hpp"
@@ -29,9 +30,10 @@ struct VoxelSamplesSource {
 
 /// Samples of the levels first_level .. last_level() − 1 of `tree`, whose last level holds the
 /// voxels; `layouts[k]` is level first_level + k's layout for bricks of `side`. Colour and normal
-/// planes are filled when `source` has them.
+/// planes are filled when `source` has them. `stage`, when given, advances by each node filtered.
 std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const SampleLayout> layouts,
-                                        std::uint32_t side, const VoxelSamplesSource& source);
+                                        std::uint32_t side, const VoxelSamplesSource& source,
+                                        Progress::Stage* stage = nullptr);
 
 /// Samples of the levels first_level .. last_level() − 1 of `tree` from those of its last level,
 /// `last` (laid out by layouts.back()), as FilterSamples filters each level from the one below:

@@ -27,22 +27,23 @@ namespace {
 using namespace svo_detail;
 
 bool Decode(const container::Frame& file, std::optional<std::uint32_t> max_level, IssueSink& sink,
-            Svo& svo) {
+            Svo& svo, Progress::Stage* stage = nullptr) {
   if (file.version() == 1) return DecodeVersion1(file, max_level, sink, svo);
-  return DecodeVersion2(file, max_level, sink, svo) &&
+  return DecodeVersion2(file, max_level, sink, svo, stage) &&
          DecodeAo(file, max_level.value_or(svo.depth), sink, svo);
 }
 
 // The strict readers: a frame with issues fails on its first, an octree on its first issue.
 StatusOr<Svo> DecodeStrict(const StatusOr<container::Frame>& opened,
-                           std::optional<std::uint32_t> max_level) {
+                           std::optional<std::uint32_t> max_level,
+                           Progress::Stage* stage = nullptr) {
   if (!opened.ok()) return opened.status();
   if (!opened->issues().empty()) {
     return Status(StatusCode::kBadInput, opened->issues().front().message);
   }
   IssueSink sink(/*stop_at_first=*/true);
   Svo svo;
-  if (!Decode(*opened, max_level, sink, svo) || !sink.empty()) {
+  if (!Decode(*opened, max_level, sink, svo, stage) || !sink.empty()) {
     return Status(StatusCode::kBadInput, sink.empty() ? opened->name() + ": inconsistent octree"
                                                       : sink.issues().front().message);
   }
@@ -92,14 +93,19 @@ StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& 
                       max_level);
 }
 
-StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint32_t> max_level) {
+StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint32_t> max_level,
+                      Progress::Stage* stage) {
   const std::uint32_t last = max_level.value_or(kMaxDepth);
-  return DecodeStrict(container::Frame::Open(path, kSvoFormat, &SectionsToLoad, &last), max_level);
+  return DecodeStrict(container::Frame::Open(path, kSvoFormat, &SectionsToLoad, &last), max_level,
+                      stage);
 }
 
 StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
                            std::optional<std::uint32_t> max_level) {
-  StatusOr<Svo> svo = RunStage(progress, "read", [&] { return ReadSvo(path, max_level); });
+  // Units: the pages, once the file says how many.
+  Progress::Stage stage(progress, "read", 1);
+  StatusOr<Svo> svo = ReadSvo(path, max_level, &stage);
+  if (!svo.ok()) stage.Cancel();
   if (svo.ok() && max_level && *max_level > svo->depth) {
     return Status::BadInput("{}: level {} exceeds the octree's depth {}", path.string(), *max_level,
                             svo->depth);

@@ -103,7 +103,12 @@ class PagedSvoWriter {
 std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression = {},
                                     SvoFileStats* stats = nullptr);
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
-                                const SvoCompression& compression = {});
+                                const SvoCompression& compression = {},
+                                Progress::Stage* stage = nullptr);
+/// WriteSvo as the "write" stage of `progress`, its units the pages.
+StatusOr<SvoFileStats> WriteSvoStage(Progress& progress, const CompactSvo& svo,
+                                     const std::filesystem::path& path,
+                                     const SvoCompression& compression);
 /// Writes `input` (a version-2 .svo) again as `output` with `baked`'s per-node ambient occlusion
 /// (every level's `ao`) as its `AOCC` section and `bake` in its META; every other section is
 /// copied as it is.
@@ -114,7 +119,8 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path,
-                      std::optional<std::uint32_t> max_level = std::nullopt);
+                      std::optional<std::uint32_t> max_level = std::nullopt,
+                      Progress::Stage* stage = nullptr);
 /// ReadSvo as the "read" stage of `progress`; a `max_level` below the octree's depth is bad
 /// input.
 StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,

@@ -176,8 +176,9 @@ namespace svo_detail {
 namespace {
 
 // The pages of an octree held whole, encoded in parallel batches and handed on in order.
-PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& writer) {
-  return [&svo, &writer](const PagedSvoWriter::Take& take) -> Status {
+PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& writer,
+                                   Progress::Stage* stage) {
+  return [&svo, &writer, stage](const PagedSvoWriter::Take& take) -> Status {
     const std::uint32_t page_level = writer.page_level();
     const std::vector<std::uint64_t> keys = KeysOfLevel(svo.whole.tree, page_level);
     const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.whole.tree, page_level);
@@ -190,8 +191,11 @@ PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& 
         const std::size_t p = first + i;
         encoded[i] = writer.Encode(PageChunk(svo, page_level, p, nbs[p], keys[p]));
       });
-      for (PagedSvoWriter::EncodedPage& page : encoded)
+      for (PagedSvoWriter::EncodedPage& page : encoded) {
+        if (stage != nullptr) stage->AddBytes(page.bytes.size());
         SVOKIT_RETURN_IF_ERROR(take(std::move(page)));
+      }
+      if (stage != nullptr) stage->Advance(n);
     }
     return Status::Ok();
   };
@@ -413,7 +417,7 @@ StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, 
 // page is decoded again to report it, so the report is in page order too. False when a page
 // failed.
 bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name, IssueSink& sink,
-                 SvoAssembler& assembler, PageVoxels& voxels) {
+                 SvoAssembler& assembler, PageVoxels& voxels, Progress::Stage* stage) {
   bool complete = true;
   const std::size_t batch = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   std::vector<std::optional<StatusOr<SvoChunk>>> decoded(batch);
@@ -437,6 +441,7 @@ bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name,
       assembler.Append(*page, std::move(bricks[i]));
       if (last == v.shape.depth) voxels.Add(p, *page);
     }
+    if (stage != nullptr) stage->Advance(count);
   }
   return complete;
 }
@@ -527,7 +532,7 @@ bool CheckHalos(const PageVoxels& voxels, const std::string& name, IssueSink& si
 }  // namespace
 
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
-                    IssueSink& sink, Svo& svo) {
+                    IssueSink& sink, Svo& svo, Progress::Stage* stage) {
   const std::string& name = file.name();
   StatusOr<Version2> parsed = ParseVersion2(file, sink);
   if (!parsed.ok()) return false;
@@ -538,7 +543,8 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   SvoAssembler assembler(v.shape, last);
   assembler.Append(*top);
   PageVoxels voxels;
-  if (!AppendPages(v, last, name, sink, assembler, voxels)) return false;
+  if (stage != nullptr) stage->SetTotal(std::max<std::size_t>(1, v.pages.size()));
+  if (!AppendPages(v, last, name, sink, assembler, voxels, stage)) return false;
   svo = assembler.Finish(v.grid, v.mode, v.metadata);
   // Each check reports every issue it finds, unless the sink stops at the first.
   bool consistent = CheckLevelCounts(v, svo, last, name, sink);
@@ -556,7 +562,7 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
                                     SvoFileStats* stats) {
   PagedSvoWriter writer(svo.frame, compression);
   return writer.Serialize(
-      svo_detail::PagesOf(svo, writer),
+      svo_detail::PagesOf(svo, writer, nullptr),
       [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
         return TopChunk(svo, writer.page_level());
       },
@@ -564,12 +570,23 @@ std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression&
 }
 
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
-                                const SvoCompression& compression) {
+                                const SvoCompression& compression, Progress::Stage* stage) {
   PagedSvoWriter writer(svo.frame, compression);
-  return writer.Write(path, svo_detail::PagesOf(svo, writer),
+  return writer.Write(path, svo_detail::PagesOf(svo, writer, stage),
                       [&](std::span<const std::uint64_t>) -> StatusOr<SvoChunk> {
                         return TopChunk(svo, writer.page_level());
                       });
+}
+
+StatusOr<SvoFileStats> WriteSvoStage(Progress& progress, const CompactSvo& svo,
+                                     const std::filesystem::path& path,
+                                     const SvoCompression& compression) {
+  const std::uint32_t page_level = PageLevel(svo.depth());
+  Progress::Stage stage(progress, "write",
+                        std::max<std::uint64_t>(1, svo.whole.tree.NodeCount(page_level)));
+  StatusOr<SvoFileStats> written = WriteSvo(svo, path, compression, &stage);
+  if (!written.ok()) stage.Cancel();
+  return written;
 }
 
 }  // namespace svokit
