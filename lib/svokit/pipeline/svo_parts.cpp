@@ -54,6 +54,12 @@ struct BandVoxel {
   OctNormal normal;
 };
 
+// Voxel n of `page` (whose voxel keys are `keys`), with its colour and normal when it has them.
+BandVoxel VoxelOf(const SvoChunk& page, std::span<const std::uint64_t> keys, std::size_t n) {
+  return {keys[n], page.colors.empty() ? HalfRgba() : page.colors[n],
+          page.normals.empty() ? OctNormal() : page.normals[n]};
+}
+
 // The voxel set page `page` was built alone from (BuildPageAlone): its own voxels and those of
 // the pages around it within its grown cube, from `bands` (ascending keys, every page's band).
 VoxelSet PageInput(const SvoFrame& frame, const SvoChunk& page, std::span<const BandVoxel> bands) {
@@ -62,10 +68,7 @@ VoxelSet PageInput(const SvoFrame& frame, const SvoChunk& page, std::span<const 
   const bool per_voxel_colors = frame.shape.has_color && frame.shape.shared_color.empty();
   std::vector<BandVoxel> voxels;
   const std::vector<std::uint64_t> keys = ChunkVoxelKeys(page);
-  for (std::size_t n = 0; n < keys.size(); ++n) {
-    voxels.push_back({keys[n], per_voxel_colors ? page.colors[n] : HalfRgba(),
-                      frame.shape.has_normal ? page.normals[n] : OctNormal()});
-  }
+  for (std::size_t n = 0; n < keys.size(); ++n) voxels.push_back(VoxelOf(page, keys, n));
   const MortonCoord c = MortonDecode(page.root_key);
   const std::int64_t cells = std::int64_t{1} << page.root_level;
   for (std::int64_t dz = -1; dz <= 1; ++dz) {
@@ -127,13 +130,8 @@ Status CheckEachPage(std::span<const PartPage> pages, const char* stage_name, Pr
   return Status::Ok();
 }
 
-// Every page of every part decoded and checked on its own (DecodeSvoPartPage), and pages' keys
-// ascending over the parts. With bricks, a page's samples and halo are then built once more from
-// its voxels and those of the pages around it, as the part's build made them, and must be the
-// page's: a part cannot bring samples its voxels do not make. What that keeps of each page
-// between the two passes is its band, the voxels a neighbour reads (~5% of them).
-Status CheckPages(const std::vector<SvoPart>& parts, const MergeOptions& options,
-                  Progress& progress) {
+// Every page of every part in part order, which must be key order: no page twice.
+StatusOr<std::vector<PartPage>> PagesInKeyOrder(const std::vector<SvoPart>& parts) {
   std::vector<PartPage> pages;
   for (const SvoPart& part : parts) {
     for (const SvoPartPage& page : part.pages) {
@@ -144,7 +142,16 @@ Status CheckPages(const std::vector<SvoPart>& parts, const MergeOptions& options
       pages.push_back({&part, &page});
     }
   }
-  const SvoFrame& frame = parts[0].head.frame;
+  return pages;
+}
+
+// Every page of every part (`pages`, PagesInKeyOrder) decoded and checked on its own
+// (DecodeSvoPartPage). With bricks, a page's samples and halo are then built once more from
+// its voxels and those of the pages around it, as the part's build made them, and must be the
+// page's: a part cannot bring samples its voxels do not make. What that keeps of each page
+// between the two passes is its band, the voxels a neighbour reads (~5% of them).
+Status CheckPages(const SvoFrame& frame, std::span<const PartPage> pages,
+                  const MergeOptions& options, Progress& progress) {
   const bool rebuild = frame.shape.brick_side != 0 && !options.trust_samples;
   const std::uint32_t bits = frame.depth() - PageLevel(frame.depth());
   const std::uint32_t last = (std::uint32_t{1} << bits) - 1;
@@ -159,10 +166,8 @@ Status CheckPages(const std::vector<SvoPart>& parts, const MergeOptions& options
         };
         for (std::size_t n = 0; n < keys.size(); ++n) {
           const MortonCoord c = MortonDecode(keys[n]);
-          if (in_band(c.x) || in_band(c.y) || in_band(c.z)) {
-            bands[i].push_back({keys[n], page.colors.empty() ? HalfRgba() : page.colors[n],
-                                page.normals.empty() ? OctNormal() : page.normals[n]});
-          }
+          if (in_band(c.x) || in_band(c.y) || in_band(c.z))
+            bands[i].push_back(VoxelOf(page, keys, n));
         }
         return Status::Ok();
       }));
@@ -227,19 +232,11 @@ Status CheckOneBuild(const std::vector<SvoPart>& parts) {
 // With bricks the parts hold their pages as built alone: each is completed from its neighbours'
 // shells, and the top levels are filtered from the completed pages' roots.
 StatusOr<SvoFileStats> MergeBuiltAlone(const std::vector<SvoPart>& parts,
+                                       std::span<const PartPage> where,
                                        const std::filesystem::path& path, Progress& progress) {
   const SvoPartHead& head = parts[0].head;
-  std::vector<PartPage> where;
   BuiltPages built;
-  for (const SvoPart& part : parts) {
-    for (const SvoPartPage& page : part.pages) {
-      where.push_back({&part, &page});
-      built.keys.push_back(page.key);
-    }
-  }
-  if (!std::is_sorted(built.keys.begin(), built.keys.end())) {
-    return Status::BadInput("{}: the parts' pages are not in key order", parts[0].name);
-  }
+  for (const PartPage& p : where) built.keys.push_back(p.page->key);
   const auto copy = [](std::span<const std::uint8_t> bytes) {
     return StatusOr<std::vector<std::uint8_t>>(
         std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
@@ -347,8 +344,11 @@ StatusOr<SvoFileStats> MergeSvoParts(std::span<const std::filesystem::path> path
   StatusOr<std::vector<SvoPart>> parts = ReadParts(paths);
   if (!parts.ok()) return parts.status();
   SVOKIT_RETURN_IF_ERROR(CheckOneBuild(*parts));
-  SVOKIT_RETURN_IF_ERROR(CheckPages(*parts, options, progress));
-  if ((*parts)[0].head.frame.shape.brick_side != 0) return MergeBuiltAlone(*parts, path, progress);
+  StatusOr<std::vector<PartPage>> pages = PagesInKeyOrder(*parts);
+  if (!pages.ok()) return pages.status();
+  const SvoFrame& frame = (*parts)[0].head.frame;
+  SVOKIT_RETURN_IF_ERROR(CheckPages(frame, *pages, options, progress));
+  if (frame.shape.brick_side != 0) return MergeBuiltAlone(*parts, *pages, path, progress);
   return MergeFinished(*parts, path, progress);
 }
 
