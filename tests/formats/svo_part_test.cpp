@@ -280,11 +280,14 @@ container::Tag TagOf(const char* name) {
 /// A change to a section's bytes; false drops the section.
 using Change = std::function<bool(std::vector<std::uint8_t>&)>;
 
-// `from`'s sections, `change` applied to `section`'s, written to `to`.
-void Rewrite(const fs::path& from, const fs::path& to, const char* section, const Change& change) {
+// `from`'s sections, `change` applied to `section`'s, written to `to` as format `version`.
+void Rewrite(const fs::path& from, const fs::path& to, const char* section, const Change& change,
+             std::uint32_t version = kSvoPartFormat.version) {
   const StatusOr<container::Reader> file = container::Reader::Open(from, kSvoPartFormat);
   ASSERT_TRUE(file.ok()) << file.status().message();
-  container::Writer writer(kSvoPartFormat, 0);
+  container::FormatId format = kSvoPartFormat;
+  format.version = version;
+  container::Writer writer(format, 0);
   for (const char* name : kSectionOrder) {
     const std::optional<std::span<const std::uint8_t>> bytes = file->Find(TagOf(name));
     ASSERT_TRUE(bytes) << name;
@@ -333,6 +336,13 @@ TEST(SvoPart, DamagedPartsAreRefusedWithOneLineNamingTheFile) {
   // Written again unchanged: the same bytes.
   Rewrite(middle, dir / "same.svopart", "PART", Resized(0));
   ASSERT_TRUE(test::ReadBytes(dir / "same.svopart") == test::ReadBytes(middle));
+
+  // The same bytes labelled version 2: its bricks would be by the older filter.
+  Rewrite(middle, dir / "v2.svopart", "PART", Resized(0), 2);
+  const StatusOr<SvoPart> v2 = ReadSvoPart(dir / "v2.svopart");
+  ASSERT_FALSE(v2.ok());
+  EXPECT_NE(v2.status().message().find("v2.svopart: a version-2 part"), std::string::npos)
+      << v2.status().message();
 
   const auto expect_refused = [&](const fs::path& from, const char* section, const Change& change,
                                   const std::string& why) {

@@ -6,6 +6,7 @@
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "tests/formats/svo_v1_writer.hpp"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,15 @@ int main(int argc, char** argv) {
   const svokit::StatusOr<svokit::Svo> svo = svokit::ReadSvo(argv[1]);
   if (!svo.ok()) {
     std::fprintf(stderr, "svo-v1-writer: %s\n", svo.status().message().c_str());
+    return 1;
+  }
+  // Version 1's bricks are by filter 1: a newer file's would be mislabelled.
+  if (const auto reader = svokit::SvoReader::Open(argv[1]);
+      reader.ok() && svokit::BrickFilterOfVersion(reader->version()) != 1) {
+    std::fprintf(stderr,
+                 "svo-v1-writer: %s is a version-%u file, whose bricks version 1 cannot "
+                 "hold\n",
+                 argv[1], reader->version());
     return 1;
   }
   // Version 1 has neither full leaves nor AO: such an octree would lose them.

@@ -101,8 +101,8 @@ TEST(SvoInspectCli, JsonMatchesTheFile) {
     bytes += LevelBytes(*svo, l).total();
   }
   EXPECT_EQ(j["bytes"]["total"], bytes);
-  // The file: version 2, its sections adding up to its size, pages from the page table.
-  EXPECT_EQ(j["version"], 2);
+  // The file: version 3, its sections adding up to its size, pages from the page table.
+  EXPECT_EQ(j["version"], 3);
   const json& layout = j["file_layout"];
   std::uint64_t stored = 0;
   for (const json& section : layout["sections"]) stored += section["stored"].get<std::uint64_t>();

@@ -1,6 +1,8 @@
 // Brick filtering (bricks.hpp) against values worked out by hand from its definition:
 //   voxel level — a sample averages the voxels whose closed cube holds it (corner 8, edge 4,
 //   face 2, centre 1), empty voxels counting with opacity 0, colour and normal premultiplied;
+//   the level above — the mean of the 2³ voxels around a sample (side 3; [1 3 3 1]/8 per axis
+//   over 4³ for side 2), which the tent over the voxel level's unquantized field equals;
 //   coarser levels — the separable [¼ ½ ¼]³ tent over the finer level's (quantized) samples at
 //   ± half the parent's sample spacing, 0 where no finer node holds the point.
 // Coordinates in the comments are in voxels. For a box of voxels the voxel-level field is a
@@ -710,7 +712,8 @@ void CheckParentsAreTents(const RealSvo& r) {
   const std::int64_t cell = side - 1;
   static constexpr float w[3] = {0.25f, 0.5f, 0.25f};
   std::uint64_t checked = 0, nonzero = 0, normals = 0;
-  for (std::uint32_t l = 0; l < svo.depth; ++l) {
+  // Level depth − 1 comes from the voxels themselves (filter_reference_test checks it).
+  for (std::uint32_t l = 0; l + 1 < svo.depth; ++l) {
     // Level l + 1: lattice point (in its sample spacings) → (node, sample).
     std::unordered_map<std::uint64_t, std::pair<std::uint64_t, std::uint32_t>> finer;
     for (std::size_t i = 0; i < r.keys[l + 1].size(); ++i) {
@@ -776,7 +779,7 @@ void CheckParentsAreTents(const RealSvo& r) {
           }
     }
   }
-  EXPECT_GT(checked, 10000u);
+  EXPECT_GT(checked, 5000u);
   EXPECT_GT(nonzero, 5000u);
   EXPECT_GT(normals, 5000u);
 }

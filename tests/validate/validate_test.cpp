@@ -74,16 +74,18 @@ VoxelSet VoxelsOf(const Mesh& mesh, std::uint32_t resolution, VoxelMode mode) {
   return voxels.ok() ? std::move(*voxels) : VoxelSet{};
 }
 
-Svo Build(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3, bool contours = true) {
+Svo Build(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3, bool contours = true,
+          int brick_filter = kBrickFilter) {
   BuildOptions options;
   options.brick_side = side;
   options.contours = contours;
+  options.brick_filter = brick_filter;
   auto svo = BuildReferenceSvo(voxels, &mesh, options);
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return svo.ok() ? std::move(*svo) : Svo{};
 }
 
-// The version-2 file of the voxels' octree, as svo-build writes it.
+// The file of the voxels' octree, as svo-build writes it.
 std::vector<std::uint8_t> File(const VoxelSet& voxels, const Mesh& mesh, std::uint32_t side = 3,
                                bool contours = true) {
   BuildOptions options;
@@ -266,7 +268,7 @@ TEST(Validate, SandwichAgreesWithBruteForceDistances) {
 struct Fixture {
   Mesh mesh = Torus();
   VoxelSet voxels = VoxelsOf(mesh, 48, VoxelMode::kConservative);
-  Svo svo = Build(voxels, mesh);
+  Svo svo = Build(voxels, mesh, 3, true, 1);  // version 1's bricks are by filter 1
   std::vector<std::uint8_t> bytes = test::EncodeSvoV1(svo);
 };
 const Fixture& Base() {
@@ -434,6 +436,38 @@ TEST(ValidateMutation, WrongParentSampleIsAFilterFinding) {
   svo.levels[level].normal[sample] = 0x0080;
   r = ValidateBytes(test::EncodeSvoV1(svo), &Base().mesh);
   EXPECT_GE(Count(Check(r, "bricks"), "brick_range"), 1u) << r.Text();
+}
+
+// Version 3: the level above the voxels comes from the voxels' own attributes, so a voxel whose
+// colour or normal was changed in its page (consistently: its voxel bricks follow it on load) no
+// longer matches the samples stored above it. A version-2 file is checked by filter 1.
+TEST(ValidateMutation, ChangedVoxelAttributeIsAFilterFindingAboveIt) {
+  const Fixture& f = Base();
+  BuildOptions options;
+  auto compact = BuildCompactSvo(f.voxels, &f.mesh, options);
+  ASSERT_TRUE(compact.ok()) << compact.status().message();
+  ExpectValid(ValidateBytes(EncodeSvo(*compact), &f.mesh));
+  for (const bool normal : {false, true}) {
+    CompactSvo changed = *compact;
+    SvoChunk& voxels = changed.whole;
+    const std::size_t v = voxels.normals.size() / 2;
+    if (normal) {
+      const Vec3f n = voxels.normals[v];
+      voxels.normals[v] = Vec3f{-n.x, -n.y, -n.z};
+    } else if (!voxels.colors.empty()) {
+      voxels.colors[v] = HalfRgba(Rgba{1, 0, 1, 1});
+    } else {
+      changed.frame.shape.shared_color[0] = HalfRgba(Rgba{1, 0, 1, 1});
+    }
+    const Report r = ValidateBytes(EncodeSvo(changed), &f.mesh);
+    const auto kinds = Kinds(r);
+    ASSERT_EQ(kinds.size(), 1u) << Describe(kinds);
+    EXPECT_GE(kinds.at("bricks/brick_filter"), 1u);
+    const CheckResult& b = Check(r, "bricks");
+    EXPECT_TRUE(std::all_of(b.examples.begin(), b.examples.end(), [&](const Finding& x) {
+      return x.level && *x.level == changed.depth() - 1;
+    })) << r.Text();
+  }
 }
 
 TEST(ValidateMutation, ContourCuttingOffGeometryIsASurfaceFinding) {

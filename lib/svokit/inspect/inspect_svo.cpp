@@ -62,7 +62,7 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   report.file_bytes = std::filesystem::file_size(r.input);
   report.version = 1;
   if (StatusOr<SvoReader> reader = SvoReader::Open(r.input); reader.ok()) {
-    report.version = 2;
+    report.version = reader->version();
     StatusOr<SvoFileStats> file_stats = reader->FileStats(r.levels);
     if (!file_stats.ok()) return file_stats.status();
     report.file_stats = std::move(*file_stats);

@@ -1,7 +1,7 @@
 #pragma once
 // The arithmetic of the brick filter, shared by the reference (bricks.cpp) and the distinct-sample
-// filter (sample_filter.cpp), which must agree to the last bit: premultiplied sums, the tent, and
-// the encoding of a sample. Internal to lib/svokit/svo.
+// filter (sample_filter.cpp), which must agree to the last bit: premultiplied sums, the level above
+// the voxels, the tent, and the encoding of a sample. Internal to lib/svokit/svo.
 
 #include <cmath>
 #include <cstdint>
@@ -52,6 +52,7 @@ namespace svokit::brick_math {
 // is the same to the last bit.
 using Lanes = float __attribute__((vector_size(16)));
 static_assert(sizeof(PremultipliedSample) == 2 * sizeof(Lanes));
+static_assert(sizeof(PremultipliedSample) == 8 * sizeof(float));
 
 inline void Accumulate(PremultipliedSample& acc, const PremultipliedSample& v, float w) {
   Lanes a[2], b[2];
@@ -108,6 +109,47 @@ inline PremultipliedSample DecodePremultiplied(const EncodedSample& e, bool colo
     p.ny = n.y * o;
     p.nz = n.z * o;
   }
+  return p;
+}
+
+/// The level above the voxels' sample at voxel corner p (formats/svo.md, "Filter"): per axis the
+/// voxels p − 1, p with weights 1, 1 (side 3) or p − 2 .. p + 1 with 1, 3, 3, 1 (side 2), summed
+/// in binary64 along x, then y, then z, each sum from +0 in ascending position, then scaled by
+/// 2⁻³ or 2⁻⁹. cell(dx, dy, dz) (d from 0 at the first voxel) is the voxel's premultiplied sample,
+/// or null where there is none: skipping it adds nothing, as adding +0 would (a sum from +0 is
+/// never −0). Colour and opacity sums are exact; the normals' order is the definition.
+template <class Cell>
+PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
+  static constexpr double kWeights3[2] = {1, 1}, kWeights2[4] = {1, 3, 3, 1};
+  const int n = side == 3 ? 2 : 4;
+  const double* w = side == 3 ? kWeights3 : kWeights2;
+  double o[8] = {};
+  for (int z = 0; z < n; ++z) {
+    double fy[8] = {};
+    bool any_y = false;
+    for (int y = 0; y < n; ++y) {
+      double fx[8] = {};
+      bool any_x = false;
+      for (int x = 0; x < n; ++x) {
+        const PremultipliedSample* v = cell(x, y, z);
+        if (v == nullptr) continue;
+        float q[8];
+        std::memcpy(q, v, sizeof q);
+        for (int c = 0; c < 8; ++c) fx[c] += w[x] * static_cast<double>(q[c]);
+        any_x = true;
+      }
+      if (!any_x) continue;
+      for (int c = 0; c < 8; ++c) fy[c] += w[y] * fx[c];
+      any_y = true;
+    }
+    if (!any_y) continue;
+    for (int c = 0; c < 8; ++c) o[c] += w[z] * fy[c];
+  }
+  const double scale = side == 3 ? 0x1p-3 : 0x1p-9;
+  float out[8];
+  for (int c = 0; c < 8; ++c) out[c] = static_cast<float>(o[c] * scale);
+  PremultipliedSample p;
+  std::memcpy(&p, out, sizeof p);
   return p;
 }
 

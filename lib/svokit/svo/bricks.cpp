@@ -192,6 +192,36 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
   }
 }
 
+// The brick of `node` (level depth − 1, its children's voxel indices in `block`) straight from the
+// voxels' attributes (filter 2): sample k at block point 2 + k·(voxel spacing), from the voxels
+// around it (brick_math::AboveVoxels).
+void AboveVoxelBrick(const VoxelSamplesSource& voxels, const Svo& svo, const Block& block,
+                     std::uint64_t node, SvoLevel& out) {
+  const bool color = svo.has_color, normal = svo.has_normal;
+  const int side = static_cast<int>(svo.brick_side);
+  const int step = side == 3 ? 1 : 2, lo = side == 3 ? 1 : 2;
+  std::array<PremultipliedSample, kBlock * kBlock * kBlock> cells;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (block[c] < 0) continue;
+    BrickSample b;
+    b.opacity = 1;
+    if (color) b.color = voxels.color(static_cast<std::size_t>(block[c]));
+    if (normal) b.normal = voxels.normals[static_cast<std::size_t>(block[c])];
+    cells[c] = Premultiply(b);
+  }
+  for (int k = 0; k < side * side * side; ++k) {
+    const int p[3] = {2 + step * (k % side), 2 + step * (k / side % side),
+                      2 + step * (k / (side * side))};
+    const PremultipliedSample sum = brick_math::AboveVoxels(
+        svo.brick_side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
+          const std::size_t c = BlockIndex(p[0] - lo + dx, p[1] - lo + dy, p[2] - lo + dz);
+          return block[c] < 0 ? nullptr : &cells[c];
+        });
+    Store(Encode(color, normal, sum), node * svo.brick_samples() + static_cast<std::size_t>(k),
+          out);
+  }
+}
+
 // Premultiply(decoded sample i of `lv`).
 PremultipliedSample DecodePremultiplied(const SvoLevel& lv, std::size_t i, bool color,
                                         bool normal) {
@@ -340,15 +370,22 @@ void AllocateBricks(const Svo& svo, bool attributes, SvoLevel& lv) {
 }  // namespace
 
 void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                  Svo& svo) {
+                  Svo& svo, int filter) {
   for (SvoLevel& lv : svo.levels) AllocateBricks(svo, true, lv);
   if (svo.brick_samples() == 0) return;
+  const VoxelSamplesSource source{voxels.colors, voxels.normals};
   for (std::uint32_t level = svo.depth; level-- > 0;) {
     // Every voxel brick must exist before a parent reads its neighbours'.
     if (level + 1 == svo.depth) {
       EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
         VoxelBricks(&voxels, svo, block, i, svo.levels[svo.depth]);
       });
+      if (filter == 2) {
+        EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
+          AboveVoxelBrick(source, svo, block, i, svo.levels[level]);
+        });
+        continue;
+      }
     }
     EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
       ParentBrick(svo, level, block, i, svo.levels[level]);
@@ -357,7 +394,7 @@ void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uin
 }
 
 SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                       std::uint32_t level) {
+                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels) {
   SvoLevel out;
   out.node_count = svo.levels[level].node_count;
   const bool voxel_level = level == svo.depth;
@@ -366,6 +403,10 @@ SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64
   if (voxel_level) {
     EachNode(svo, level_keys, level - 1,
              [&](const Block& block, std::size_t i) { VoxelBricks(nullptr, svo, block, i, out); });
+  } else if (filter == 2 && level + 1 == svo.depth) {
+    EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
+      AboveVoxelBrick(voxels, svo, block, i, out);
+    });
   } else {
     EachNode(svo, level_keys, level,
              [&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i, out); });

@@ -7,6 +7,10 @@ Status CheckBuildInput(const VoxelSet& voxels, const Mesh* mesh, const BuildOpti
   if (options.brick_side != 0 && options.brick_side != 2 && options.brick_side != 3) {
     return Status::BadInput("bricks must be 3, 2 or none (got {})", options.brick_side);
   }
+  if (options.brick_filter != 1 && options.brick_filter != kBrickFilter) {
+    return Status::BadInput("brick filter must be 1 or {} (got {})", kBrickFilter,
+                            options.brick_filter);
+  }
   if (options.contours && mesh == nullptr) {
     return Status::BadInput("contours need the mesh the voxels came from");
   }

@@ -14,9 +14,14 @@ namespace svokit {
 struct InteriorCubes;
 class InteriorFinder;
 
+/// The newest brick filter (bricks.hpp), what .svo version 3 stores; 1 is versions 1 and 2's.
+inline constexpr int kBrickFilter = 2;
+
 struct BuildOptions {
   std::uint32_t brick_side = 3;  ///< 3, 2 or 0 (no bricks)
-  bool contours = true;          ///< needs the mesh
+  /// The brick filter, 1 or 2; filter 1 only in BuildReferenceSvo (a version 1 or 2 file's bricks).
+  int brick_filter = kBrickFilter;
+  bool contours = true;  ///< needs the mesh
   ContourOptions contour;
   /// A solid's interior (FillInterior, same grid): its cubes become full leaves. Null: a surface.
   const InteriorCubes* interior = nullptr;

@@ -67,6 +67,10 @@ StatusOr<std::vector<std::vector<std::uint8_t>>> FullMasks(
 StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const BuildOptions& options,
                                      std::string metadata, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckBuildInput(voxels, mesh, options));
+  if (options.brick_filter != kBrickFilter) {
+    return Status::BadInput("brick filter {} is only the reference builder's",
+                            options.brick_filter);
+  }
   CompactSvo svo;
   SvoFrame& frame = svo.frame;
   SvoShape& shape = frame.shape;

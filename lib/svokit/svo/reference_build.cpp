@@ -82,7 +82,7 @@ StatusOr<Svo> BuildReferenceSvo(const VoxelSet& voxels, const Mesh* mesh,
   }
   if (svo.brick_side != 0) {
     Progress::Stage stage(progress, "bricks", 1);
-    FilterBricks(voxels, keys, svo);
+    FilterBricks(voxels, keys, svo, options.brick_filter);
     stage.Advance();
   }
   if (options.contours) {

@@ -87,30 +87,17 @@ class VoxelTile {
       const std::int64_t v = first++;
       if (present_[i / 64] >> (i % 64) & 1u) continue;
       present_[i / 64] |= std::uint64_t{1} << (i % 64);
-      voxel_[i] = {v, false, {}, {}, {}, {}};
+      voxel_[i] = {v, false, false, {}, {}};
     }
   }
 
-  // The decoded voxel-level sample at half-voxel coordinates h, as a tent reads it (the zero
-  // sample where no voxel holds the point), computed once per tile.
-  const PremultipliedSample& Decoded(int hx, int hy, int hz) {
-    const int h[3] = {hx, hy, hz};
-    Point& p = PointAt(h);
-    if (p.decoded_stamp == stamp_) return p.decoded;
-    int lo[3], hi[3];
-    CellsAround(h, lo, hi);
-    if (!AnyPresent(lo, hi)) {
-      p.decoded = {};
-      p.decoded_stamp = stamp_;
-      return p.decoded;
-    }
-    Compute(p, lo, hi);
-    if (p.decoded_stamp != stamp_) {
-      p.decoded_stamp = stamp_;
-      p.decoded = p.encoded.opacity == 0 ? PremultipliedSample{}
-                                         : DecodePremultiplied(p.encoded, f_.color, f_.normal);
-    }
-    return p.decoded;
+  // The level above the voxels' sample at voxel corner p (brick_math::AboveVoxels).
+  PremultipliedSample Above(const int p[3], std::uint32_t side) {
+    const int lo = side == 3 ? 1 : 2;
+    return brick_math::AboveVoxels(side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
+      const int x = p[0] - lo + dx, y = p[1] - lo + dy, z = p[2] - lo + dz;
+      return Present(x, y, z) ? &Cell(voxel_[VoxelAt(x, y, z)]).cell : nullptr;
+    });
   }
 
   // The encoded voxel-level sample at half-voxel coordinates h (a voxel brick's sample).
@@ -125,17 +112,13 @@ class VoxelTile {
  private:
   struct Voxel {
     std::int64_t index = -1;
-    bool converted = false;
+    bool has_cell = false, has_alone = false;
     PremultipliedSample cell;  // opacity 1, colour and normal (premultiplied by 1)
     EncodedSample alone;       // the voxel's own sample
-    Rgba alone_color;          // that sample's colour and normal decoded
-    Vec3f alone_normal;
   };
   struct Point {
     EncodedSample encoded;
-    PremultipliedSample decoded;      // the encoded sample premultiplied again, as a tent reads it
-    std::uint32_t stamp = 0;          // `encoded` is this tile's
-    std::uint32_t decoded_stamp = 0;  // `decoded` is this tile's (only the filter reads it)
+    std::uint32_t stamp = 0;  // `encoded` is this tile's
   };
 
   int VoxelSide() const { return width_ + 4; }
@@ -182,26 +165,15 @@ class VoxelTile {
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         for (int x = lo[0]; x <= hi[0]; ++x) {
-          if (Present(x, y, z)) contributors[n++] = &Convert(voxel_[VoxelAt(x, y, z)]);
+          if (Present(x, y, z)) contributors[n++] = &Cell(voxel_[VoxelAt(x, y, z)]);
         }
       }
     }
     const int count = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
     if (n == 1) {
-      // One voxel: its own colour and normal, exactly (the scaling by 1/count is a power of 2),
-      // and decoded from what it decodes to alone.
-      const Voxel& v = *contributors[0];
-      p.encoded = v.alone;
+      // One voxel: its own colour and normal, exactly (the scaling by 1/count is a power of 2).
+      p.encoded = Alone(*contributors[0]).alone;
       p.encoded.opacity = EncodeUnorm8(1.f / static_cast<float>(count));
-      p.decoded_stamp = stamp_;
-      const float o = p.decoded.opacity = DecodeUnorm8(p.encoded.opacity);
-      p.decoded.r = v.alone_color.r * o;
-      p.decoded.g = v.alone_color.g * o;
-      p.decoded.b = v.alone_color.b * o;
-      p.decoded.a = v.alone_color.a * o;
-      p.decoded.nx = v.alone_normal.x * o;
-      p.decoded.ny = v.alone_normal.y * o;
-      p.decoded.nz = v.alone_normal.z * o;
       return p;
     }
     PremultipliedSample sum;
@@ -212,18 +184,21 @@ class VoxelTile {
     return p;
   }
 
-  Voxel& Convert(Voxel& v) {
-    if (v.converted) return v;
+  Voxel& Cell(Voxel& v) {
+    if (v.has_cell) return v;
     BrickSample b;
     b.opacity = 1;
     const auto i = static_cast<std::size_t>(v.index);
     if (f_.color) b.color = source_->color(i);
     if (f_.normal) b.normal = source_->normals[i];
     v.cell = Premultiply(b);
-    v.alone = Encode(f_.color, f_.normal, v.cell);
-    v.alone_color = f_.color ? DecodeColor(v.alone.color) : Rgba{0, 0, 0, 0};
-    v.alone_normal = f_.normal ? DecodeNormal(v.alone.normal) : Vec3f{0, 0, 0};
-    v.converted = true;
+    v.has_cell = true;
+    return v;
+  }
+  Voxel& Alone(Voxel& v) {
+    if (v.has_alone) return v;
+    v.alone = Encode(f_.color, f_.normal, Cell(v).cell);
+    v.has_alone = true;
     return v;
   }
 
@@ -321,6 +296,22 @@ class TapCache {
   std::array<PremultipliedSample, 343> taps_;
 };
 
+// Calls store(s, at) for every sample s a node stores, at its index `at` in layout order: its home
+// samples, then its orphans.
+template <class Store>
+void ForEachStoredSample(std::uint32_t side, std::uint32_t orphans, std::uint64_t first,
+                         const Store& store) {
+  const layout_detail::SideTable& t = layout_detail::TableFor(side);
+  std::uint64_t next = first + t.home_count;
+  for (unsigned s = 0; s < side * side * side; ++s) {
+    if (t.is_home[s]) {
+      store(s, first + t.index[s]);
+    } else if (orphans >> t.index[s] & 1u) {
+      store(s, next++);
+    }
+  }
+}
+
 // Filters and stores the samples a node stores, in layout order: its home samples, then its
 // orphans. fetch(tx, ty, tz) is the decoded finer sample at tap index t = 2k + d (k the sample,
 // d ∈ 0..2 the tap, t ∈ [0, 2·side]). With side 3 the eight home samples share one separable pass
@@ -386,12 +377,9 @@ void StoreNodeSamples(std::uint32_t side, std::uint32_t orphans, Fetch&& fetch, 
   } else {
     StoreSample(Encode(f.color, f.normal, tent_of(0)), first, out);
   }
-  std::uint64_t next = first + t.home_count;
-  for (unsigned s = 0; s < side * side * side; ++s) {
-    if (!t.is_home[s] && (orphans >> t.index[s] & 1u)) {
-      StoreSample(Encode(f.color, f.normal, tent_of(s)), next++, out);
-    }
-  }
+  ForEachStoredSample(side, orphans, first, [&](unsigned s, std::uint64_t at) {
+    if (!t.is_home[s]) StoreSample(Encode(f.color, f.normal, tent_of(s)), at, out);
+  });
 }
 
 LevelSamples Allocate(std::uint64_t n, Flags f) {
@@ -402,25 +390,23 @@ LevelSamples Allocate(std::uint64_t n, Flags f) {
   return out;
 }
 
-// The level above the voxels: each node's samples from the voxel-level samples around it (encoded,
-// as the voxel bricks would store them, then decoded), which its tile computes once.
+// The level above the voxels: each node's samples straight from the voxels around them, which
+// its tile gathers once.
 void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::uint32_t side,
                        const VoxelSamplesSource& source, Flags f, LevelSamples& out,
                        Progress::Stage* stage) {
+  const int step = side == 3 ? 1 : 2;
   ForEachAboveVoxels(
       tree, source, f,
       [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
-        // Tap t of the node's lattice (2k + d − 1 voxel-level steps from its corner) in half
-        // voxels.
-        int origin[3];
-        for (int a = 0; a < 3; ++a) origin[a] = 2 * (corner[a] + 2);
-        const int step = side == 3 ? 1 : 2;
-        const auto decoded = [&](int x, int y, int z) -> const PremultipliedSample& {
-          return tile.Decoded(origin[0] + step * (x - 1), origin[1] + step * (y - 1),
-                              origin[2] + step * (z - 1));
-        };
-        // No per-node cache of taps: the tile holds each point's decoded sample once already.
-        StoreNodeSamples(side, layout.orphans[i], decoded, f, out, layout.first[i]);
+        ForEachStoredSample(
+            side, layout.orphans[i], layout.first[i], [&](unsigned s, std::uint64_t at) {
+              // The node's first voxel is the block's (2, 2, 2).
+              const int p[3] = {corner[0] + 2 + step * static_cast<int>(s % side),
+                                corner[1] + 2 + step * static_cast<int>(s / side % side),
+                                corner[2] + 2 + step * static_cast<int>(s / (side * side))};
+              StoreSample(Encode(f.color, f.normal, tile.Above(p, side)), at, out);
+            });
       },
       stage);
 }

@@ -78,10 +78,18 @@ CheckResult CheckStructure(const LenientSvo& file) {
   return r;
 }
 
-CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys) {
+CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                        int filter, const VoxelSamplesSource& voxels) {
   CheckResult r("bricks");
   if (svo.brick_side == 0) {
     r.Skip("no bricks");
+    return r;
+  }
+  const std::uint64_t voxel_count = svo.voxel_count();
+  if (filter == 2 &&
+      ((svo.has_color && voxels.colors.size() != 1 && voxels.colors.size() != voxel_count) ||
+       (svo.has_normal && voxels.normals.size() != voxel_count))) {
+    r.Skip("the voxels' own colours or normals are not in the file");
     return r;
   }
   const int side = static_cast<int>(svo.brick_side);
@@ -91,7 +99,7 @@ CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint6
   for (std::uint32_t level = svo.depth + 1; level-- > 0;) {
     const SvoLevel& lv = svo.levels[level];
     const std::vector<std::uint64_t>& keys = level_keys[level];
-    const SvoLevel ref = RefilterLevel(svo, level_keys, level);
+    const SvoLevel ref = RefilterLevel(svo, level_keys, level, filter, voxels);
     const KeyIndex index(keys);
     OrderedFindings found(keys.size(), 1024);
     std::vector<std::uint64_t> shared_parts(found.chunks(), 0);

@@ -7,6 +7,7 @@
 
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/validate/report.hpp"
 
@@ -18,9 +19,12 @@ CheckResult CheckStructure(const LenientSvo& file);
 
 /// Bricks of a consistent octree: codes in range (no half-zero normal, no colour or normal on an
 /// empty sample), samples shared by neighbouring bricks byte-identical, and every level equal to
-/// RefilterLevel (the builder's filter over the stored finer level; the voxel level's opacity from
-/// the occupancy) within one quantization step per channel. `level_keys` from LevelKeysFromVoxels.
-CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys);
+/// RefilterLevel by brick filter `filter` (the level above the voxels from `voxels`, the voxels'
+/// own attributes, in filter 2; the others over the stored finer level; the voxel level's opacity
+/// from the occupancy) within one quantization step per channel. `level_keys` from
+/// LevelKeysFromVoxels.
+CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                        int filter, const VoxelSamplesSource& voxels);
 
 /// Contour words of a consistent octree: the decoded slab meets its node's cube.
 CheckResult CheckContourRanges(const Svo& svo);

@@ -34,7 +34,8 @@ Report Validate(const LenientSvo& file, const std::string& name, const ValidateO
   for (std::uint32_t l = 0; l <= svo.depth; ++l) keys[l] = svo.LevelKeys(l);
   {
     Progress::Stage stage(progress, "bricks", 1);
-    report.checks.push_back(CheckBricks(svo, keys));
+    report.checks.push_back(CheckBricks(svo, keys, BrickFilterOfVersion(file.version),
+                                        {file.voxel_colors, file.voxel_normals}));
   }
   {
     Progress::Stage stage(progress, "contours", 1);

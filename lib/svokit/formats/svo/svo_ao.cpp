@@ -105,7 +105,7 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const
   StatusOr<container::Frame> frame = container::Frame::Open(input, kSvoFormat);
   if (!frame.ok()) return frame.status();
   if (!frame->issues().empty()) return Status::BadInput("{}", frame->issues().front().message);
-  if (frame->version() != kSvoFormat.version) {
+  if (frame->version() < 2) {
     return Status::BadInput("{}: a version-{} file; rebuild it to bake into it", input.string(),
                             frame->version());
   }
@@ -117,7 +117,10 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const
   provenance.bake = bake;
   const std::string meta_text = ProvenanceJson(provenance);
 
-  container::Writer writer(kSvoFormat, frame->flags());
+  // The input's version: the bricks keep the filter they were made by.
+  container::FormatId format = kSvoFormat;
+  format.version = frame->version();
+  container::Writer writer(format, frame->flags());
   for (const container::Frame::Section& s : frame->sections()) {
     if (s.tag == kAo || s.tag == kMetadata) continue;
     writer.AddSectionView(s.tag, s.bytes);

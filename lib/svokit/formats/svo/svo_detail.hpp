@@ -62,9 +62,16 @@ std::optional<std::span<const std::uint8_t>> Loaded(const container::Frame& file
 /// invariant to `sink`; true when the octree is complete and consistent.
 bool DecodeVersion1(const container::Frame& file, std::optional<std::uint32_t> max_level,
                     IssueSink& sink, Svo& svo);
-/// The same for version 2; `stage`, when given, learns the page count and advances by each page.
+/// The voxels' own attributes (LenientSvo's voxel_colors and voxel_normals).
+struct VoxelAttributeArrays {
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
+};
+/// The same for versions 2 and 3 (one layout); `stage`, when given, learns the page count and
+/// advances by each page; `voxels`, when given, receives the voxels' attributes.
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
-                    IssueSink& sink, Svo& svo, Progress::Stage* stage = nullptr);
+                    IssueSink& sink, Svo& svo, Progress::Stage* stage = nullptr,
+                    VoxelAttributeArrays* voxels = nullptr);
 
 /// The `AOCC` section of `svo`'s levels' ambient occlusion (svo_ao.cpp).
 std::vector<std::uint8_t> EncodeAoSection(const Svo& svo);

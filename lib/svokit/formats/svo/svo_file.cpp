@@ -27,9 +27,9 @@ namespace {
 using namespace svo_detail;
 
 bool Decode(const container::Frame& file, std::optional<std::uint32_t> max_level, IssueSink& sink,
-            Svo& svo, Progress::Stage* stage = nullptr) {
+            Svo& svo, Progress::Stage* stage = nullptr, VoxelAttributeArrays* voxels = nullptr) {
   if (file.version() == 1) return DecodeVersion1(file, max_level, sink, svo);
-  return DecodeVersion2(file, max_level, sink, svo, stage) &&
+  return DecodeVersion2(file, max_level, sink, svo, stage, voxels) &&
          DecodeAo(file, max_level.value_or(svo.depth), sink, svo);
 }
 
@@ -78,7 +78,11 @@ StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {
       sink.issues().push_back({kind, issue.message});
     }
   }
-  out.complete = Decode(*opened, std::nullopt, sink, out.svo);
+  VoxelAttributeArrays voxels;
+  out.complete = Decode(*opened, std::nullopt, sink, out.svo, nullptr, &voxels);
+  out.version = opened->version();
+  out.voxel_colors = std::move(voxels.colors);
+  out.voxel_normals = std::move(voxels.normals);
   out.issues = std::move(sink.issues());
   out.issue_counts = std::move(sink.counts());
   return out;

@@ -1,7 +1,8 @@
 #pragma once
 // .svo — the sparse voxel octree file svo-build and mesh2svo write, in the shared container.
-// Version 2 (what is written): the top levels in one chunk and each subtree below the page level
-// a page, compressed; version 1 (still read): levels breadth-first with every node's brick.
+// Version 3 (what is written): the top levels in one chunk and each subtree below the page level
+// a page, compressed; version 2 (still read) has the same layout and brick filter 1; version 1
+// (still read): levels breadth-first with every node's brick.
 // Layout: formats/svo.md. A renderer that streams pages uses svo_reader.hpp.
 
 #include <array>
@@ -27,7 +28,12 @@
 namespace svokit {
 
 inline constexpr container::FormatId kSvoFormat{
-    {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 2, "svokit sparse voxel octree (.svo)"};
+    {'\x89', 'S', 'V', 'O', '\r', '\n', '\x1a', '\n'}, 3, "svokit sparse voxel octree (.svo)"};
+
+/// The brick filter (bricks.hpp) a file of .svo version `version` stores: 1 for versions 1 and 2.
+inline int BrickFilterOfVersion(std::uint32_t version) {
+  return version >= 3 ? 2 : 1;
+}
 
 /// Stored and raw (decoded) bytes of one kind of array, over all chunks: "masks", "contours",
 /// "opacity", "colours", "normals", "voxel colours", "voxel normals", "halo", or "frame" (header,
@@ -36,7 +42,7 @@ struct SvoSectionBytes {
   std::string name;
   std::uint64_t stored = 0, raw = 0;
 };
-/// What writing a version-2 file made.
+/// What writing a file made.
 struct SvoFileStats {
   std::uint64_t file_bytes = 0;
   std::uint64_t voxels = 0;
@@ -50,7 +56,7 @@ struct SvoFileStats {
   std::vector<std::vector<SvoSectionBytes>> levels;
 };
 
-/// Writes a version-2 file as its pages arrive, in key order, from a build that may never hold
+/// Writes a file as its pages arrive, in key order, from a build that may never hold
 /// the whole octree: each page's bytes go to the file at once; the header, the top chunk (made
 /// from the page keys once all are in) and the page table follow them. Every build, held whole
 /// or made page by page, writes through it, so they write the same bytes.
@@ -99,7 +105,7 @@ class PagedSvoWriter {
   std::vector<std::uint8_t> head_, top_;
 };
 
-/// The version-2 file of `svo`, and what it holds.
+/// The file of `svo`, and what it holds.
 std::vector<std::uint8_t> EncodeSvo(const CompactSvo& svo, const SvoCompression& compression = {},
                                     SvoFileStats* stats = nullptr);
 StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::path& path,
@@ -109,9 +115,9 @@ StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::pa
 StatusOr<SvoFileStats> WriteSvoStage(Progress& progress, const CompactSvo& svo,
                                      const std::filesystem::path& path,
                                      const SvoCompression& compression);
-/// Writes `input` (a version-2 .svo) again as `output` with `baked`'s per-node ambient occlusion
-/// (every level's `ao`) as its `AOCC` section and `bake` in its META; every other section is
-/// copied as it is.
+/// Writes `input` (a version 2 or 3 .svo) again as `output` with `baked`'s per-node ambient
+/// occlusion (every level's `ao`) as its `AOCC` section and `bake` in its META; every other section
+/// is copied as it is.
 Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const BakeSettings& bake,
                      const std::filesystem::path& output);
 
@@ -140,6 +146,11 @@ struct LenientSvo {
   std::map<std::string, std::uint64_t> issue_counts;  ///< per kind, all of them
   /// Every level decoded and linked consistently (checksum issues do not stop this).
   bool complete = false;
+  std::uint32_t version = 0;  ///< the file's; its bricks are by BrickFilterOfVersion(version)
+  /// Versions 2 and 3, when complete: the voxels' own colours (one when shared) and normals, in
+  /// the voxel level's order (what filter 2's level above the voxels is computed from).
+  DefaultInitVector<HalfRgba> voxel_colors;
+  DefaultInitVector<OctNormal> voxel_normals;
 };
 /// Fails (BadInput) only for input that is not an .svo at all: unreadable, foreign magic, or a
 /// newer version.

@@ -237,6 +237,10 @@ Status WriteSvoPart(const std::filesystem::path& path, const SvoPartHead& head,
 StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path) {
   StatusOr<container::Reader> file = container::Reader::Open(path, kSvoPartFormat);
   if (!file.ok()) return file.status();
+  if (file->version() != kSvoPartFormat.version) {
+    return Status::BadInput("{}: a version-{} part; parts are merged by the svokit that built them",
+                            path.string(), file->version());
+  }
   SvoPart part{path.string(), std::move(*file)};
   StatusOr<std::span<const std::uint8_t>> grid = part.file.Require(kGrid);
   StatusOr<std::span<const std::uint8_t>> head = part.file.Require(kPartHead);

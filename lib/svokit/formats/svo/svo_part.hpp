@@ -22,7 +22,7 @@
 namespace svokit {
 
 inline constexpr container::FormatId kSvoPartFormat{
-    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 2, "svokit octree part (.svopart)"};
+    {'\x89', 'S', 'V', 'P', '\r', '\n', '\x1a', '\n'}, 3, "svokit octree part (.svopart)"};
 
 /// Which share of a build by pages a part holds: part `part` of `parts` (0-based), of the build
 /// `identity` names (e.g. checksums of the input and options; merging refuses parts whose

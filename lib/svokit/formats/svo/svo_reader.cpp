@@ -20,13 +20,14 @@ SvoReader::~SvoReader() = default;
 
 namespace {
 
-// The checks Open and FromBytes share: a version-2 frame without issues, its tables parsed.
+// The checks Open and FromBytes share: a paged (version 2 or 3) frame without issues, its tables
+// parsed.
 StatusOr<svo_detail::Version2> ParseFrame(const StatusOr<container::Frame>& frame) {
   if (!frame.ok()) return frame.status();
   if (!frame->issues().empty()) {
     return Status(StatusCode::kBadInput, frame->issues().front().message);
   }
-  if (frame->version() != 2) {
+  if (frame->version() < 2) {
     return Status::BadInput("{}: a version-{} .svo has no pages (read it whole)", frame->name(),
                             frame->version());
   }
@@ -59,6 +60,10 @@ StatusOr<SvoReader> SvoReader::FromBytes(std::span<const std::uint8_t> bytes,
 
 const std::string& SvoReader::name() const {
   return state_->frame.name();
+}
+
+std::uint32_t SvoReader::version() const {
+  return state_->frame.version();
 }
 const GridTransform& SvoReader::grid() const {
   return state_->v.grid;

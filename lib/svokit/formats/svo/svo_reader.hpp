@@ -1,9 +1,9 @@
 #pragma once
-// Streaming a version-2 .svo, as a renderer does: open the file (mapped; only its header, tables
-// and top chunk are checked), load the top levels, then the pages it needs, by index or by a
-// world-space box, each checked (CRC-32C, streams, counts) when it is loaded. A page's bricks are
-// assembled into a brick pool, side³ samples per node, the bytes version 1 stored; its voxels'
-// colours and normals are at hand too. formats/svo.md, "Reading pages", shows the loop.
+// Streaming a paged .svo (version 2 or 3), as a renderer does: open the file (mapped; only its
+// header, tables and top chunk are checked), load the top levels, then the pages it needs, by index
+// or by a world-space box, each checked (CRC-32C, streams, counts) when it is loaded. A page's
+// bricks are assembled into a brick pool, side³ samples per node, the bytes version 1 stored; its
+// voxels' colours and normals are at hand too. formats/svo.md, "Reading pages", shows the loop.
 
 #include <cstdint>
 #include <filesystem>
@@ -30,7 +30,7 @@ struct SvoPageInfo {
 
 class SvoReader {
  public:
-  /// Opens a version-2 file (version 1 has no pages: ReadSvo reads it whole).
+  /// Opens a version 2 or 3 file (version 1 has no pages: ReadSvo reads it whole).
   static StatusOr<SvoReader> Open(const std::filesystem::path& path);
   /// The same over bytes that outlive the reader; `name` is used in messages.
   static StatusOr<SvoReader> FromBytes(std::span<const std::uint8_t> bytes,
@@ -40,6 +40,8 @@ class SvoReader {
   ~SvoReader();
 
   const std::string& name() const;
+  /// The file's version (2 or 3): its bricks are by brick filter BrickFilterOfVersion(version()).
+  std::uint32_t version() const;
   const GridTransform& grid() const;
   VoxelMode mode() const;
   const SvoShape& shape() const;

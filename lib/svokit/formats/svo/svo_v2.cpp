@@ -532,7 +532,8 @@ bool CheckHalos(const PageVoxels& voxels, const std::string& name, IssueSink& si
 }  // namespace
 
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
-                    IssueSink& sink, Svo& svo, Progress::Stage* stage) {
+                    IssueSink& sink, Svo& svo, Progress::Stage* stage,
+                    VoxelAttributeArrays* attributes) {
   const std::string& name = file.name();
   StatusOr<Version2> parsed = ParseVersion2(file, sink);
   if (!parsed.ok()) return false;
@@ -553,7 +554,13 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   if (!consistent && sink.stops()) return false;
   if (v.shape.solid) consistent = CheckFullLeavesInGrid(v, svo, name, sink) && consistent;
   if (!consistent && sink.stops()) return false;
-  return CheckHalos(voxels, name, sink) && consistent;
+  consistent = CheckHalos(voxels, name, sink) && consistent;
+  if (attributes != nullptr) {
+    attributes->colors = std::move(voxels.colors);
+    if (!v.shape.shared_color.empty()) attributes->colors.assign(1, v.shape.shared_color[0]);
+    attributes->normals = std::move(voxels.normals);
+  }
+  return consistent;
 }
 
 }  // namespace svo_detail
