@@ -106,7 +106,7 @@ struct BuildCli {
     cli.add_flag("--contours,!--no-contours", contours,
                  "ESVO contour slabs fitted to the surface; they need the mesh (default: on)");
     cli.add_option("--compression", compression,
-                   "How the file's arrays are stored: zstd at its level 3, zstd:LEVEL (1-22), or "
+                   "How the file's arrays are stored: zstd at its level 1, zstd:LEVEL (1-22), or "
                    "none")
         ->option_text("zstd[:LEVEL]|none")
         ->capture_default_str();

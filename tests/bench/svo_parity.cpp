@@ -1,6 +1,7 @@
-// Version 2 against version 1 at full scale (scripts/bench parity). The reference is
-// BuildReferenceSvo, the octree version 1 stores node by node; the version-2 file of the same
-// voxels is written, then read back through SvoReader one page at a time, as a renderer reads it:
+// The paged file against the per-node reference at full scale (scripts/bench parity). The
+// reference is BuildReferenceSvo, the octree a version-1 file stores node by node, by today's
+// brick filter; the file of the same voxels is written, then read back through SvoReader one page
+// at a time, as a renderer reads it:
 // every level's keys, child masks, contour words and assembled bricks, and the voxels' own colours
 // and normals, must equal the reference byte for byte. Then the time to read each file whole and
 // assemble every brick (ReadSvo), medians of 3, where the version-1 file is written (--v1-limit,

@@ -186,6 +186,8 @@ void ParseBuildText(const std::string& text, Provenance& p) {
   const auto compression = words.find("compression");
   const std::string c = compression == words.end() ? "" : compression->second;
   b.compression.zstd = c.starts_with("zstd");
+  // Option text is older than zstd level 1 by default: plain "zstd" then meant level 3.
+  b.compression.level = 3;
   if (c.starts_with("zstd:")) b.compression.level = ParseNumber<int>(c.substr(5)).value_or(3);
   p.build = b;
 }

@@ -4,35 +4,6 @@
 
 namespace svokit {
 
-namespace {
-
-// For child c and offset slot o: the parent's slot and the child bit of node 2p + c + o.
-struct ChildStep {
-  std::uint8_t parent_slot, bit;
-};
-constexpr std::array<std::array<ChildStep, 27>, 8> MakeChildSteps() {
-  std::array<std::array<ChildStep, 27>, 8> steps{};
-  for (int c = 0; c < 8; ++c) {
-    for (int z = -1; z <= 1; ++z) {
-      for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) {
-          const int ax = (c & 1) + x, ay = (c >> 1 & 1) + y, az = (c >> 2 & 1) + z;
-          // Floor division by 2 of −1..2 and the remainder, without relying on >> of negatives.
-          const auto half = [](int a) { return a < 0 ? -1 : a / 2; };
-          const auto bit = [](int a) { return a < 0 ? 1 : a % 2; };
-          steps[c][NeighbourSlot(x, y, z)] = {
-              static_cast<std::uint8_t>(NeighbourSlot(half(ax), half(ay), half(az))),
-              static_cast<std::uint8_t>(bit(ax) | bit(ay) << 1 | bit(az) << 2)};
-        }
-      }
-    }
-  }
-  return steps;
-}
-constexpr auto kChildSteps = MakeChildSteps();
-
-}  // namespace
-
 std::uint64_t MaskTree::NodeCount(std::uint32_t level) const {
   if (level == first_level) return 1;
   const std::vector<std::uint8_t>& above = masks[level - 1 - first_level];
@@ -71,19 +42,26 @@ MaskTree MaskTreeFromKeys(std::span<const std::vector<std::uint64_t>> level_keys
   return tree;
 }
 
-Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
-                                 const Neighbourhood& parent, unsigned c) {
+ChildNeighbourhoods::ChildNeighbourhoods(const MaskTree& tree, std::uint32_t level,
+                                         const Neighbourhood& parent) {
   const std::uint8_t* masks = tree.masks[level - tree.first_level].data();
   const std::uint64_t* first = tree.first_child[level - tree.first_level].data();
-  Neighbourhood out;
-  for (int o = 0; o < 27; ++o) {
-    const ChildStep step = kChildSteps[c][o];
-    const std::int64_t p = parent[step.parent_slot];
-    const unsigned m = p < 0 ? 0u : masks[p];
-    out[o] =
-        (m >> step.bit & 1u) ? static_cast<std::int64_t>(first[p] + RankInByte(m, step.bit)) : -1;
+  // Per axis, cell b (child-level offset b − 1 from the first child) lies in the parent
+  // neighbour at offset kParent[b], as its child bit kBit[b].
+  static constexpr int kParent[4] = {-1, 0, 0, 1};
+  static constexpr unsigned kBit[4] = {1, 0, 1, 0};
+  for (int bz = 0; bz < 4; ++bz) {
+    for (int by = 0; by < 4; ++by) {
+      for (int bx = 0; bx < 4; ++bx) {
+        const std::int64_t p =
+            parent[static_cast<std::size_t>(NeighbourSlot(kParent[bx], kParent[by], kParent[bz]))];
+        const unsigned m = p < 0 ? 0u : masks[p];
+        const unsigned bit = kBit[bx] | kBit[by] << 1 | kBit[bz] << 2;
+        block_[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))] =
+            (m >> bit & 1u) ? static_cast<std::int64_t>(first[p] + RankInByte(m, bit)) : -1;
+      }
+    }
   }
-  return out;
 }
 
 std::vector<Neighbourhood> LevelNeighbourhoods(const MaskTree& tree, std::uint32_t level) {
@@ -96,8 +74,10 @@ std::vector<Neighbourhood> LevelNeighbourhoods(const MaskTree& tree, std::uint32
     next.reserve(tree.NodeCount(l + 1));
     const std::vector<std::uint8_t>& masks = tree.masks[l - tree.first_level];
     for (std::size_t i = 0; i < current.size(); ++i) {
+      if (masks[i] == 0) continue;
+      const ChildNeighbourhoods children(tree, l, current[i]);
       for (unsigned c = 0; c < 8; ++c) {
-        if (masks[i] >> c & 1u) next.push_back(ChildNeighbourhood(tree, l, current[i], c));
+        if (masks[i] >> c & 1u) next.push_back(children[c]);
       }
     }
     current = std::move(next);

@@ -74,9 +74,31 @@ std::vector<std::vector<std::uint64_t>> TreeLevelKeys(const MaskTree& tree, std:
 /// The Morton keys of `level` of a tree whose root has key 0.
 std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level);
 
-/// The neighbourhood of child `c` of a node of `level` whose neighbourhood is `parent`.
-Neighbourhood ChildNeighbourhood(const MaskTree& tree, std::uint32_t level,
-                                 const Neighbourhood& parent, unsigned c);
+/// The neighbourhoods of the children of a node of `level` whose neighbourhood is `parent`: the
+/// 4³ next-level nodes around them are looked up once (64 lookups, where 27 a child would take up
+/// to 216), and each child's neighbourhood is its 3³ window.
+class ChildNeighbourhoods {
+ public:
+  ChildNeighbourhoods(const MaskTree& tree, std::uint32_t level, const Neighbourhood& parent);
+  /// Child c's (an absent child's is that of the cell it would take).
+  Neighbourhood operator[](unsigned c) const {
+    Neighbourhood out;
+    const int x = static_cast<int>(c & 1), y = static_cast<int>(c >> 1 & 1),
+              z = static_cast<int>(c >> 2 & 1);
+    for (int oz = 0; oz < 3; ++oz) {
+      for (int oy = 0; oy < 3; ++oy) {
+        for (int ox = 0; ox < 3; ++ox) {
+          out[static_cast<std::size_t>(ox + 3 * (oy + 3 * oz))] =
+              block_[static_cast<std::size_t>((x + ox) + 4 * ((y + oy) + 4 * (z + oz)))];
+        }
+      }
+    }
+    return out;
+  }
+
+ private:
+  std::array<std::int64_t, 64> block_;  // child-level cells −1 .. 2 per axis, x fastest
+};
 
 /// The neighbourhoods of every node of `level`, walked down from the root (which has no
 /// neighbours: nodes outside the tree count as absent).
@@ -103,10 +125,9 @@ void ForEachNeighbourhood(const MaskTree& tree, std::uint32_t level, const Body&
                         }
                         const std::uint8_t m = tree.masks[l - tree.first_level][i];
                         std::uint64_t child = tree.first_child[l - tree.first_level][i];
+                        const ChildNeighbourhoods children(tree, l, nb);
                         for (unsigned c = 0; c < 8; ++c) {
-                          if (m >> c & 1u) {
-                            self(self, l + 1, child++, ChildNeighbourhood(tree, l, nb, c));
-                          }
+                          if (m >> c & 1u) self(self, l + 1, child++, children[c]);
                         }
                       };
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {

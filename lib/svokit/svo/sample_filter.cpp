@@ -261,10 +261,10 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
       }
       const std::uint8_t m = tree.masks[level - tree.first_level][i];
       std::uint64_t child = tree.first_child[level - tree.first_level][i];
+      const ChildNeighbourhoods children(tree, level, nb);
       for (int c = 0; c < 8; ++c) {
         if (!(m >> c & 1u)) continue;
-        self(self, level + 1, child++,
-             ChildNeighbourhood(tree, level, nb, static_cast<unsigned>(c)), 2 * x + (c & 1),
+        self(self, level + 1, child++, children[static_cast<unsigned>(c)], 2 * x + (c & 1),
              2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
       }
     };

@@ -72,10 +72,12 @@ class PageSampleCopier {
     const std::uint8_t m = page_.tree.masks[k][local];
     std::uint64_t local_child = page_.tree.first_child[k][local];
     std::uint64_t global_child = tree.first_child[l][global];
+    const ChildNeighbourhoods local_children(page_.tree, l, local_nb);
+    const ChildNeighbourhoods global_children(tree, l, global_nb);
     for (unsigned ch = 0; ch < 8; ++ch) {
       if (!(m >> ch & 1u)) continue;
-      Visit(l + 1, local_child++, global_child++, ChildNeighbourhood(page_.tree, l, local_nb, ch),
-            ChildNeighbourhood(tree, l, global_nb, ch), node_key << 3 | ch);
+      Visit(l + 1, local_child++, global_child++, local_children[ch], global_children[ch],
+            node_key << 3 | ch);
     }
   }
 

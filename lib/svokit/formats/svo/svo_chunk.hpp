@@ -16,7 +16,7 @@ namespace svokit {
 /// How chunk streams are stored: zstd at `level`, or as they are.
 struct SvoCompression {
   bool zstd = true;
-  int level = 3;  ///< 1 .. 22 (zstd's levels)
+  int level = 1;  ///< 1 .. 22 (zstd's levels; docs/design.md says why 1)
   bool operator==(const SvoCompression&) const = default;
 };
 
