@@ -103,10 +103,11 @@ class VoxelTile {
   // The encoded voxel-level sample at half-voxel coordinates h (a voxel brick's sample).
   EncodedSample Encoded(int hx, int hy, int hz) {
     const int h[3] = {hx, hy, hz};
+    Point& p = PointAt(h);
+    if (p.stamp == stamp_) return p.encoded;  // most points are shared by several voxels
     int lo[3], hi[3];
     CellsAround(h, lo, hi);
-    if (!AnyPresent(lo, hi)) return {};
-    return Compute(PointAt(h), lo, hi).encoded;
+    return Compute(p, lo, hi).encoded;
   }
 
  private:
@@ -129,17 +130,6 @@ class VoxelTile {
     const std::size_t at = VoxelAt(x, y, z);
     return present_[at / 64] >> (at % 64) & 1u;
   }
-  bool AnyPresent(const int lo[3], const int hi[3]) const {
-    for (int z = lo[2]; z <= hi[2]; ++z) {
-      for (int y = lo[1]; y <= hi[1]; ++y) {
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          if (Present(x, y, z)) return true;
-        }
-      }
-    }
-    return false;
-  }
-
   Point& PointAt(const int h[3]) {
     const int points = 2 * width_ + 5;
     return point_[static_cast<std::size_t>((h[0] + 2) +
@@ -528,16 +518,17 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
       // The voxel's corner in half voxels.
       const int h[3] = {2 * (corner[0] + 2 + (c & 1)), 2 * (corner[1] + 2 + (c >> 1 & 1)),
                         2 * (corner[2] + 2 + (c >> 2 & 1))};
-      const int step = side == 3 ? 1 : 2;
-      for (unsigned s = 0; s < n; ++s) {
-        const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
-                          static_cast<int>(s / (side * side))};
-        const EncodedSample e =
-            tile.Encoded(h[0] + step * k[0], h[1] + step * k[1], h[2] + step * k[2]);
-        const std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n + s;
-        out.opacity[to] = e.opacity;
-        if (f.color) out.color[to] = e.color;
-        if (f.normal) out.normal[to] = e.normal;
+      const int step = side == 3 ? 1 : 2, last = step * static_cast<int>(side - 1);
+      std::uint64_t to = static_cast<std::uint64_t>(to_voxel) * n;
+      for (int z = 0; z <= last; z += step) {
+        for (int y = 0; y <= last; y += step) {
+          for (int x = 0; x <= last; x += step, ++to) {
+            const EncodedSample e = tile.Encoded(h[0] + x, h[1] + y, h[2] + z);
+            out.opacity[to] = e.opacity;
+            if (f.color) out.color[to] = e.color;
+            if (f.normal) out.normal[to] = e.normal;
+          }
+        }
       }
     }
   });
