@@ -332,31 +332,35 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
 // Calls body(block, i) for every node i of `level`. Blocks are derived top-down: key lookups
 // for the nodes three levels up only, then each child's block from the 3³ window of its parent's
 // (no hashing on the big levels). Subtrees spread over TBB; each node writes its own samples
-// only, so the result does not depend on the thread count or the visiting order.
+// only, so the result does not depend on the thread count or the visiting order. `stage`, when
+// given, advances by the nodes visited.
 template <class Body>
 void EachNode(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-              std::uint32_t level, const Body& body) {
+              std::uint32_t level, const Body& body, Progress::Stage* stage = nullptr) {
   const std::uint32_t top = level >= 3 ? level - 3 : 0;
   const KeyIndex index(level_keys[top]);
-  const auto visit = [&](const auto& self, std::uint32_t l, std::size_t node,
-                         const Block& block) -> void {
+  const auto visit = [&](const auto& self, std::uint32_t l, std::size_t node, const Block& block,
+                         std::uint64_t& visited) -> void {
     if (l == level) {
       body(block, node);
+      ++visited;
       return;
     }
     const SvoNode& n = svo.levels[l].nodes[node];
     std::size_t child = n.first_child;
     for (unsigned ch = 0; ch < 8; ++ch) {
       if (!(n.child_mask & (1u << ch))) continue;
-      self(self, l + 1, child++, ChildBlock(svo, l + 1, block, ch));
+      self(self, l + 1, child++, ChildBlock(svo, l + 1, block, ch), visited);
     }
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level_keys[top].size(), 4),
                     [&](const tbb::blocked_range<std::size_t>& r) {
+                      std::uint64_t visited = 0;
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        visit(visit, top, i,
-                              GatherChildren(svo, top, index, i, level_keys[top][i]));
+                        visit(visit, top, i, GatherChildren(svo, top, index, i, level_keys[top][i]),
+                              visited);
                       }
+                      if (stage != nullptr) stage->Advance(visited);
                     });
 }
 
@@ -394,22 +398,27 @@ void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uin
 }
 
 SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels) {
+                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
+                       Progress::Stage* stage) {
   SvoLevel out;
   out.node_count = svo.levels[level].node_count;
   const bool voxel_level = level == svo.depth;
   AllocateBricks(svo, !voxel_level, out);
   if (svo.brick_samples() == 0) return out;
   if (voxel_level) {
-    EachNode(svo, level_keys, level - 1,
-             [&](const Block& block, std::size_t i) { VoxelBricks(nullptr, svo, block, i, out); });
+    EachNode(
+        svo, level_keys, level - 1,
+        [&](const Block& block, std::size_t i) { VoxelBricks(nullptr, svo, block, i, out); },
+        stage);
   } else if (filter == 2 && level + 1 == svo.depth) {
-    EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
-      AboveVoxelBrick(voxels, svo, block, i, out);
-    });
+    EachNode(
+        svo, level_keys, level,
+        [&](const Block& block, std::size_t i) { AboveVoxelBrick(voxels, svo, block, i, out); },
+        stage);
   } else {
-    EachNode(svo, level_keys, level,
-             [&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i, out); });
+    EachNode(
+        svo, level_keys, level,
+        [&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i, out); }, stage);
   }
   return out;
 }

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo.hpp"
@@ -32,8 +33,11 @@ void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uin
 /// reference a checker compares the stored bricks with. The level above the voxels in filter 2,
 /// from `voxels` (the attributes of svo's voxels, in their order); other levels below the voxel
 /// level, the tent over the stored level + 1 bricks (colour and normal included); at the voxel
-/// level, the opacity alone. `level_keys` as for FilterBricks.
+/// level, the opacity alone. `level_keys` as for FilterBricks. `stage`, when given, advances by
+/// the nodes filtered: those of `level`, or at the voxel level their parents (whose children's
+/// bricks are made together).
 SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels);
+                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
+                       Progress::Stage* stage = nullptr);
 
 }  // namespace svokit

@@ -79,7 +79,7 @@ CheckResult CheckStructure(const LenientSvo& file) {
 }
 
 CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                        int filter, const VoxelSamplesSource& voxels) {
+                        int filter, const VoxelSamplesSource& voxels, Progress::Stage* stage) {
   CheckResult r("bricks");
   if (svo.brick_side == 0) {
     r.Skip("no bricks");
@@ -92,6 +92,12 @@ CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint6
     r.Skip("the voxels' own colours or normals are not in the file");
     return r;
   }
+  if (stage != nullptr) {
+    // Every node compared once and filtered once (the voxels by their parents: RefilterLevel).
+    std::uint64_t units = svo.depth >= 1 ? svo.levels[svo.depth - 1].node_count : 0;
+    for (const SvoLevel& lv : svo.levels) units += 2 * lv.node_count;
+    stage->SetTotal(units - svo.levels[svo.depth].node_count);
+  }
   const int side = static_cast<int>(svo.brick_side);
   const std::uint32_t samples = svo.brick_samples();
   std::uint64_t compared = 0, shared = 0;
@@ -99,7 +105,7 @@ CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint6
   for (std::uint32_t level = svo.depth + 1; level-- > 0;) {
     const SvoLevel& lv = svo.levels[level];
     const std::vector<std::uint64_t>& keys = level_keys[level];
-    const SvoLevel ref = RefilterLevel(svo, level_keys, level, filter, voxels);
+    const SvoLevel ref = RefilterLevel(svo, level_keys, level, filter, voxels, stage);
     const KeyIndex index(keys);
     OrderedFindings found(keys.size(), 1024);
     std::vector<std::uint64_t> shared_parts(found.chunks(), 0);
@@ -198,6 +204,7 @@ CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint6
           }
         }
       }
+      if (stage != nullptr) stage->Advance(last - first);
     });
     found.MergeInto(r);
     compared += keys.size() * samples;

@@ -23,8 +23,10 @@ CheckResult CheckStructure(const LenientSvo& file);
 /// own attributes, in filter 2; the others over the stored finer level; the voxel level's opacity
 /// from the occupancy) within one quantization step per channel. `level_keys` from
 /// LevelKeysFromVoxels.
+/// `stage`, when given, learns its total and advances by the nodes filtered and compared.
 CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                        int filter, const VoxelSamplesSource& voxels);
+                        int filter, const VoxelSamplesSource& voxels,
+                        Progress::Stage* stage = nullptr);
 
 /// Contour words of a consistent octree: the decoded slab meets its node's cube.
 CheckResult CheckContourRanges(const Svo& svo);

@@ -33,9 +33,9 @@ Report Validate(const LenientSvo& file, const std::string& name, const ValidateO
   std::vector<std::vector<std::uint64_t>> keys(svo.depth + 1);
   for (std::uint32_t l = 0; l <= svo.depth; ++l) keys[l] = svo.LevelKeys(l);
   {
-    Progress::Stage stage(progress, "bricks", 1);
+    Progress::Stage stage(progress, "bricks", 1);  // CheckBricks counts the nodes
     report.checks.push_back(CheckBricks(svo, keys, BrickFilterOfVersion(file.version),
-                                        {file.voxel_colors, file.voxel_normals}));
+                                        {file.voxel_colors, file.voxel_normals}, &stage));
   }
   {
     Progress::Stage stage(progress, "contours", 1);
