@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "svokit/svo/sample_codec.hpp"
+#include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/sample_layout.hpp"
 #include "svokit/svo/svo.hpp"
 
@@ -112,16 +113,27 @@ inline PremultipliedSample DecodePremultiplied(const EncodedSample& e, bool colo
   return p;
 }
 
+/// Voxel i of `voxels` as the filter reads it: opacity 1, its colour and normal (each only when
+/// asked for), premultiplied.
+inline PremultipliedSample VoxelCell(const VoxelSamplesSource& voxels, std::size_t i, bool color,
+                                     bool normal) {
+  BrickSample b;
+  b.opacity = 1;
+  if (color) b.color = voxels.color(i);
+  if (normal) b.normal = voxels.normals[i];
+  return Premultiply(b);
+}
+
 /// The level above the voxels' sample at voxel corner p (formats/svo.md, "Filter"): per axis the
 /// voxels p − 1, p with weights 1, 1 (side 3) or p − 2 .. p + 1 with 1, 3, 3, 1 (side 2), summed
 /// in binary64 along x, then y, then z, each sum from +0 in ascending position, then scaled by
-/// 2⁻³ or 2⁻⁹. cell(dx, dy, dz) (d from 0 at the first voxel) is the voxel's premultiplied sample,
-/// or null where there is none: skipping it adds nothing, as adding +0 would (a sum from +0 is
-/// never −0). Colour and opacity sums are exact; the normals' order is the definition.
+/// 2⁻³ or 2⁻⁹. cell(dx, dy, dz) is the premultiplied sample of voxel p + d, or null where there is
+/// none: skipping it adds nothing, as adding +0 would (a sum from +0 is never −0). Colour and
+/// opacity sums are exact; the normals' order is the definition.
 template <class Cell>
 PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
   static constexpr double kWeights3[2] = {1, 1}, kWeights2[4] = {1, 3, 3, 1};
-  const int n = side == 3 ? 2 : 4;
+  const int n = side == 3 ? 2 : 4, first = side == 3 ? -1 : -2;
   const double* w = side == 3 ? kWeights3 : kWeights2;
   double o[8] = {};
   for (int z = 0; z < n; ++z) {
@@ -131,7 +143,7 @@ PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
       double fx[8] = {};
       bool any_x = false;
       for (int x = 0; x < n; ++x) {
-        const PremultipliedSample* v = cell(x, y, z);
+        const PremultipliedSample* v = cell(first + x, first + y, first + z);
         if (v == nullptr) continue;
         float q[8];
         std::memcpy(q, v, sizeof q);

@@ -106,10 +106,12 @@ void Store(const EncodedSample& e, std::size_t at, SvoLevel& out) {
 // attributes (null `voxels`: the opacity alone, from the occupancy). The samples of all children
 // lie on one lattice of (2·side − 1)³ points: each point is computed and encoded once, then
 // copied into every child brick that holds it.
-void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std::uint64_t node,
-                 SvoLevel& out) {
+void VoxelBricks(const VoxelSamplesSource* voxels, const Svo& svo, const Block& block,
+                 std::uint64_t node, SvoLevel& out) {
   const bool color = voxels != nullptr && svo.has_color,
              normal = voxels != nullptr && svo.has_normal;
+  static const VoxelSamplesSource kOccupancyOnly;
+  const VoxelSamplesSource& source = voxels != nullptr ? *voxels : kOccupancyOnly;
   const int side = static_cast<int>(svo.brick_side);
   const int points = 2 * side - 1;     // per axis, over the 2 children
   const int step = side == 3 ? 1 : 2;  // point spacing in half voxels
@@ -119,12 +121,10 @@ void VoxelBricks(const VoxelSet* voxels, const Svo& svo, const Block& block, std
     for (int cy = 1; cy <= 4; ++cy) {
       for (int cx = 1; cx <= 4; ++cx) {
         const std::size_t c = BlockIndex(cx, cy, cz);
-        if (block[c] < 0) continue;
-        BrickSample b;
-        b.opacity = 1;
-        if (color) b.color = voxels->color(static_cast<std::size_t>(block[c]));
-        if (normal) b.normal = voxels->normals[static_cast<std::size_t>(block[c])];
-        cells[c] = Premultiply(b);
+        if (block[c] >= 0) {
+          cells[c] =
+              brick_math::VoxelCell(source, static_cast<std::size_t>(block[c]), color, normal);
+        }
       }
     }
   }
@@ -199,22 +199,19 @@ void AboveVoxelBrick(const VoxelSamplesSource& voxels, const Svo& svo, const Blo
                      std::uint64_t node, SvoLevel& out) {
   const bool color = svo.has_color, normal = svo.has_normal;
   const int side = static_cast<int>(svo.brick_side);
-  const int step = side == 3 ? 1 : 2, lo = side == 3 ? 1 : 2;
+  const int step = side == 3 ? 1 : 2;
   std::array<PremultipliedSample, kBlock * kBlock * kBlock> cells;
   for (std::size_t c = 0; c < cells.size(); ++c) {
-    if (block[c] < 0) continue;
-    BrickSample b;
-    b.opacity = 1;
-    if (color) b.color = voxels.color(static_cast<std::size_t>(block[c]));
-    if (normal) b.normal = voxels.normals[static_cast<std::size_t>(block[c])];
-    cells[c] = Premultiply(b);
+    if (block[c] >= 0) {
+      cells[c] = brick_math::VoxelCell(voxels, static_cast<std::size_t>(block[c]), color, normal);
+    }
   }
   for (int k = 0; k < side * side * side; ++k) {
     const int p[3] = {2 + step * (k % side), 2 + step * (k / side % side),
                       2 + step * (k / (side * side))};
     const PremultipliedSample sum = brick_math::AboveVoxels(
         svo.brick_side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
-          const std::size_t c = BlockIndex(p[0] - lo + dx, p[1] - lo + dy, p[2] - lo + dz);
+          const std::size_t c = BlockIndex(p[0] + dx, p[1] + dy, p[2] + dz);
           return block[c] < 0 ? nullptr : &cells[c];
         });
     Store(Encode(color, normal, sum), node * svo.brick_samples() + static_cast<std::size_t>(k),
@@ -371,44 +368,18 @@ void AllocateBricks(const Svo& svo, bool attributes, SvoLevel& lv) {
   lv.normal.assign(attributes && svo.has_normal ? n : 0, 0);
 }
 
-}  // namespace
-
-void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                  Svo& svo, int filter) {
-  for (SvoLevel& lv : svo.levels) AllocateBricks(svo, true, lv);
-  if (svo.brick_samples() == 0) return;
-  const VoxelSamplesSource source{voxels.colors, voxels.normals};
-  for (std::uint32_t level = svo.depth; level-- > 0;) {
-    // Every voxel brick must exist before a parent reads its neighbours'.
-    if (level + 1 == svo.depth) {
-      EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
-        VoxelBricks(&voxels, svo, block, i, svo.levels[svo.depth]);
-      });
-      if (filter == 2) {
-        EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
-          AboveVoxelBrick(source, svo, block, i, svo.levels[level]);
-        });
-        continue;
-      }
-    }
-    EachNode(svo, level_keys, level, [&](const Block& block, std::size_t i) {
-      ParentBrick(svo, level, block, i, svo.levels[level]);
-    });
-  }
-}
-
-SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
-                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
-                       Progress::Stage* stage) {
-  SvoLevel out;
-  out.node_count = svo.levels[level].node_count;
-  const bool voxel_level = level == svo.depth;
-  AllocateBricks(svo, !voxel_level, out);
-  if (svo.brick_samples() == 0) return out;
-  if (voxel_level) {
+// The bricks of `level` into `out` by brick filter `filter`: the voxel level's from the voxels
+// (their colours and normals only with `voxel_attributes`: otherwise the opacity alone), the
+// level above them in filter 2 from `voxels` too, the others by the tent over level + 1 as `svo`
+// stores it. `stage`, when given, advances by the nodes EachNode visits.
+void FilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                 std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
+                 bool voxel_attributes, SvoLevel& out, Progress::Stage* stage) {
+  if (level == svo.depth) {
+    const VoxelSamplesSource* attributes = voxel_attributes ? &voxels : nullptr;
     EachNode(
         svo, level_keys, level - 1,
-        [&](const Block& block, std::size_t i) { VoxelBricks(nullptr, svo, block, i, out); },
+        [&](const Block& block, std::size_t i) { VoxelBricks(attributes, svo, block, i, out); },
         stage);
   } else if (filter == 2 && level + 1 == svo.depth) {
     EachNode(
@@ -419,6 +390,31 @@ SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64
     EachNode(
         svo, level_keys, level,
         [&](const Block& block, std::size_t i) { ParentBrick(svo, level, block, i, out); }, stage);
+  }
+}
+
+}  // namespace
+
+void FilterBricks(const VoxelSet& voxels, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                  Svo& svo, int filter) {
+  for (SvoLevel& lv : svo.levels) AllocateBricks(svo, true, lv);
+  if (svo.brick_samples() == 0 || svo.depth == 0) return;  // a lone root has no level above it
+  const VoxelSamplesSource source{voxels.colors, voxels.normals};
+  // Finest first: a level's bricks read the level below as stored.
+  for (std::uint32_t level = svo.depth + 1; level-- > 0;) {
+    FilterLevel(svo, level_keys, level, filter, source, true, svo.levels[level], nullptr);
+  }
+}
+
+SvoLevel RefilterLevel(const Svo& svo, const std::vector<std::vector<std::uint64_t>>& level_keys,
+                       std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
+                       Progress::Stage* stage) {
+  SvoLevel out;
+  out.node_count = svo.levels[level].node_count;
+  const bool voxel_level = level == svo.depth;
+  AllocateBricks(svo, !voxel_level, out);
+  if (svo.brick_samples() != 0) {
+    FilterLevel(svo, level_keys, level, filter, voxels, false, out, stage);
   }
   return out;
 }

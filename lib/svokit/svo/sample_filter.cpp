@@ -93,9 +93,8 @@ class VoxelTile {
 
   // The level above the voxels' sample at voxel corner p (brick_math::AboveVoxels).
   PremultipliedSample Above(const int p[3], std::uint32_t side) {
-    const int lo = side == 3 ? 1 : 2;
     return brick_math::AboveVoxels(side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
-      const int x = p[0] - lo + dx, y = p[1] - lo + dy, z = p[2] - lo + dz;
+      const int x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
       return Present(x, y, z) ? &Cell(voxel_[VoxelAt(x, y, z)]).cell : nullptr;
     });
   }
@@ -176,12 +175,8 @@ class VoxelTile {
 
   Voxel& Cell(Voxel& v) {
     if (v.has_cell) return v;
-    BrickSample b;
-    b.opacity = 1;
-    const auto i = static_cast<std::size_t>(v.index);
-    if (f_.color) b.color = source_->color(i);
-    if (f_.normal) b.normal = source_->normals[i];
-    v.cell = Premultiply(b);
+    v.cell =
+        brick_math::VoxelCell(*source_, static_cast<std::size_t>(v.index), f_.color, f_.normal);
     v.has_cell = true;
     return v;
   }
