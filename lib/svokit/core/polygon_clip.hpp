@@ -1,8 +1,8 @@
 #pragma once
 // Sutherland–Hodgman clipping of a convex polygon against one half-space {distance(v) ≥ 0}. Every
-// clipper in svokit (the attribute sampler's, the column-area path's, the contour fitter's) walks
-// the polygon with ForEachClipEdge, so all of them cut an edge with the same arithmetic; what
-// each keeps, and how it stores the result, is the caller's.
+// clipper in svokit (the attribute sampler's, the column-area path's, the contour fitter's) cuts
+// an edge with ClipLerp at t = d_prev / (d_prev − d_cur), most of them walking the polygon with
+// ForEachClipEdge; what each keeps, and how it stores the result, is the caller's.
 
 #include <algorithm>
 #include <utility>

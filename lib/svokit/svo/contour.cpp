@@ -105,27 +105,41 @@ struct Pieces {
 
 // Sutherland–Hodgman against one closed axis half-space: keeps p[axis] ≤ value (keep_low) or
 // ≥ value. Points on the plane are kept, so geometry in a shared face goes to both sides; new
-// vertices are snapped onto the plane. Exact consecutive duplicates are dropped.
-void ClipAxis(const std::vector<Vec3d>& in, int axis, double value, bool keep_low,
-              std::vector<Vec3d>& out) {
-  out.clear();
-  if (in.empty()) return;
-  const int n = static_cast<int>(in.size());
-  const auto dist = [&](const Vec3d& p) { return keep_low ? p[axis] - value : value - p[axis]; };
+// vertices are snapped onto the plane. Exact consecutive duplicates are dropped. `out` has room
+// for 2n vertices (each edge emits at most its start and its cut); returns the count written.
+int ClipAxis(const Vec3d* in, int n, int axis, double value, bool keep_low, Vec3d* out) {
+  if (n == 0) return 0;
+  int m = 0;
   const auto push = [&](const Vec3d& p) {
-    if (out.empty() || !(out.back() == p)) out.push_back(p);
+    if (m == 0 || !(out[m - 1] == p)) out[m++] = p;
   };
-  // Each edge emits its start (when kept) and then its cut: the walk starts at the edge 0 → 1.
-  ForEachClipEdge(in.data(), n, n > 1 ? 1 : 0, dist, [&](const ClipEdge<Vec3d>& e) {
-    if (e.d_prev <= 0) push(e.prev);
-    if ((e.d_prev < 0 && e.d_cur > 0) || (e.d_prev > 0 && e.d_cur < 0)) {
-      Vec3d p = e.cut;
+  const auto dist = [&](const Vec3d& p) { return keep_low ? p[axis] - value : value - p[axis]; };
+  // Edges 0 → 1, …, n − 1 → 0: each emits its start (when kept), then its cut.
+  double d_prev = dist(in[0]);
+  for (int i = 0; i < n; ++i) {
+    const Vec3d& prev = in[i];
+    const Vec3d& cur = in[i + 1 < n ? i + 1 : 0];
+    const double d_cur = dist(cur);
+    if (d_prev <= 0) push(prev);
+    if ((d_prev < 0 && d_cur > 0) || (d_prev > 0 && d_cur < 0)) {
+      Vec3d p = ClipLerp(prev, cur, d_prev / (d_prev - d_cur));
       p[axis] = value;
       push(p);
     }
-  });
-  if (out.size() > 1 && out.front() == out.back()) out.pop_back();
+    d_prev = d_cur;
+  }
+  if (m > 1 && out[0] == out[m - 1]) --m;
+  return m;
 }
+
+// A scratch polygon: room for `n` vertices, grown only when a larger polygon comes.
+struct PolygonBuffer {
+  std::vector<Vec3d> v;
+  Vec3d* Room(int n) {
+    if (v.size() < static_cast<std::size_t>(n)) v.resize(static_cast<std::size_t>(n));
+    return v.data();
+  }
+};
 
 struct Fit {
   double cost = std::numeric_limits<double>::infinity();  // clipped thickness / node size
@@ -133,9 +147,9 @@ struct Fit {
 };
 
 struct Scratch {
-  std::vector<Vec3d> a, b;
-  std::array<std::vector<Vec3d>, 2> x;
-  std::array<std::vector<Vec3d>, 4> xy;
+  std::array<PolygonBuffer, 2> x;
+  std::array<PolygonBuffer, 4> xy;
+  PolygonBuffer a, b;
   std::vector<Vec3d> u;  // fit points in node units
   std::vector<float> uf;
   std::vector<Fit> starts;
@@ -148,8 +162,9 @@ void SplitPieces(const Pieces& in, const Vec3d& mid, double eps, std::array<Piec
                  Scratch& s) {
   for (const Piece& pc : in.pieces) {
     const Vec3d* v = in.verts.data() + pc.begin;
+    const int n = static_cast<int>(pc.count);
     Vec3d lo = v[0], hi = v[0];
-    for (std::uint32_t i = 1; i < pc.count; ++i) {
+    for (int i = 1; i < n; ++i) {
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min(lo[a], v[i][a]);
         hi[a] = std::max(hi[a], v[i][a]);
@@ -168,36 +183,38 @@ void SplitPieces(const Pieces& in, const Vec3d& mid, double eps, std::array<Piec
       if (out[single]) out[single]->Add(pc.tri, v, pc.count);
       continue;
     }
-    s.a.assign(v, v + pc.count);
     // Stage x → up to 2 polygons, y → up to 4, z → up to 8; a side the piece does not reach
-    // (or whose children are all absent) is skipped.
+    // (or whose children are all absent) is skipped, an axis the piece does not cross is not cut.
     for (unsigned cx = 0; cx < 2; ++cx) {
       if (!(sides[0] >> cx & 1u)) continue;
-      auto& px = s.x[cx];
+      const Vec3d* px = v;
+      int nx = n;
       if (sides[0] == 3u) {
-        ClipAxis(s.a, 0, cx ? mid.x - eps : mid.x + eps, cx == 0, px);
-      } else {
-        px = s.a;
+        Vec3d* dst = s.x[cx].Room(2 * n);
+        nx = ClipAxis(v, n, 0, cx ? mid.x - eps : mid.x + eps, cx == 0, dst);
+        px = dst;
       }
-      if (px.empty()) continue;
+      if (nx == 0) continue;
       for (unsigned cy = 0; cy < 2; ++cy) {
         if (!(sides[1] >> cy & 1u)) continue;
-        auto& pxy = s.xy[cx * 2 + cy];
+        const Vec3d* pxy = px;
+        int nxy = nx;
         if (sides[1] == 3u) {
-          ClipAxis(px, 1, cy ? mid.y - eps : mid.y + eps, cy == 0, pxy);
-        } else {
-          pxy = px;
+          Vec3d* dst = s.xy[cx * 2 + cy].Room(2 * nx);
+          nxy = ClipAxis(px, nx, 1, cy ? mid.y - eps : mid.y + eps, cy == 0, dst);
+          pxy = dst;
         }
-        if (pxy.empty()) continue;
+        if (nxy == 0) continue;
         for (unsigned cz = 0; cz < 2; ++cz) {
           if (!(sides[2] >> cz & 1u)) continue;
           Pieces* dst = out[cx | cy << 1 | cz << 2];
           if (!dst) continue;
           if (sides[2] == 3u) {
-            ClipAxis(pxy, 2, cz ? mid.z - eps : mid.z + eps, cz == 0, s.b);
-            if (!s.b.empty()) dst->Add(pc.tri, s.b.data(), s.b.size());
+            Vec3d* b = s.b.Room(2 * nxy);
+            const int nb = ClipAxis(pxy, nxy, 2, cz ? mid.z - eps : mid.z + eps, cz == 0, b);
+            if (nb > 0) dst->Add(pc.tri, b, static_cast<std::size_t>(nb));
           } else {
-            dst->Add(pc.tri, pxy.data(), pxy.size());
+            dst->Add(pc.tri, pxy, static_cast<std::size_t>(nxy));
           }
         }
       }
@@ -279,6 +296,7 @@ const Offsets kOffsets;
 // float pass over the points (it vectorizes, where 26 passes would not), then re-fits the winner
 // exactly in double, so rounding in the search can cost tightness but never conservativeness.
 Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, int max_steps) {
+  if (max_steps <= 0) return best;
   uf.resize(u.size() * 3);
   for (std::size_t i = 0; i < u.size(); ++i) {
     uf[3 * i] = float(u[i].x);
@@ -417,8 +435,12 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
       starts.push_back(EvalNormal(pts, q[0], q[1], q[2]));
     }
   }
-  std::stable_sort(starts.begin(), starts.end(),
-                   [](const Fit& x, const Fit& y) { return x.cost < y.cost; });
+  // Stable insertion sort: at most 15 starts, and std::stable_sort would allocate per node.
+  for (std::size_t i = 1; i < starts.size(); ++i) {
+    for (std::size_t j = i; j > 0 && starts[j].cost < starts[j - 1].cost; --j) {
+      std::swap(starts[j], starts[j - 1]);
+    }
+  }
   Fit best;
   const std::size_t searches = std::min<std::size_t>(starts.size(), big ? 4 : 1);
   for (std::size_t i = 0; i < searches; ++i) {
@@ -552,12 +574,15 @@ std::vector<std::vector<std::uint32_t>> ContourFitter::FitSubtree(
   const double rlo = -eps_, rhi = extent + eps_;
   for (const std::uint32_t t : triangles) {
     const Triangle& tri = mesh_.triangles[t];
-    s.a = {vox_[tri[0]], vox_[tri[1]], vox_[tri[2]]};
-    for (int a = 0; a < 3 && !s.a.empty(); ++a) {
-      ClipAxis(s.a, a, rlo, false, s.b);
-      ClipAxis(s.b, a, rhi, true, s.a);
+    Vec3d* a = s.a.Room(3 << 6);
+    Vec3d* b = s.b.Room(3 << 6);
+    a[0] = vox_[tri[0]], a[1] = vox_[tri[1]], a[2] = vox_[tri[2]];
+    int n = 3;
+    for (int axis = 0; axis < 3 && n > 0; ++axis) {
+      n = ClipAxis(a, n, axis, rlo, false, b);
+      n = ClipAxis(b, n, axis, rhi, true, a);
     }
-    if (!s.a.empty()) pieces.Add(t, s.a.data(), s.a.size());
+    if (n > 0) pieces.Add(t, a, static_cast<std::size_t>(n));
   }
   const std::uint64_t root = level_keys[0][0];
   for (std::uint32_t l = 0; l < first && !pieces.pieces.empty(); ++l) {

@@ -132,11 +132,23 @@ class PageSampleCopier {
     const MortonCoord c = MortonDecode(node_key);
     const std::vector<std::uint8_t>& masks = svo_.whole.tree.masks[l];
     const std::vector<std::uint64_t>& first = svo_.whole.tree.first_child[l];
+    // A neighbour inside the page's cube has all its voxels in the page: only the page's
+    // border nodes look at their neighbours' voxels.
+    const MortonCoord page = MortonDecode(page_.root_key);
+    const int shift = static_cast<int>(l - page_.root_level);
+    const auto inside = [shift](std::int64_t v, std::uint32_t page_coord) {
+      return v >= 0 && (v >> shift) == static_cast<std::int64_t>(page_coord);
+    };
     for (int oz = -1; oz <= 1; ++oz) {
       for (int oy = -1; oy <= 1; ++oy) {
         for (int ox = -1; ox <= 1; ++ox) {
           const std::int64_t q = global_nb[NeighbourSlot(ox, oy, oz)];
           if (q < 0) continue;
+          if (inside(static_cast<std::int64_t>(c.x) + ox, page.x) &&
+              inside(static_cast<std::int64_t>(c.y) + oy, page.y) &&
+              inside(static_cast<std::int64_t>(c.z) + oz, page.z)) {
+            continue;
+          }
           std::uint64_t voxel = first[q];
           for (unsigned ch = 0; ch < 8; ++ch) {
             if (!(masks[q] >> ch & 1u)) continue;
