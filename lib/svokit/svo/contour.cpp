@@ -228,12 +228,12 @@ int Floor(double x) {
   return i - (x < i ? 1 : 0);
 }
 
-// The tightest quantized slab along integer normal n (non-zero) holding n·u ∈ [dmin, dmax], widened
-// by the safety margin and rounded outward.
-Fit Quantize(double dmin, double dmax, int nx, int ny, int nz) {
+// The tightest quantized slab along integer normal n (non-zero, Euclidean length `norm`) holding
+// n·u ∈ [dmin, dmax], widened by the safety margin and rounded outward.
+Fit Quantize(double dmin, double dmax, int nx, int ny, int nz, double norm) {
   Fit f;
   const double l1 = std::abs(nx) + std::abs(ny) + std::abs(nz), half = 0.5 * l1;
-  const double inv_norm = 1 / std::sqrt(double(nx * nx + ny * ny + nz * nz));
+  const double inv_norm = 1 / norm;
   // Geometry inside the cube never leaves [−L1/2, L1/2] along n: clamp before widening.
   const double margin = kSlabMargin * l1;
   const double lo = (std::max(dmin, -half) - margin) * (1 / kStep);
@@ -269,7 +269,7 @@ Fit EvalNormal(const std::vector<Vec3d>& u, int nx, int ny, int nz,
     dmax = std::max(dmax, d);
     if (std::min(dmax, half) - std::max(dmin, -half) >= width_bound) return f;
   }
-  return Quantize(dmin, dmax, nx, ny, nz);
+  return Quantize(dmin, dmax, nx, ny, nz, norm);
 }
 
 // The 26 integer neighbour offsets of a normal (each component −1, 0 or +1), padded to 28 lanes.
@@ -329,7 +329,8 @@ Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, i
       const double half = 0.5 * (std::abs(nx) + std::abs(ny) + std::abs(nz));
       const double width = std::min(double(mx[k]), half) - std::max(double(mn[k]), -half);
       if (width * width >= best.cost * best.cost * double(nx * nx + ny * ny + nz * nz)) continue;
-      const double cost = Quantize(mn[k], mx[k], nx, ny, nz).cost;
+      const double cost =
+          Quantize(mn[k], mx[k], nx, ny, nz, std::sqrt(double(nx * nx + ny * ny + nz * nz))).cost;
       if (cost < best.cost + 1e-6) est[std::size_t(n_est++)] = {cost, int(k)};
     }
     std::sort(est.begin(), est.begin() + n_est);
@@ -372,7 +373,7 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
                       Scratch& s) {
   s.u.clear();
   Vec3d normal{}, fallback{};
-  double abs_area = 0;
+  double abs_area = 0, fallback_length = 0;
   const double inv = 1.0 / size;
   const auto to_u = [&](const Vec3d& v) { return (v - center) * inv; };
   for (const Piece& pc : pieces.pieces) {
@@ -391,8 +392,9 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
       area = Cross(b - a, c - a);
     }
     normal = normal + area;
-    abs_area += Length(area);
-    if (Length(area) > Length(fallback)) fallback = area;
+    const double area_length = Length(area);
+    abs_area += area_length;
+    if (area_length > fallback_length) fallback = area, fallback_length = area_length;
   }
   if (s.u.empty()) return 0;
   // Starting normals: the area-weighted normal; where the surface folds back inside the node
@@ -410,12 +412,13 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
   const std::vector<Vec3d>& pts = *search_pts;
   std::vector<Fit>& starts = s.starts;
   starts.clear();
-  if (Length(normal) > 1e-3 * abs_area && Length(normal) > 0) {
+  const double normal_length = Length(normal);
+  if (normal_length > 1e-3 * abs_area && normal_length > 0) {
     const auto q = QuantizeNormal(normal);
     starts.push_back(EvalNormal(pts, q[0], q[1], q[2]));
   }
   const bool big = pieces.pieces.size() >= kMultiStartPieces;
-  if (big || Length(normal) <= 0.25 * abs_area) {
+  if (big || normal_length <= 0.25 * abs_area) {
     static constexpr std::array<std::array<int, 3>, 13> kDirs{{{31, 0, 0},
                                                                {0, 31, 0},
                                                                {0, 0, 31},
@@ -430,7 +433,7 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
                                                                {31, -31, 31},
                                                                {-31, 31, 31}}};
     for (const auto& d : kDirs) starts.push_back(EvalNormal(pts, d[0], d[1], d[2]));
-    if (Length(fallback) > 0) {
+    if (fallback_length > 0) {
       const auto q = QuantizeNormal(fallback);
       starts.push_back(EvalNormal(pts, q[0], q[1], q[2]));
     }
@@ -452,8 +455,11 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
   if (!std::isfinite(best.cost)) return 0;
   if (search_pts != &s.u) best = EvalNormal(s.u, best.c.nx, best.c.ny, best.c.nz);
   if (!std::isfinite(best.cost)) return 0;
-  const ContourSpan span = ClippedSpan(best.c);
-  if (!((span.high - span.low) / span.l1 <= ctx.options.max_relative_thickness)) return 0;
+  // The storage rule on ClippedSpan's extent fraction (without its Euclidean length).
+  const double l1 = std::abs(best.c.nx) + std::abs(best.c.ny) + std::abs(best.c.nz);
+  const double kept = std::clamp(best.c.High(), -0.5 * l1, 0.5 * l1) -
+                      std::clamp(best.c.Low(), -0.5 * l1, 0.5 * l1);
+  if (!(kept / l1 <= ctx.options.max_relative_thickness)) return 0;
   return EncodeContour(best.c);
 }
 
