@@ -91,11 +91,14 @@ class VoxelTile {
     }
   }
 
-  // The level above the voxels' sample at voxel corner p (brick_math::AboveVoxels).
+  // The level above the voxels' sample at voxel corner p (brick_math::AboveVoxels). An absent
+  // voxel reads as +0 rather than being skipped: the same sums (a sum from +0 is never −0), with
+  // no branch on presence.
   PremultipliedSample Above(const int p[3], std::uint32_t side) {
+    static constexpr PremultipliedSample kAbsent{};
     return brick_math::AboveVoxels(side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
       const int x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
-      return Present(x, y, z) ? &Cell(voxel_[VoxelAt(x, y, z)]).cell : nullptr;
+      return Present(x, y, z) ? &Cell(voxel_[VoxelAt(x, y, z)]).cell : &kAbsent;
     });
   }
 
@@ -259,28 +262,6 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
   });
 }
 
-// Decoded finer samples around one node, computed on first use: index t ∈ [0, 7)³ per axis, the
-// finer lattice point 2k + d − 1 of the node's sample k and tap d (in finer lattice steps from
-// the node's corner).
-template <class Compute>
-class TapCache {
- public:
-  explicit TapCache(const Compute& compute) : compute_(compute) { done_.fill(0); }
-  const PremultipliedSample& operator()(int x, int y, int z) {
-    const int i = x + 7 * (y + 7 * z);
-    if (!done_[i]) {
-      taps_[i] = compute_(x, y, z);
-      done_[i] = 1;
-    }
-    return taps_[i];
-  }
-
- private:
-  const Compute& compute_;
-  std::array<std::uint8_t, 343> done_;
-  std::array<PremultipliedSample, 343> taps_;
-};
-
 // Calls store(s, at) for every sample s a node stores, at its index `at` in layout order: its home
 // samples, then its orphans.
 template <class Store>
@@ -296,6 +277,69 @@ void ForEachStoredSample(std::uint32_t side, std::uint32_t orphans, std::uint64_
     }
   }
 }
+
+// The decoded finer samples a node's tents read: tap t ∈ [0, 7)³ is the finer lattice point t − 1
+// (in finer lattice steps from the node's corner), zero where no finer node holds it. Filled by
+// walking the finer nodes of the node's child block once, each scattering the samples it stores
+// within the taps of the node's stored samples: every point is stored by exactly one node, and
+// the one storing a point at −1 .. 2·side − 1 is within the block.
+class TapBlock {
+ public:
+  TapBlock(const ChildBlock& block, const SampleLayout& finer_layout, const LevelSamples& finer,
+           std::uint32_t side, std::uint32_t orphans, Flags f) {
+    present_.fill(0);
+    const int top = static_cast<int>(side) - 1;
+    // Per axis, the last lattice point a stored sample's tent reads (sample k reads 2k − 1 ..
+    // 2k + 1): home samples reach 2·top − 1, orphans 2·side − 1.
+    int reach[3] = {2 * top - 1, 2 * top - 1, 2 * top - 1};
+    ForEachStoredSample(side, orphans, 0, [&](unsigned s, std::uint64_t) {
+      const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
+                        static_cast<int>(s / (side * side))};
+      for (int a = 0; a < 3; ++a) reach[a] = std::max(reach[a], 2 * k[a] + 1);
+    });
+    for (int bz = 0; bz < kBlock; ++bz) {
+      for (int by = 0; by < kBlock; ++by) {
+        for (int bx = 0; bx < kBlock; ++bx) {
+          const std::int64_t q = block[static_cast<std::size_t>(BlockIndex(bx, by, bz))];
+          if (q < 0) continue;
+          const auto node = static_cast<std::uint64_t>(q);
+          // The finer node's first lattice point, relative to the node's corner.
+          const int base[3] = {top * (bx - 2), top * (by - 2), top * (bz - 2)};
+          if (base[0] > reach[0] || base[1] > reach[1] || base[2] > reach[2] ||
+              base[0] + top < -1 || base[1] + top < -1 || base[2] + top < -1) {
+            continue;
+          }
+          ForEachStoredSample(
+              side, finer_layout.orphans[node], finer_layout.first[node],
+              [&](unsigned s, std::uint64_t at) {
+                const int p[3] = {base[0] + static_cast<int>(s % side),
+                                  base[1] + static_cast<int>(s / side % side),
+                                  base[2] + static_cast<int>(s / (side * side))};
+                for (int a = 0; a < 3; ++a) {
+                  if (p[a] < -1 || p[a] > reach[a]) return;
+                }
+                const EncodedSample e = LoadSample(finer, at);
+                if (e.opacity == 0) return;
+                const int i = (p[0] + 1) + 7 * ((p[1] + 1) + 7 * (p[2] + 1));
+                taps_[static_cast<std::size_t>(i)] = DecodePremultiplied(e, f.color, f.normal);
+                present_[static_cast<std::size_t>(i / 64)] |= std::uint64_t{1} << (i % 64);
+              });
+        }
+      }
+    }
+  }
+  const PremultipliedSample& operator()(int x, int y, int z) const {
+    const int i = x + 7 * (y + 7 * z);
+    return present_[static_cast<std::size_t>(i / 64)] >> (i % 64) & 1u
+               ? taps_[static_cast<std::size_t>(i)]
+               : kZero;
+  }
+
+ private:
+  static constexpr PremultipliedSample kZero{};
+  std::array<std::uint64_t, 6> present_;
+  std::array<PremultipliedSample, 343> taps_;
+};
 
 // Filters and stores the samples a node stores, in layout order: its home samples, then its
 // orphans. fetch(tx, ty, tz) is the decoded finer sample at tap index t = 2k + d (k the sample,
@@ -403,34 +447,8 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
   ForEachNeighbourhood(
       tree, level,
       [&](std::uint64_t i, const Neighbourhood& nb) {
-        const ChildBlock block = ChildrenOf(tree, level, nb);
-        const auto finer_sample = [&](int x, int y, int z) {
-          // Finer lattice point 2k + d − 1: its home node's block coordinate and home sample.
-          const int t[3] = {x, y, z};
-          int home[3], k[3];
-          for (int a = 0; a < 3; ++a) {
-            if (side == 3) {
-              const int r = t[a] - 1;  // −1..5
-              const int half = r < 0 ? -1 : r / 2;
-              home[a] = half + 2;
-              k[a] = r - 2 * half;
-            } else {
-              home[a] = t[a] + 1;
-              k[a] = 0;
-            }
-          }
-          const std::uint64_t at =
-              PointIndex(finer_layout, static_cast<unsigned>(k[0] + side * (k[1] + side * k[2])),
-                         [&](unsigned fb) {
-                           return block[BlockIndex(home[0] - static_cast<int>(fb & 1),
-                                                   home[1] - static_cast<int>(fb >> 1 & 1),
-                                                   home[2] - static_cast<int>(fb >> 2 & 1))];
-                         });
-          if (at == ~std::uint64_t{0}) return PremultipliedSample{};
-          const EncodedSample e = LoadSample(finer, at);
-          return e.opacity == 0 ? PremultipliedSample{} : DecodePremultiplied(e, f.color, f.normal);
-        };
-        TapCache taps(finer_sample);
+        const TapBlock taps(ChildrenOf(tree, level, nb), finer_layout, finer, side,
+                            layout.orphans[i], f);
         StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
       },
       stage);

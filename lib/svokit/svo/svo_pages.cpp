@@ -40,10 +40,7 @@ class PageSampleCopier {
       : svo_(svo), page_(page), voxels_(voxels) {}
 
   void Run(std::uint64_t page_node, const Neighbourhood& nb) {
-    Neighbourhood root;
-    root.fill(-1);
-    root[NeighbourSlot(0, 0, 0)] = 0;
-    Visit(page_.root_level, 0, page_node, root, nb, page_.root_key);
+    Visit(page_.root_level, 0, page_node, &nb, page_.root_key);
   }
 
   // The halo's keys, colours and normals, in key order.
@@ -59,12 +56,15 @@ class PageSampleCopier {
   }
 
  private:
+  // Node `local` of the page, `global` of the whole tree, at level l. `global_nb` is its
+  // neighbourhood in the whole tree, or null when all its neighbours lie inside the page: there
+  // it stores what it stores in the whole tree, and so do its descendants.
   void Visit(std::uint32_t l, std::uint64_t local, std::uint64_t global,
-             const Neighbourhood& local_nb, const Neighbourhood& global_nb,
-             std::uint64_t node_key) {
+             const Neighbourhood* global_nb, std::uint64_t node_key) {
+    if (global_nb != nullptr && InsidePage(l, node_key)) global_nb = nullptr;
     CopyNodeSamples(l, local, global, global_nb);
     if (l + 1 == svo_.depth()) {
-      CollectHalo(l, global, global_nb, node_key);
+      if (global_nb != nullptr) CollectHalo(l, global, *global_nb, node_key);
       return;
     }
     const MaskTree& tree = svo_.whole.tree;
@@ -72,19 +72,34 @@ class PageSampleCopier {
     const std::uint8_t m = page_.tree.masks[k][local];
     std::uint64_t local_child = page_.tree.first_child[k][local];
     std::uint64_t global_child = tree.first_child[l][global];
-    const ChildNeighbourhoods local_children(page_.tree, l, local_nb);
-    const ChildNeighbourhoods global_children(tree, l, global_nb);
+    if (global_nb == nullptr) {
+      for (unsigned ch = 0; ch < 8; ++ch) {
+        if (m >> ch & 1u) Visit(l + 1, local_child++, global_child++, nullptr, node_key << 3 | ch);
+      }
+      return;
+    }
+    const ChildNeighbourhoods global_children(tree, l, *global_nb);
     for (unsigned ch = 0; ch < 8; ++ch) {
       if (!(m >> ch & 1u)) continue;
-      Visit(l + 1, local_child++, global_child++, local_children[ch], global_children[ch],
-            node_key << 3 | ch);
+      const Neighbourhood child_nb = global_children[ch];
+      Visit(l + 1, local_child++, global_child++, &child_nb, node_key << 3 | ch);
     }
+  }
+
+  // Whether the 27 cubes around the level-l node `node_key` all lie inside the page's cube.
+  bool InsidePage(std::uint32_t l, std::uint64_t node_key) const {
+    const MortonCoord c = MortonDecode(node_key), page = MortonDecode(page_.root_key);
+    const int shift = static_cast<int>(l - page_.root_level);
+    const auto inside = [shift](std::uint32_t v, std::uint32_t page_coord) {
+      return v > 0 && ((v - 1) >> shift) == page_coord && ((v + 1) >> shift) == page_coord;
+    };
+    return inside(c.x, page.x) && inside(c.y, page.y) && inside(c.z, page.z);
   }
 
   // The samples the page's layout gives node `local`, copied from where the whole tree's layout
   // keeps them.
   void CopyNodeSamples(std::uint32_t l, std::uint64_t local, std::uint64_t global,
-                       const Neighbourhood& global_nb) {
+                       const Neighbourhood* global_nb) {
     const std::uint32_t k = l - page_.root_level;
     const SampleLayout& layout = page_.layouts[k];
     const SampleLayout& whole = svo_.whole.layouts[l];
@@ -103,7 +118,7 @@ class PageSampleCopier {
       }
     };
     const std::uint32_t orphans = layout.orphans[local];
-    if (orphans == whole.orphans[global]) {
+    if (orphans == whole.orphans[global] || global_nb == nullptr) {
       // Away from the page's border the node stores what it stores in the whole tree, in the
       // same order: one run of samples.
       copy(whole.first[global], layout.first[local], whole.first[global + 1] - whole.first[global]);
@@ -121,7 +136,7 @@ class PageSampleCopier {
       } else {
         continue;
       }
-      copy(SampleIndex(whole, global_nb, s), to, 1);
+      copy(SampleIndex(whole, *global_nb, s), to, 1);
     }
   }
 
