@@ -23,37 +23,6 @@ struct Flags {
   bool color, normal;
 };
 
-// The children of a node's 27 neighbours: next-level node indices, 6³, block coordinate
-// 2·offset + child bit + 2 per axis (the node's own children at 2..3), −1 where absent.
-constexpr int kBlock = 6;
-using ChildBlock = std::array<std::int64_t, kBlock * kBlock * kBlock>;
-constexpr int BlockIndex(int x, int y, int z) {
-  return x + kBlock * (y + kBlock * z);
-}
-
-ChildBlock ChildrenOf(const MaskTree& tree, std::uint32_t level, const Neighbourhood& nb) {
-  ChildBlock block;
-  block.fill(-1);
-  const std::uint8_t* masks = tree.masks[level - tree.first_level].data();
-  const std::uint64_t* first = tree.first_child[level - tree.first_level].data();
-  for (int oz = -1; oz <= 1; ++oz) {
-    for (int oy = -1; oy <= 1; ++oy) {
-      for (int ox = -1; ox <= 1; ++ox) {
-        const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
-        if (q < 0) continue;
-        const unsigned m = masks[q];
-        auto child = static_cast<std::int64_t>(first[q]);
-        for (int c = 0; c < 8; ++c) {
-          if (!(m >> c & 1u)) continue;
-          block[BlockIndex(2 * ox + (c & 1) + 2, 2 * oy + (c >> 1 & 1) + 2,
-                           2 * oz + (c >> 2 & 1) + 2)] = child++;
-        }
-      }
-    }
-  }
-  return block;
-}
-
 // The voxels around a tile of the octree (a node up to four levels above the voxels) as the filter
 // sees them, and the voxel-level samples there, each computed once per tile. Coordinates are
 // relative to the tile's corner: voxels from −2 to W + 1 (W voxels per tile edge), lattice points
@@ -278,69 +247,6 @@ void ForEachStoredSample(std::uint32_t side, std::uint32_t orphans, std::uint64_
   }
 }
 
-// The decoded finer samples a node's tents read: tap t ∈ [0, 7)³ is the finer lattice point t − 1
-// (in finer lattice steps from the node's corner), zero where no finer node holds it. Filled by
-// walking the finer nodes of the node's child block once, each scattering the samples it stores
-// within the taps of the node's stored samples: every point is stored by exactly one node, and
-// the one storing a point at −1 .. 2·side − 1 is within the block.
-class TapBlock {
- public:
-  TapBlock(const ChildBlock& block, const SampleLayout& finer_layout, const LevelSamples& finer,
-           std::uint32_t side, std::uint32_t orphans, Flags f) {
-    present_.fill(0);
-    const int top = static_cast<int>(side) - 1;
-    // Per axis, the last lattice point a stored sample's tent reads (sample k reads 2k − 1 ..
-    // 2k + 1): home samples reach 2·top − 1, orphans 2·side − 1.
-    int reach[3] = {2 * top - 1, 2 * top - 1, 2 * top - 1};
-    ForEachStoredSample(side, orphans, 0, [&](unsigned s, std::uint64_t) {
-      const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
-                        static_cast<int>(s / (side * side))};
-      for (int a = 0; a < 3; ++a) reach[a] = std::max(reach[a], 2 * k[a] + 1);
-    });
-    for (int bz = 0; bz < kBlock; ++bz) {
-      for (int by = 0; by < kBlock; ++by) {
-        for (int bx = 0; bx < kBlock; ++bx) {
-          const std::int64_t q = block[static_cast<std::size_t>(BlockIndex(bx, by, bz))];
-          if (q < 0) continue;
-          const auto node = static_cast<std::uint64_t>(q);
-          // The finer node's first lattice point, relative to the node's corner.
-          const int base[3] = {top * (bx - 2), top * (by - 2), top * (bz - 2)};
-          if (base[0] > reach[0] || base[1] > reach[1] || base[2] > reach[2] ||
-              base[0] + top < -1 || base[1] + top < -1 || base[2] + top < -1) {
-            continue;
-          }
-          ForEachStoredSample(
-              side, finer_layout.orphans[node], finer_layout.first[node],
-              [&](unsigned s, std::uint64_t at) {
-                const int p[3] = {base[0] + static_cast<int>(s % side),
-                                  base[1] + static_cast<int>(s / side % side),
-                                  base[2] + static_cast<int>(s / (side * side))};
-                for (int a = 0; a < 3; ++a) {
-                  if (p[a] < -1 || p[a] > reach[a]) return;
-                }
-                const EncodedSample e = LoadSample(finer, at);
-                if (e.opacity == 0) return;
-                const int i = (p[0] + 1) + 7 * ((p[1] + 1) + 7 * (p[2] + 1));
-                taps_[static_cast<std::size_t>(i)] = DecodePremultiplied(e, f.color, f.normal);
-                present_[static_cast<std::size_t>(i / 64)] |= std::uint64_t{1} << (i % 64);
-              });
-        }
-      }
-    }
-  }
-  const PremultipliedSample& operator()(int x, int y, int z) const {
-    const int i = x + 7 * (y + 7 * z);
-    return present_[static_cast<std::size_t>(i / 64)] >> (i % 64) & 1u
-               ? taps_[static_cast<std::size_t>(i)]
-               : kZero;
-  }
-
- private:
-  static constexpr PremultipliedSample kZero{};
-  std::array<std::uint64_t, 6> present_;
-  std::array<PremultipliedSample, 343> taps_;
-};
-
 // Filters and stores the samples a node stores, in layout order: its home samples, then its
 // orphans. fetch(tx, ty, tz) is the decoded finer sample at tap index t = 2k + d (k the sample,
 // d ∈ 0..2 the tap, t ∈ [0, 2·side]). With side 3 the eight home samples share one separable pass
@@ -440,18 +346,124 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
       stage);
 }
 
-// An inner level's samples from the stored samples of the level below.
+// Calls visit(i, x, y, z) for every node i of level `to` whose coordinates relative to the corner
+// of a tile (a node of level tile_level whose neighbourhood is `nb`), in level-`to` units, lie in
+// [lo, hi]³: the tile's own nodes and those of its neighbours' that are near enough, descending
+// only into subtrees that reach the range.
+template <class Visit>
+void ForEachNodeNearTile(const MaskTree& tree, std::uint32_t tile_level, const Neighbourhood& nb,
+                         std::uint32_t to, int lo, int hi, const Visit& visit) {
+  const auto descend = [&](const auto& self, std::uint32_t l, std::uint64_t i, int x, int y,
+                           int z) -> void {
+    const int span = 1 << (to - l);  // level-`to` nodes per edge of this node
+    const auto reaches = [&](int c) { return c * span <= hi && (c + 1) * span - 1 >= lo; };
+    if (!reaches(x) || !reaches(y) || !reaches(z)) return;
+    if (l == to) {
+      visit(i, x, y, z);
+      return;
+    }
+    const std::uint8_t m = tree.masks[l - tree.first_level][i];
+    std::uint64_t child = tree.first_child[l - tree.first_level][i];
+    for (int c = 0; c < 8; ++c) {
+      if (m >> c & 1u) {
+        self(self, l + 1, child++, 2 * x + (c & 1), 2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
+      }
+    }
+  };
+  for (int oz = -1; oz <= 1; ++oz) {
+    for (int oy = -1; oy <= 1; ++oy) {
+      for (int ox = -1; ox <= 1; ++ox) {
+        const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
+        if (q >= 0) descend(descend, tile_level, static_cast<std::uint64_t>(q), ox, oy, oz);
+      }
+    }
+  }
+}
+
+// The decoded samples of the finer level around a tile: lattice points −1 .. n − 2 per axis (in
+// finer lattice steps from the tile's corner), zero where no finer node holds one. Each finer
+// node near the tile scatters the samples it stores once; every point is stored by exactly one
+// node. Entries are valid for the tile they were written in (a bitmap of those written).
+class FinerWindow {
+ public:
+  void Start(int n) {
+    if (n != n_) {
+      n_ = n;
+      samples_.resize(static_cast<std::size_t>(n) * n * n);
+      present_.resize((samples_.size() + 63) / 64);
+    }
+    std::fill(present_.begin(), present_.end(), 0);
+  }
+  int size() const { return n_; }
+  // Point p (each component −1 .. n − 2).
+  void Put(const int p[3], const PremultipliedSample& v) {
+    const std::size_t i = Index(p[0] + 1, p[1] + 1, p[2] + 1);
+    samples_[i] = v;
+    present_[i / 64] |= std::uint64_t{1} << (i % 64);
+  }
+  // Point (x, y, z) − 1.
+  const PremultipliedSample& At(int x, int y, int z) const {
+    static constexpr PremultipliedSample kAbsent{};
+    const std::size_t i = Index(x, y, z);
+    return present_[i / 64] >> (i % 64) & 1u ? samples_[i] : kAbsent;
+  }
+
+ private:
+  std::size_t Index(int x, int y, int z) const {
+    return static_cast<std::size_t>(x + n_ * (y + n_ * z));
+  }
+  int n_ = 0;
+  std::vector<PremultipliedSample> samples_;
+  std::vector<std::uint64_t> present_;
+};
+
+// An inner level's samples from the stored samples of the level below, tile by tile: the nodes
+// below one node two levels up (or the tree's root) read their taps from one window of the finer
+// samples around them.
 void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
                  const SampleLayout& finer_layout, const LevelSamples& finer, std::uint32_t side,
                  Flags f, LevelSamples& out, Progress::Stage* stage) {
-  ForEachNeighbourhood(
-      tree, level,
-      [&](std::uint64_t i, const Neighbourhood& nb) {
-        const TapBlock taps(ChildrenOf(tree, level, nb), finer_layout, finer, side,
-                            layout.orphans[i], f);
-        StoreNodeSamples(side, layout.orphans[i], taps, f, out, layout.first[i]);
-      },
-      stage);
+  const std::uint32_t tile_level = std::max(tree.first_level, level >= 2 ? level - 2 : 0u);
+  const int nodes = 1 << (level - tile_level), finer_nodes = 2 * nodes;
+  const int top = static_cast<int>(side) - 1;
+  // Lattice points −1 .. top·finer_nodes + 1 per axis: the tents' reach over the tile. A point's
+  // home node is ⌊p/top⌋, and a point on a node plane may be stored by the node before its home:
+  // the nodes storing them lie within −2 .. ⌊last/top⌋.
+  const int last = top * finer_nodes + 1;
+  ForEachNeighbourhood(tree, tile_level, [&](std::uint64_t, const Neighbourhood& tile_nb) {
+    static thread_local FinerWindow window;
+    window.Start(last + 2);
+    ForEachNodeNearTile(
+        tree, tile_level, tile_nb, level + 1, -2, last / top,
+        [&](std::uint64_t q, int x, int y, int z) {
+          const int base[3] = {top * x, top * y, top * z};
+          ForEachStoredSample(side, finer_layout.orphans[q], finer_layout.first[q],
+                              [&](unsigned s, std::uint64_t at) {
+                                const int p[3] = {base[0] + static_cast<int>(s % side),
+                                                  base[1] + static_cast<int>(s / side % side),
+                                                  base[2] + static_cast<int>(s / (side * side))};
+                                for (int a = 0; a < 3; ++a) {
+                                  if (p[a] < -1 || p[a] > last) return;
+                                }
+                                const EncodedSample e = LoadSample(finer, at);
+                                if (e.opacity != 0) {
+                                  window.Put(p, DecodePremultiplied(e, f.color, f.normal));
+                                }
+                              });
+        });
+    std::uint64_t filtered = 0;
+    ForEachNodeNearTile(tree, tile_level, tile_nb, level, 0, nodes - 1,
+                        [&](std::uint64_t i, int x, int y, int z) {
+                          // Tap t of the node is point 2·top·(x, y, z) + t − 1.
+                          const int corner[3] = {2 * top * x, 2 * top * y, 2 * top * z};
+                          const auto tap = [&](int tx, int ty, int tz) -> const PremultipliedSample& {
+                            return window.At(corner[0] + tx, corner[1] + ty, corner[2] + tz);
+                          };
+                          StoreNodeSamples(side, layout.orphans[i], tap, f, out, layout.first[i]);
+                          ++filtered;
+                        });
+    if (stage != nullptr) stage->Advance(filtered);
+  });
 }
 
 // Levels from − 1 .. first_level of `out` (indexed from first_level), each filtered from the one
