@@ -23,6 +23,40 @@ struct Flags {
   bool color, normal;
 };
 
+// Calls visit(i, x, y, z) for every node i of level `to` whose coordinates relative to the corner
+// of a tile (a node of level tile_level whose neighbourhood is `nb`), in level-`to` units, lie in
+// [lo, hi]³: the tile's own nodes and those of its neighbours' that are near enough, descending
+// only into subtrees that reach the range.
+template <class Visit>
+void ForEachNodeNearTile(const MaskTree& tree, std::uint32_t tile_level, const Neighbourhood& nb,
+                         std::uint32_t to, int lo, int hi, const Visit& visit) {
+  const auto descend = [&](const auto& self, std::uint32_t l, std::uint64_t i, int x, int y,
+                           int z) -> void {
+    const int span = 1 << (to - l);  // level-`to` nodes per edge of this node
+    const auto reaches = [&](int c) { return c * span <= hi && (c + 1) * span - 1 >= lo; };
+    if (!reaches(x) || !reaches(y) || !reaches(z)) return;
+    if (l == to) {
+      visit(i, x, y, z);
+      return;
+    }
+    const std::uint8_t m = tree.masks[l - tree.first_level][i];
+    std::uint64_t child = tree.first_child[l - tree.first_level][i];
+    for (int c = 0; c < 8; ++c) {
+      if (m >> c & 1u) {
+        self(self, l + 1, child++, 2 * x + (c & 1), 2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
+      }
+    }
+  };
+  for (int oz = -1; oz <= 1; ++oz) {
+    for (int oy = -1; oy <= 1; ++oy) {
+      for (int ox = -1; ox <= 1; ++ox) {
+        const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
+        if (q >= 0) descend(descend, tile_level, static_cast<std::uint64_t>(q), ox, oy, oz);
+      }
+    }
+  }
+}
+
 // The voxels around a tile of the octree (a node up to four levels above the voxels) as the filter
 // sees them, and the voxel-level samples there, each computed once per tile. Coordinates are
 // relative to the tile's corner: voxels from −2 to W + 1 (W voxels per tile edge), lattice points
@@ -179,7 +213,8 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
   const std::uint32_t voxels = tree.last_level(), above = voxels - 1;
   const std::uint32_t tile_level = std::max(tree.first_level, voxels >= 4 ? voxels - 4 : 0u);
   const std::uint32_t width = 1u << (voxels - tile_level);
-  ForEachNeighbourhood(tree, tile_level, [&](std::uint64_t t, const Neighbourhood& tile_nb) {
+  const int nodes_per_edge = static_cast<int>(width / 2);
+  ForEachNeighbourhood(tree, tile_level, [&](std::uint64_t, const Neighbourhood& tile_nb) {
     static thread_local std::unique_ptr<VoxelTile> scratch;
     if (!scratch || scratch->width() != static_cast<int>(width)) {
       scratch = std::make_unique<VoxelTile>(width);
@@ -190,42 +225,21 @@ void ForEachAboveVoxels(const MaskTree& tree, const VoxelSamplesSource& source, 
       std::uint64_t i;
       int corner[3];
     };
-    std::vector<Node> nodes;
-    const std::uint8_t* above_masks = tree.masks[above - tree.first_level].data();
-    const std::uint64_t* above_first = tree.first_child[above - tree.first_level].data();
-    const auto descend = [&](const auto& self, std::uint32_t level, std::uint64_t i,
-                             const Neighbourhood& nb, int x, int y, int z) -> void {
-      if (level == above) {
-        // The node at (x, y, z) in its level's units: its first child is voxel 2·(x, y, z). It adds
-        // its own voxels and those of its neighbours outside the tile (the ones inside add theirs).
-        const int nodes_per_edge = static_cast<int>(width / 2);
-        for (int oz = -1; oz <= 1; ++oz) {
-          for (int oy = -1; oy <= 1; ++oy) {
-            for (int ox = -1; ox <= 1; ++ox) {
-              const int p[3] = {x + ox, y + oy, z + oz};
-              const bool inside = p[0] >= 0 && p[0] < nodes_per_edge && p[1] >= 0 &&
-                                  p[1] < nodes_per_edge && p[2] >= 0 && p[2] < nodes_per_edge;
-              if (inside && (ox | oy | oz) != 0) continue;
-              const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
-              if (q < 0) continue;
-              const int at[3] = {2 * p[0], 2 * p[1], 2 * p[2]};
-              tile.AddChildren(above_masks[q], static_cast<std::int64_t>(above_first[q]), at);
-            }
-          }
-        }
-        nodes.push_back({i, {2 * x - 2, 2 * y - 2, 2 * z - 2}});
-        return;
-      }
-      const std::uint8_t m = tree.masks[level - tree.first_level][i];
-      std::uint64_t child = tree.first_child[level - tree.first_level][i];
-      const ChildNeighbourhoods children(tree, level, nb);
-      for (int c = 0; c < 8; ++c) {
-        if (!(m >> c & 1u)) continue;
-        self(self, level + 1, child++, children[static_cast<unsigned>(c)], 2 * x + (c & 1),
-             2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
-      }
-    };
-    descend(descend, tile_level, t, tile_nb, 0, 0, 0);
+    static thread_local std::vector<Node> nodes;
+    nodes.clear();
+    const std::uint8_t* masks = tree.masks[above - tree.first_level].data();
+    const std::uint64_t* first = tree.first_child[above - tree.first_level].data();
+    // The nodes of the level above within one node of the tile bring their voxels (−2 .. W + 1);
+    // the node at (x, y, z), in its level's units, has voxel 2·(x, y, z) as its first child.
+    ForEachNodeNearTile(tree, tile_level, tile_nb, above, -1, nodes_per_edge,
+                        [&](std::uint64_t i, int x, int y, int z) {
+                          const int at[3] = {2 * x, 2 * y, 2 * z};
+                          tile.AddChildren(masks[i], static_cast<std::int64_t>(first[i]), at);
+                          if (x >= 0 && x < nodes_per_edge && y >= 0 && y < nodes_per_edge &&
+                              z >= 0 && z < nodes_per_edge) {
+                            nodes.push_back({i, {2 * x - 2, 2 * y - 2, 2 * z - 2}});
+                          }
+                        });
     for (const Node& n : nodes) body(tile, n.i, n.corner);
     if (stage != nullptr) stage->Advance(nodes.size());
   });
@@ -344,40 +358,6 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
             });
       },
       stage);
-}
-
-// Calls visit(i, x, y, z) for every node i of level `to` whose coordinates relative to the corner
-// of a tile (a node of level tile_level whose neighbourhood is `nb`), in level-`to` units, lie in
-// [lo, hi]³: the tile's own nodes and those of its neighbours' that are near enough, descending
-// only into subtrees that reach the range.
-template <class Visit>
-void ForEachNodeNearTile(const MaskTree& tree, std::uint32_t tile_level, const Neighbourhood& nb,
-                         std::uint32_t to, int lo, int hi, const Visit& visit) {
-  const auto descend = [&](const auto& self, std::uint32_t l, std::uint64_t i, int x, int y,
-                           int z) -> void {
-    const int span = 1 << (to - l);  // level-`to` nodes per edge of this node
-    const auto reaches = [&](int c) { return c * span <= hi && (c + 1) * span - 1 >= lo; };
-    if (!reaches(x) || !reaches(y) || !reaches(z)) return;
-    if (l == to) {
-      visit(i, x, y, z);
-      return;
-    }
-    const std::uint8_t m = tree.masks[l - tree.first_level][i];
-    std::uint64_t child = tree.first_child[l - tree.first_level][i];
-    for (int c = 0; c < 8; ++c) {
-      if (m >> c & 1u) {
-        self(self, l + 1, child++, 2 * x + (c & 1), 2 * y + (c >> 1 & 1), 2 * z + (c >> 2 & 1));
-      }
-    }
-  };
-  for (int oz = -1; oz <= 1; ++oz) {
-    for (int oy = -1; oy <= 1; ++oy) {
-      for (int ox = -1; ox <= 1; ++ox) {
-        const std::int64_t q = nb[NeighbourSlot(ox, oy, oz)];
-        if (q >= 0) descend(descend, tile_level, static_cast<std::uint64_t>(q), ox, oy, oz);
-      }
-    }
-  }
 }
 
 // The decoded samples of the finer level around a tile: lattice points −1 .. n − 2 per axis (in
