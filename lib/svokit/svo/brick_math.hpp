@@ -124,17 +124,36 @@ inline PremultipliedSample VoxelCell(const VoxelSamplesSource& voxels, std::size
   return Premultiply(b);
 }
 
+/// A premultiplied sample's channels in binary64, as the level above the voxels sums them.
+struct WideSample {
+  double c[8] = {};
+};
+inline WideSample Widen(const PremultipliedSample& p) {
+  float q[8];
+  std::memcpy(q, &p, sizeof q);
+  WideSample w;
+  for (int c = 0; c < 8; ++c) w.c[c] = static_cast<double>(q[c]);
+  return w;
+}
+inline void LoadWide(const WideSample* v, double q[8]) {
+  std::memcpy(q, v->c, sizeof v->c);
+}
+inline void LoadWide(const PremultipliedSample* v, double q[8]) {
+  std::memcpy(q, Widen(*v).c, sizeof(WideSample::c));
+}
+
 /// The level above the voxels' sample at voxel corner p (formats/svo.md, "Filter"): per axis the
 /// voxels p − 1, p with weights 1, 1 (side 3) or p − 2 .. p + 1 with 1, 3, 3, 1 (side 2), summed
 /// in binary64 along x, then y, then z, each sum from +0 in ascending position, then scaled by
-/// 2⁻³ or 2⁻⁹. cell(dx, dy, dz) is the premultiplied sample of voxel p + d, or null where there is
-/// none: skipping it adds nothing, as adding +0 would (a sum from +0 is never −0). Colour and
-/// opacity sums are exact; the normals' order is the definition.
-template <class Cell>
-PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
-  static constexpr double kWeights3[2] = {1, 1}, kWeights2[4] = {1, 3, 3, 1};
-  const int n = side == 3 ? 2 : 4, first = side == 3 ? -1 : -2;
-  const double* w = side == 3 ? kWeights3 : kWeights2;
+/// 2⁻³ or 2⁻⁹. cell(dx, dy, dz) points to the premultiplied sample of voxel p + d
+/// (PremultipliedSample or WideSample), or is null where there is none: skipping it adds nothing,
+/// as adding +0 would (a sum from +0 is never −0). Colour and opacity sums are exact; the normals'
+/// order is the definition. (Weights of 1 multiply nothing: 1·v = v exactly.)
+template <std::uint32_t kSide, class Cell>
+PremultipliedSample AboveVoxels(const Cell& cell) {
+  static_assert(kSide == 2 || kSide == 3);
+  constexpr int n = kSide == 3 ? 2 : 4, first = kSide == 3 ? -1 : -2;
+  static constexpr double kWeights2[4] = {1, 3, 3, 1};  // side 3's are all 1
   double o[8] = {};
   for (int z = 0; z < n; ++z) {
     double fy[8] = {};
@@ -143,26 +162,42 @@ PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
       double fx[8] = {};
       bool any_x = false;
       for (int x = 0; x < n; ++x) {
-        const PremultipliedSample* v = cell(first + x, first + y, first + z);
+        const auto* v = cell(first + x, first + y, first + z);
         if (v == nullptr) continue;
-        float q[8];
-        std::memcpy(q, v, sizeof q);
-        for (int c = 0; c < 8; ++c) fx[c] += w[x] * static_cast<double>(q[c]);
+        double q[8];
+        LoadWide(v, q);
+        if constexpr (kSide == 3) {
+          for (int c = 0; c < 8; ++c) fx[c] += q[c];
+        } else {
+          for (int c = 0; c < 8; ++c) fx[c] += kWeights2[x] * q[c];
+        }
         any_x = true;
       }
       if (!any_x) continue;
-      for (int c = 0; c < 8; ++c) fy[c] += w[y] * fx[c];
+      if constexpr (kSide == 3) {
+        for (int c = 0; c < 8; ++c) fy[c] += fx[c];
+      } else {
+        for (int c = 0; c < 8; ++c) fy[c] += kWeights2[y] * fx[c];
+      }
       any_y = true;
     }
     if (!any_y) continue;
-    for (int c = 0; c < 8; ++c) o[c] += w[z] * fy[c];
+    if constexpr (kSide == 3) {
+      for (int c = 0; c < 8; ++c) o[c] += fy[c];
+    } else {
+      for (int c = 0; c < 8; ++c) o[c] += kWeights2[z] * fy[c];
+    }
   }
-  const double scale = side == 3 ? 0x1p-3 : 0x1p-9;
+  constexpr double scale = kSide == 3 ? 0x1p-3 : 0x1p-9;
   float out[8];
   for (int c = 0; c < 8; ++c) out[c] = static_cast<float>(o[c] * scale);
   PremultipliedSample p;
   std::memcpy(&p, out, sizeof p);
   return p;
+}
+template <class Cell>
+PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
+  return side == 3 ? AboveVoxels<3>(cell) : AboveVoxels<2>(cell);
 }
 
 inline constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};

@@ -90,18 +90,24 @@ class VoxelTile {
       const std::int64_t v = first++;
       if (present_[i / 64] >> (i % 64) & 1u) continue;
       present_[i / 64] |= std::uint64_t{1} << (i % 64);
-      voxel_[i] = {v, false, false, {}, {}};
+      Voxel& voxel = voxel_[i];
+      voxel.index = v;
+      voxel.cell =
+          brick_math::VoxelCell(*source_, static_cast<std::size_t>(v), f_.color, f_.normal);
+      voxel.wide = brick_math::Widen(voxel.cell);
+      voxel.has_alone = false;
     }
   }
 
   // The level above the voxels' sample at voxel corner p (brick_math::AboveVoxels). An absent
   // voxel reads as +0 rather than being skipped: the same sums (a sum from +0 is never −0), with
   // no branch on presence.
-  PremultipliedSample Above(const int p[3], std::uint32_t side) {
-    static constexpr PremultipliedSample kAbsent{};
-    return brick_math::AboveVoxels(side, [&](int dx, int dy, int dz) -> const PremultipliedSample* {
+  template <std::uint32_t kSide>
+  PremultipliedSample Above(const int p[3]) {
+    static constexpr brick_math::WideSample kAbsent{};
+    return brick_math::AboveVoxels<kSide>([&](int dx, int dy, int dz) {
       const int x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
-      return Present(x, y, z) ? &Cell(voxel_[VoxelAt(x, y, z)]).cell : &kAbsent;
+      return Present(x, y, z) ? &voxel_[VoxelAt(x, y, z)].wide : &kAbsent;
     });
   }
 
@@ -118,9 +124,10 @@ class VoxelTile {
  private:
   struct Voxel {
     std::int64_t index = -1;
-    bool has_cell = false, has_alone = false;
-    PremultipliedSample cell;  // opacity 1, colour and normal (premultiplied by 1)
-    EncodedSample alone;       // the voxel's own sample
+    bool has_alone = false;
+    PremultipliedSample cell;     // opacity 1, colour and normal (premultiplied by 1)
+    brick_math::WideSample wide;  // `cell` in binary64
+    EncodedSample alone;          // the voxel's own sample
   };
   struct Point {
     EncodedSample encoded;
@@ -160,7 +167,7 @@ class VoxelTile {
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         for (int x = lo[0]; x <= hi[0]; ++x) {
-          if (Present(x, y, z)) contributors[n++] = &Cell(voxel_[VoxelAt(x, y, z)]);
+          if (Present(x, y, z)) contributors[n++] = &voxel_[VoxelAt(x, y, z)];
         }
       }
     }
@@ -179,16 +186,9 @@ class VoxelTile {
     return p;
   }
 
-  Voxel& Cell(Voxel& v) {
-    if (v.has_cell) return v;
-    v.cell =
-        brick_math::VoxelCell(*source_, static_cast<std::size_t>(v.index), f_.color, f_.normal);
-    v.has_cell = true;
-    return v;
-  }
   Voxel& Alone(Voxel& v) {
     if (v.has_alone) return v;
-    v.alone = Encode(f_.color, f_.normal, Cell(v).cell);
+    v.alone = Encode(f_.color, f_.normal, v.cell);
     v.has_alone = true;
     return v;
   }
@@ -354,7 +354,8 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
               const int p[3] = {corner[0] + 2 + step * static_cast<int>(s % side),
                                 corner[1] + 2 + step * static_cast<int>(s / side % side),
                                 corner[2] + 2 + step * static_cast<int>(s / (side * side))};
-              StoreSample(Encode(f.color, f.normal, tile.Above(p, side)), at, out);
+              const PremultipliedSample sum = side == 3 ? tile.Above<3>(p) : tile.Above<2>(p);
+              StoreSample(Encode(f.color, f.normal, sum), at, out);
             });
       },
       stage);
@@ -413,11 +414,11 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
   ForEachNeighbourhood(tree, tile_level, [&](std::uint64_t, const Neighbourhood& tile_nb) {
     static thread_local FinerWindow window;
     window.Start(last + 2);
-    ForEachNodeNearTile(
-        tree, tile_level, tile_nb, level + 1, -2, last / top,
-        [&](std::uint64_t q, int x, int y, int z) {
-          const int base[3] = {top * x, top * y, top * z};
-          ForEachStoredSample(side, finer_layout.orphans[q], finer_layout.first[q],
+    ForEachNodeNearTile(tree, tile_level, tile_nb, level + 1, -2, last / top,
+                        [&](std::uint64_t q, int x, int y, int z) {
+                          const int base[3] = {top * x, top * y, top * z};
+                          ForEachStoredSample(
+                              side, finer_layout.orphans[q], finer_layout.first[q],
                               [&](unsigned s, std::uint64_t at) {
                                 const int p[3] = {base[0] + static_cast<int>(s % side),
                                                   base[1] + static_cast<int>(s / side % side),
@@ -430,18 +431,18 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
                                   window.Put(p, DecodePremultiplied(e, f.color, f.normal));
                                 }
                               });
-        });
-    std::uint64_t filtered = 0;
-    ForEachNodeNearTile(tree, tile_level, tile_nb, level, 0, nodes - 1,
-                        [&](std::uint64_t i, int x, int y, int z) {
-                          // Tap t of the node is point 2·top·(x, y, z) + t − 1.
-                          const int corner[3] = {2 * top * x, 2 * top * y, 2 * top * z};
-                          const auto tap = [&](int tx, int ty, int tz) -> const PremultipliedSample& {
-                            return window.At(corner[0] + tx, corner[1] + ty, corner[2] + tz);
-                          };
-                          StoreNodeSamples(side, layout.orphans[i], tap, f, out, layout.first[i]);
-                          ++filtered;
                         });
+    std::uint64_t filtered = 0;
+    ForEachNodeNearTile(
+        tree, tile_level, tile_nb, level, 0, nodes - 1, [&](std::uint64_t i, int x, int y, int z) {
+          // Tap t of the node is point 2·top·(x, y, z) + t − 1.
+          const int corner[3] = {2 * top * x, 2 * top * y, 2 * top * z};
+          const auto tap = [&](int tx, int ty, int tz) -> const PremultipliedSample& {
+            return window.At(corner[0] + tx, corner[1] + ty, corner[2] + tz);
+          };
+          StoreNodeSamples(side, layout.orphans[i], tap, f, out, layout.first[i]);
+          ++filtered;
+        });
     if (stage != nullptr) stage->Advance(filtered);
   });
 }
