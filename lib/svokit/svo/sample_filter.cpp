@@ -271,8 +271,7 @@ void StoreNodeSamples(std::uint32_t side, std::uint32_t orphans, Fetch&& fetch, 
   using brick_math::Lanes;
   const layout_detail::SideTable& t = layout_detail::TableFor(side);
   const auto tent_of = [&](unsigned s) {
-    const int k[3] = {static_cast<int>(s % side), static_cast<int>(s / side % side),
-                      static_cast<int>(s / (side * side))};
+    const std::uint8_t* k = t.coord[s];
     return Tent([&](int dx, int dy, int dz) -> const PremultipliedSample& {
       return fetch(2 * k[0] + dx, 2 * k[1] + dy, 2 * k[2] + dz);
     });
@@ -345,15 +344,16 @@ void FilterAboveVoxels(const MaskTree& tree, const SampleLayout& layout, std::ui
                        const VoxelSamplesSource& source, Flags f, LevelSamples& out,
                        Progress::Stage* stage) {
   const int step = side == 3 ? 1 : 2;
+  const auto& coord = layout_detail::TableFor(side).coord;
   ForEachAboveVoxels(
       tree, source, f,
       [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
         ForEachStoredSample(
             side, layout.orphans[i], layout.first[i], [&](unsigned s, std::uint64_t at) {
               // The node's first voxel is the block's (2, 2, 2).
-              const int p[3] = {corner[0] + 2 + step * static_cast<int>(s % side),
-                                corner[1] + 2 + step * static_cast<int>(s / side % side),
-                                corner[2] + 2 + step * static_cast<int>(s / (side * side))};
+              const std::uint8_t* k = coord[s];
+              const int p[3] = {corner[0] + 2 + step * k[0], corner[1] + 2 + step * k[1],
+                                corner[2] + 2 + step * k[2]};
               const PremultipliedSample sum = side == 3 ? tile.Above<3>(p) : tile.Above<2>(p);
               StoreSample(Encode(f.color, f.normal, sum), at, out);
             });
@@ -407,6 +407,7 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
   const std::uint32_t tile_level = std::max(tree.first_level, level >= 2 ? level - 2 : 0u);
   const int nodes = 1 << (level - tile_level), finer_nodes = 2 * nodes;
   const int top = static_cast<int>(side) - 1;
+  const auto& coord = layout_detail::TableFor(side).coord;
   // Lattice points −1 .. top·finer_nodes + 1 per axis: the tents' reach over the tile. A point's
   // home node is ⌊p/top⌋, and a point on a node plane may be stored by the node before its home:
   // the nodes storing them lie within −2 .. ⌊last/top⌋.
@@ -420,9 +421,8 @@ void FilterInner(const MaskTree& tree, std::uint32_t level, const SampleLayout& 
                           ForEachStoredSample(
                               side, finer_layout.orphans[q], finer_layout.first[q],
                               [&](unsigned s, std::uint64_t at) {
-                                const int p[3] = {base[0] + static_cast<int>(s % side),
-                                                  base[1] + static_cast<int>(s / side % side),
-                                                  base[2] + static_cast<int>(s / (side * side))};
+                                const std::uint8_t* k = coord[s];
+                                const int p[3] = {base[0] + k[0], base[1] + k[1], base[2] + k[2]};
                                 for (int a = 0; a < 3; ++a) {
                                   if (p[a] < -1 || p[a] > last) return;
                                 }

@@ -13,6 +13,7 @@ constexpr SideTable MakeSideTable(int side) {
   int homes = 0, others = 0;
   for (int s = 0; s < side * side * side; ++s) {
     const int k[3] = {s % side, s / side % side, s / (side * side)};
+    for (int a = 0; a < 3; ++a) t.coord[s][a] = static_cast<std::uint8_t>(k[a]);
     t.is_home[s] = k[0] < top && k[1] < top && k[2] < top;
     t.index[s] = static_cast<std::uint8_t>(t.is_home[s] ? homes++ : others++);
     if (!t.is_home[s]) continue;

@@ -64,6 +64,8 @@ struct SideTable {
   /// Per brick sample: its index among the home samples, or among the others.
   std::uint8_t index[27] = {};
   bool is_home[27] = {};
+  /// Per brick sample x + side·(y + side·z): {x, y, z}.
+  std::uint8_t coord[27][3] = {};
 };
 const SideTable& TableFor(std::uint32_t side);
 
