@@ -1,7 +1,9 @@
 #include "svokit/svo/svo_assembler.hpp"
 
 #include <algorithm>
+#include <new>
 #include <span>
+#include <stdexcept>
 #include <utility>
 
 #include "svokit/svo/sample_filter.hpp"
@@ -15,10 +17,10 @@ void AppendTo(std::vector<T, A>& to, const std::vector<T, A>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
-// The first part moves in whole.
+// The first part moves in whole, unless room was reserved for all of them.
 template <class T, class A>
 void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
-  if (to.empty()) {
+  if (to.empty() && to.capacity() <= from.size()) {
     to = std::move(from);
   } else {
     AppendTo(to, static_cast<const std::vector<T, A>&>(from));
@@ -74,6 +76,23 @@ SvoAssembler::SvoAssembler(const SvoShape& shape, std::uint32_t max_level)
       full_(shape.solid ? shape.depth : 0),
       words_(shape.depth + 1),
       levels_(shape.depth + 1) {}
+
+void SvoAssembler::Reserve(std::span<const std::uint64_t> nodes) {
+  const std::uint64_t samples =
+      std::uint64_t{shape_.brick_side} * shape_.brick_side * shape_.brick_side;
+  try {
+    for (std::uint32_t l = 0; l <= max_level_ && l < nodes.size(); ++l) {
+      words_[l].reserve(nodes[l]);
+      if (l < shape_.depth) masks_[l].reserve(nodes[l]);
+      if (samples == 0) continue;
+      levels_[l].opacity.reserve(nodes[l] * samples);
+      if (shape_.has_color) levels_[l].color.reserve(nodes[l] * samples);
+      if (shape_.has_normal) levels_[l].normal.reserve(nodes[l] * samples);
+    }
+  } catch (const std::bad_alloc&) {  // a hint: appending grows the arrays as needed
+  } catch (const std::length_error&) {
+  }
+}
 
 std::vector<SvoLevel> SvoAssembler::Bricks(const SvoChunk& chunk) const {
   std::vector<SvoLevel> bricks;

@@ -4,6 +4,7 @@
 // bricks are computed from its voxels and halo.
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ class SvoAssembler {
  public:
   /// An octree of the levels 0 .. max_level (at most the depth).
   SvoAssembler(const SvoShape& shape, std::uint32_t max_level);
+  /// Makes room for `nodes[l]` nodes of each level l (what a file says it holds), so appending
+  /// chunks does not move what is in: a hint, ignored where the memory is not there.
+  void Reserve(std::span<const std::uint64_t> nodes);
   /// The bricks of the levels `chunk` holds, down to max_level: the costly part of Append, which
   /// may run for several chunks at once (it only reads the assembler).
   std::vector<SvoLevel> Bricks(const SvoChunk& chunk) const;

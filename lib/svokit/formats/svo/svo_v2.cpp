@@ -542,6 +542,17 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   StatusOr<SvoChunk> top = DecodeTopOfPages(v, name, sink);
   if (!top.ok()) return false;
   SvoAssembler assembler(v.shape, last);
+  // HEAD's counts (checked once the pages are in), bounded by what the chunks can hold: the top
+  // chunk's levels are decoded, and a page holds at most 8^k nodes k levels below its root.
+  std::vector<std::uint64_t> nodes(last + 1);
+  for (std::uint32_t l = 0; l <= last && l < v.levels.size(); ++l) {
+    const std::uint32_t below = l - std::min(l, v.page_level);
+    const std::uint64_t bound = l < v.page_level ? top->tree.NodeCount(l)
+                                : below >= 20    ? ~std::uint64_t{0}
+                                                 : v.pages.size() << (3 * below);
+    nodes[l] = std::min(v.levels[l][0], bound);
+  }
+  assembler.Reserve(nodes);
   assembler.Append(*top);
   PageVoxels voxels;
   if (stage != nullptr) stage->SetTotal(std::max<std::size_t>(1, v.pages.size()));
