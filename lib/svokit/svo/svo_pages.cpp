@@ -32,15 +32,35 @@ Vector Slice(const Vector& all, const Range& range) {
                 all.begin() + static_cast<std::ptrdiff_t>(range.second));
 }
 
-// Copies the samples of one page from the whole tree, walking the page and the whole tree in step,
-// and collects the page's halo: the voxels outside it that touch one of its voxels.
+// Lays out one page's samples and copies them from the whole tree, walking the page and the
+// whole tree in step (depth first: each level's nodes in order), and collects the page's halo:
+// the voxels outside it that touch one of its voxels.
 class PageSampleCopier {
  public:
-  PageSampleCopier(const CompactSvo& svo, SvoChunk& page, const Range& voxels)
-      : svo_(svo), page_(page), voxels_(voxels) {}
+  PageSampleCopier(const CompactSvo& svo, SvoChunk& page, const std::vector<Range>& ranges)
+      : svo_(svo), page_(page), voxels_(ranges.back()) {
+    const SvoShape& shape = svo.frame.shape;
+    for (std::uint32_t l = page.root_level; l < shape.depth; ++l) {
+      const Range& nodes = ranges[l - page.root_level];
+      SampleLayout& layout = page.layouts.emplace_back();
+      layout.side = shape.brick_side;
+      layout.orphans.resize(nodes.second - nodes.first);
+      layout.first.resize(nodes.second - nodes.first + 1);
+      // About what the whole tree stores for these nodes; a page's border adds orphans.
+      const std::vector<std::uint64_t>& first = svo.whole.layouts[l].first;
+      const std::uint64_t n = first[nodes.second] - first[nodes.first];
+      LevelSamples& samples = page.samples.emplace_back();
+      samples.opacity.reserve(n);
+      if (shape.has_color) samples.color.reserve(n);
+      if (shape.has_normal) samples.normal.reserve(n);
+    }
+  }
 
   void Run(std::uint64_t page_node, const Neighbourhood& nb) {
     Visit(page_.root_level, 0, page_node, &nb, page_.root_key);
+    for (std::size_t k = 0; k < page_.layouts.size(); ++k) {
+      page_.layouts[k].first.back() = page_.samples[k].opacity.size();
+    }
   }
 
   // The halo's keys, colours and normals, in key order.
@@ -62,7 +82,7 @@ class PageSampleCopier {
   void Visit(std::uint32_t l, std::uint64_t local, std::uint64_t global,
              const Neighbourhood* global_nb, std::uint64_t node_key) {
     if (global_nb != nullptr && InsidePage(l, node_key)) global_nb = nullptr;
-    CopyNodeSamples(l, local, global, global_nb);
+    CopyNodeSamples(l, local, global, global_nb, node_key);
     if (l + 1 == svo_.depth()) {
       if (global_nb != nullptr) CollectHalo(l, global, *global_nb, node_key);
       return;
@@ -96,48 +116,68 @@ class PageSampleCopier {
     return inside(c.x, page.x) && inside(c.y, page.y) && inside(c.z, page.z);
   }
 
-  // The samples the page's layout gives node `local`, copied from where the whole tree's layout
-  // keeps them.
+  // Node `local`'s orphans in the page's layout and its samples, copied from where the whole
+  // tree's layout keeps them. Nodes outside the page count as absent in its layout.
   void CopyNodeSamples(std::uint32_t l, std::uint64_t local, std::uint64_t global,
-                       const Neighbourhood* global_nb) {
+                       const Neighbourhood* global_nb, std::uint64_t node_key) {
     const std::uint32_t k = l - page_.root_level;
-    const SampleLayout& layout = page_.layouts[k];
+    SampleLayout& layout = page_.layouts[k];
     const SampleLayout& whole = svo_.whole.layouts[l];
     const LevelSamples& in = svo_.whole.samples[l];
     LevelSamples& out = page_.samples[k];
-    const auto copy = [&](std::uint64_t from, std::uint64_t to, std::uint64_t count) {
-      std::copy_n(in.opacity.begin() + static_cast<std::ptrdiff_t>(from), count,
-                  out.opacity.begin() + static_cast<std::ptrdiff_t>(to));
-      if (!out.color.empty()) {
-        std::copy_n(in.color.begin() + static_cast<std::ptrdiff_t>(from), count,
-                    out.color.begin() + static_cast<std::ptrdiff_t>(to));
-      }
-      if (!out.normal.empty()) {
-        std::copy_n(in.normal.begin() + static_cast<std::ptrdiff_t>(from), count,
-                    out.normal.begin() + static_cast<std::ptrdiff_t>(to));
-      }
+    const auto copy = [&](std::uint64_t from, std::uint64_t count) {
+      const auto run = [&](const auto& from_vector, auto& to_vector) {
+        const auto begin = from_vector.begin() + static_cast<std::ptrdiff_t>(from);
+        to_vector.insert(to_vector.end(), begin, begin + static_cast<std::ptrdiff_t>(count));
+      };
+      run(in.opacity, out.opacity);
+      if (!in.color.empty()) run(in.color, out.color);
+      if (!in.normal.empty()) run(in.normal, out.normal);
     };
-    const std::uint32_t orphans = layout.orphans[local];
-    if (orphans == whole.orphans[global] || global_nb == nullptr) {
+    const std::uint32_t side = svo_.frame.shape.brick_side;
+    const std::uint32_t orphans = global_nb == nullptr
+                                      ? whole.orphans[global]
+                                      : OrphanMask(side, InPage(*global_nb, l, node_key));
+    layout.orphans[local] = orphans;
+    layout.first[local] = out.opacity.size();
+    if (orphans == whole.orphans[global]) {
       // Away from the page's border the node stores what it stores in the whole tree, in the
       // same order: one run of samples.
-      copy(whole.first[global], layout.first[local], whole.first[global + 1] - whole.first[global]);
+      copy(whole.first[global], whole.first[global + 1] - whole.first[global]);
       return;
     }
-    const std::uint32_t side = svo_.frame.shape.brick_side;
+    // Its home samples, then its orphans, each in brick order.
     const layout_detail::SideTable& t = layout_detail::TableFor(side);
-    std::uint64_t next = layout.first[local] + t.home_count;
     for (unsigned s = 0; s < side * side * side; ++s) {
-      std::uint64_t to;
-      if (t.is_home[s]) {
-        to = layout.first[local] + t.index[s];
-      } else if (orphans >> t.index[s] & 1u) {
-        to = next++;
-      } else {
-        continue;
-      }
-      copy(SampleIndex(whole, *global_nb, s), to, 1);
+      if (t.is_home[s]) copy(SampleIndex(whole, *global_nb, s), 1);
     }
+    for (unsigned s = 0; s < side * side * side; ++s) {
+      if (!t.is_home[s] && (orphans >> t.index[s] & 1u)) {
+        copy(SampleIndex(whole, *global_nb, s), 1);
+      }
+    }
+  }
+
+  // The neighbourhood `nb` of the level-l node `node_key` with the nodes outside the page
+  // removed.
+  Neighbourhood InPage(const Neighbourhood& nb, std::uint32_t l, std::uint64_t node_key) const {
+    const MortonCoord c = MortonDecode(node_key), page = MortonDecode(page_.root_key);
+    const int shift = static_cast<int>(l - page_.root_level);
+    const auto inside = [shift](std::uint32_t v, int o, std::uint32_t page_coord) {
+      const std::int64_t w = static_cast<std::int64_t>(v) + o;
+      return w >= 0 && (w >> shift) == static_cast<std::int64_t>(page_coord);
+    };
+    Neighbourhood out = nb;
+    for (int oz = -1; oz <= 1; ++oz) {
+      for (int oy = -1; oy <= 1; ++oy) {
+        for (int ox = -1; ox <= 1; ++ox) {
+          if (!inside(c.x, ox, page.x) || !inside(c.y, oy, page.y) || !inside(c.z, oz, page.z)) {
+            out[NeighbourSlot(ox, oy, oz)] = -1;
+          }
+        }
+      }
+    }
+    return out;
   }
 
   // The voxels of the nodes around node `global` of the level above the voxels that lie outside
@@ -226,18 +266,6 @@ void CutVoxels(const CompactSvo& svo, const Range& voxels, SvoChunk& page) {
   if (svo.frame.shape.has_normal) page.normals = Slice(svo.whole.normals, voxels);
 }
 
-// The page's own sample layouts, with room for their samples.
-void LayOutPage(const SvoShape& shape, SvoChunk& page) {
-  for (std::uint32_t l = page.root_level; l < shape.depth; ++l) {
-    page.layouts.push_back(LayOutSamples(page.tree, l, shape.brick_side));
-    LevelSamples& s = page.samples.emplace_back();
-    const std::uint64_t n = page.layouts.back().size();
-    s.opacity.resize(n);
-    s.color.resize(shape.has_color ? n : 0);
-    s.normal.resize(shape.has_normal ? n : 0);
-  }
-}
-
 }  // namespace
 
 SvoChunk TopChunk(const CompactSvo& svo, std::uint32_t page_level) {
@@ -268,8 +296,7 @@ SvoChunk PageChunk(const CompactSvo& svo, std::uint32_t page_level, std::uint64_
   CutTree(svo, ranges, chunk);
   CutVoxels(svo, ranges.back(), chunk);
   if (svo.frame.shape.brick_side == 0) return chunk;  // no samples to copy, no halo to find
-  LayOutPage(svo.frame.shape, chunk);
-  PageSampleCopier copier(svo, chunk, ranges.back());
+  PageSampleCopier copier(svo, chunk, ranges);
   copier.Run(page, nb);
   copier.StoreHalo();
   return chunk;
