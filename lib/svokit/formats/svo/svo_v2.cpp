@@ -15,6 +15,7 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/morton.hpp"
+#include "svokit/core/parallel.hpp"
 #include "svokit/formats/container/grid_section.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/svo/svo_assembler.hpp"
@@ -175,29 +176,25 @@ std::vector<std::uint8_t> PagedSvoWriter::Serialize(PageSource pages, TopMaker t
 namespace svo_detail {
 namespace {
 
-// The pages of an octree held whole, encoded in parallel batches and handed on in order.
+// The pages of an octree held whole, encoded in parallel and handed on in order as each is
+// ready: no batch waits for its slowest page.
 PagedSvoWriter::PageSource PagesOf(const CompactSvo& svo, const PagedSvoWriter& writer,
                                    Progress::Stage* stage) {
   return [&svo, &writer, stage](const PagedSvoWriter::Take& take) -> Status {
     const std::uint32_t page_level = writer.page_level();
     const std::vector<std::uint64_t> keys = KeysOfLevel(svo.whole.tree, page_level);
     const std::vector<Neighbourhood> nbs = LevelNeighbourhoods(svo.whole.tree, page_level);
-    const std::size_t batch = 64;
-    std::vector<PagedSvoWriter::EncodedPage> encoded;
-    for (std::size_t first = 0; first < keys.size(); first += batch) {
-      const std::size_t n = std::min(batch, keys.size() - first);
-      encoded.assign(n, {});
-      tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-        const std::size_t p = first + i;
-        encoded[i] = writer.Encode(PageChunk(svo, page_level, p, nbs[p], keys[p]));
-      });
-      for (PagedSvoWriter::EncodedPage& page : encoded) {
-        if (stage != nullptr) stage->AddBytes(page.bytes.size());
-        SVOKIT_RETURN_IF_ERROR(take(std::move(page)));
-      }
-      if (stage != nullptr) stage->Advance(n);
-    }
-    return Status::Ok();
+    return ParallelInOrder<PagedSvoWriter::EncodedPage>(
+        0, keys.size(), MostInFlight(),
+        [&](std::size_t p) {
+          return writer.Encode(PageChunk(svo, page_level, p, nbs[p], keys[p]));
+        },
+        [&](PagedSvoWriter::EncodedPage page) {
+          if (stage != nullptr) stage->AddBytes(page.bytes.size());
+          Status taken = take(std::move(page));
+          if (stage != nullptr) stage->Advance(1);
+          return taken;
+        });
   };
 }
 
