@@ -346,12 +346,20 @@ Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, i
   return best;
 }
 
+// std::lround for |x| < 2^31, inline: x − trunc(x) is exact.
+int RoundHalfAway(double x) {
+  int i = static_cast<int>(x);
+  const double frac = x - i;
+  if (frac >= 0.5) ++i;
+  if (frac <= -0.5) --i;
+  return i;
+}
+
 // Scales a real direction so its largest component is ±31 and rounds it.
 std::array<int, 3> QuantizeNormal(const Vec3d& n) {
   const double m = std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
   std::array<int, 3> q{};
-  for (int a = 0; a < 3; ++a)
-    q[static_cast<std::size_t>(a)] = static_cast<int>(std::lround(n[a] / m * 31));
+  for (int a = 0; a < 3; ++a) q[static_cast<std::size_t>(a)] = RoundHalfAway(n[a] / m * 31);
   return q;
 }
 
@@ -484,7 +492,7 @@ struct Workspace {
 void VisitNode(const Context& ctx, std::uint32_t level, std::size_t index, const Pieces& pieces,
                Workspace& ws) {
   const std::uint64_t key = ctx.keys[level - ctx.first][index];
-  const double size = std::ldexp(1.0, static_cast<int>(ctx.depth - level));
+  const double size = static_cast<double>(std::uint64_t{1} << (ctx.depth - level));
   const MortonCoord mc = MortonDecode(key);
   const Vec3d lo{mc.x * size, mc.y * size, mc.z * size};
   const Vec3d center = lo + Vec3d{size, size, size} * 0.5;
