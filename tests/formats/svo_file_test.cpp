@@ -369,9 +369,9 @@ TEST(SvoFile, RejectsNodesOutsideTheGridAndImpossibleCounts) {
   svo = HandSvo();
   svo.levels[0].node_count = 2;
   svo.levels[0].nodes.push_back(svo.levels[0].nodes[0]);
-  svo.levels[0].opacity.resize(2 * 27);
-  svo.levels[0].color.resize(2 * 27);
-  svo.levels[0].normal.resize(2 * 27);
+  svo.levels[0].opacity.resize(2 * 27, 0);
+  svo.levels[0].color.resize(2 * 27, 0);
+  svo.levels[0].normal.resize(2 * 27, 0);
   ExpectRejected(svo, "level 0 counts (2 nodes");
   // A brick plane one sample short, or missing.
   svo = HandSvo();

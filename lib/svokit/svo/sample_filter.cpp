@@ -4,6 +4,7 @@
 #include <array>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "svokit/svo/brick_math.hpp"
 
@@ -485,25 +486,47 @@ std::vector<LevelSamples> FilterSamplesAbove(const MaskTree& tree,
   return out;
 }
 
+BrickSpans ResizeBricks(SvoLevel& out, std::uint64_t nodes, std::uint32_t side, bool color,
+                        bool normal) {
+  const std::uint64_t n = nodes * side * side * side;
+  out.opacity.resize(n);
+  out.color.resize(color ? n : 0);
+  out.normal.resize(normal ? n : 0);
+  return {out.opacity, out.color, out.normal};
+}
+
+BrickSpans BricksOf(SvoLevel& out, std::uint64_t first, std::uint64_t nodes, std::uint32_t side) {
+  const std::uint64_t n = std::uint64_t{side} * side * side;
+  const auto part = [&](auto& v) {
+    using T = typename std::remove_reference_t<decltype(v)>::value_type;
+    return v.empty() ? std::span<T>() : std::span<T>(v).subspan(first * n, nodes * n);
+  };
+  return {part(out.opacity), part(out.color), part(out.normal)};
+}
+
 void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
-                    const LevelSamples& samples, SvoLevel& out) {
+                    const LevelSamples& samples, const BrickSpans& out) {
   const std::uint32_t n = layout.side * layout.side * layout.side;
-  const std::uint64_t nodes = tree.NodeCount(level);
-  out.opacity.resize(nodes * n);
-  out.color.resize(samples.color.empty() ? 0 : nodes * n);
-  out.normal.resize(samples.normal.empty() ? 0 : nodes * n);
+  const bool color = !out.color.empty(), normal = !out.normal.empty();
   ForEachNeighbourhood(tree, level, [&](std::uint64_t i, const Neighbourhood& nb) {
     for (unsigned s = 0; s < n; ++s) {
       const std::uint64_t from = SampleIndex(layout, nb, s), to = i * n + s;
       out.opacity[to] = samples.opacity[from];
-      if (!out.color.empty()) out.color[to] = samples.color[from];
-      if (!out.normal.empty()) out.normal[to] = samples.normal[from];
+      if (color) out.color[to] = samples.color[from];
+      if (normal) out.normal[to] = samples.normal[from];
     }
   });
 }
 
+void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
+                    const LevelSamples& samples, SvoLevel& out) {
+  AssembleBricks(tree, level, layout, samples,
+                 ResizeBricks(out, tree.NodeCount(level), layout.side, !samples.color.empty(),
+                              !samples.normal.empty()));
+}
+
 void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
-                 SvoLevel& out, std::span<const std::uint8_t> keep) {
+                 const BrickSpans& out, std::span<const std::uint8_t> keep) {
   const Flags f{!source.colors.empty(), !source.normals.empty()};
   const std::uint32_t level = tree.last_level() - 1, n = side * side * side;
   const std::uint64_t voxels = tree.NodeCount(tree.last_level());
@@ -511,9 +534,6 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
   std::vector<std::int64_t> slot(voxels);
   std::int64_t kept = 0;
   for (std::uint64_t v = 0; v < voxels; ++v) slot[v] = keep.empty() || keep[v] ? kept++ : -1;
-  out.opacity.resize(static_cast<std::uint64_t>(kept) * n);
-  out.color.resize(f.color ? out.opacity.size() : 0);
-  out.normal.resize(f.normal ? out.opacity.size() : 0);
   ForEachAboveVoxels(tree, source, f, [&](VoxelTile& tile, std::uint64_t i, const int corner[3]) {
     const std::uint8_t m = tree.masks[level - tree.first_level][i];
     std::uint64_t voxel = tree.first_child[level - tree.first_level][i];
@@ -538,6 +558,17 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
       }
     }
   });
+}
+
+void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
+                 SvoLevel& out, std::span<const std::uint8_t> keep) {
+  const std::uint64_t voxels = tree.NodeCount(tree.last_level());
+  const std::uint64_t kept =
+      keep.empty() ? voxels
+                   : static_cast<std::uint64_t>(std::count_if(
+                         keep.begin(), keep.end(), [](std::uint8_t k) { return k != 0; }));
+  VoxelBricks(tree, side, source,
+              ResizeBricks(out, kept, side, !source.colors.empty(), !source.normals.empty()), keep);
 }
 
 }  // namespace svokit

@@ -42,14 +42,34 @@ std::vector<LevelSamples> FilterSamplesAbove(const MaskTree& tree,
                                              std::span<const SampleLayout> layouts,
                                              std::uint32_t side, LevelSamples last);
 
+/// Where bricks are assembled: side³ samples per node in node order, as SvoLevel holds them
+/// (colour and normal empty where the bricks carry none).
+struct BrickSpans {
+  std::span<std::uint8_t> opacity;
+  std::span<std::uint32_t> color;
+  std::span<std::uint16_t> normal;
+};
+/// `out`'s brick arrays sized for `nodes` bricks of side³ samples, with colour and normal where
+/// asked for, and their spans.
+BrickSpans ResizeBricks(SvoLevel& out, std::uint64_t nodes, std::uint32_t side, bool color,
+                        bool normal);
+/// The spans of bricks first .. first + nodes − 1 of `out` (sized for them).
+BrickSpans BricksOf(SvoLevel& out, std::uint64_t first, std::uint64_t nodes, std::uint32_t side);
+
 /// The bricks of level `level` (< tree.last_level()) assembled from its distinct samples: side³
-/// samples per node, SvoLevel's layout.
+/// samples per node, SvoLevel's layout, into `out` (room for every node's brick; colour and
+/// normal as `samples` has them).
+void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
+                    const LevelSamples& samples, const BrickSpans& out);
 void AssembleBricks(const MaskTree& tree, std::uint32_t level, const SampleLayout& layout,
                     const LevelSamples& samples, SvoLevel& out);
 
 /// The voxel level's bricks (of tree.last_level()), computed from the voxels: side³ samples per
 /// voxel, SvoLevel's layout. With `keep` (one flag per voxel), only the voxels it marks get
-/// bricks, in their order (a page's voxels among its halo's); the others only contribute.
+/// bricks, in their order (a page's voxels among its halo's); the others only contribute. `out`
+/// has room for the kept voxels' bricks, colour and normal as `source` has them.
+void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
+                 const BrickSpans& out, std::span<const std::uint8_t> keep = {});
 void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
                  SvoLevel& out, std::span<const std::uint8_t> keep = {});
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "svokit/core/bit_count.hpp"
+#include "svokit/core/default_init.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/vec.hpp"
 #include "svokit/svo/sample_codec.hpp"
@@ -53,9 +54,10 @@ struct SvoLevel {
   std::vector<SvoNode> nodes;  ///< node_count records; empty at the voxel level
   /// Bricks: brick_samples() consecutive samples per node, sample (x, y, z) ∈ [0, side)³ at index
   /// x + side·(y + side·z), sitting at node_min + (x, y, z)·node_size/(side − 1).
-  std::vector<std::uint8_t> opacity;  ///< 8-bit linear
-  std::vector<std::uint32_t> color;   ///< RGBA8: sRGB-encoded RGB, linear A; R in the low byte
-  std::vector<std::uint16_t> normal;  ///< octahedral, 8 bits per axis (x low byte)
+  /// (Resized without zero-filling: whoever sizes them writes every sample.)
+  DefaultInitVector<std::uint8_t> opacity;  ///< 8-bit linear
+  DefaultInitVector<std::uint32_t> color;   ///< RGBA8: sRGB-encoded RGB, linear A; R in the low byte
+  DefaultInitVector<std::uint16_t> normal;  ///< octahedral, 8 bits per axis (x low byte)
   /// ESVO contours of this level's nodes that have one, in node order (membership: the parents'
   /// contour masks; at level 0 the root has one when this holds one element).
   std::vector<std::uint32_t> contours;

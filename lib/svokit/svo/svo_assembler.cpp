@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <tbb/parallel_for.h>
+
 #include "svokit/svo/sample_filter.hpp"
 
 namespace svokit {
@@ -40,6 +42,12 @@ VoxelSamplesSource VoxelSamplesOf(const SvoChunk& chunk, const SvoShape& shape) 
 }
 
 void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out) {
+  ChunkVoxelBricks(chunk, shape,
+                   ResizeBricks(out, chunk.tree.NodeCount(chunk.tree.last_level()),
+                                shape.brick_side, shape.has_color, shape.has_normal));
+}
+
+void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, const BrickSpans& out) {
   VoxelSamplesSource source = VoxelSamplesOf(chunk, shape);
   if (chunk.halo_keys.empty()) {
     VoxelBricks(chunk.tree, shape.brick_side, source, out);
@@ -110,6 +118,10 @@ std::vector<SvoLevel> SvoAssembler::Bricks(const SvoChunk& chunk) const {
 }
 
 void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
+  AppendLevels(chunk, &bricks);
+}
+
+void SvoAssembler::AppendLevels(const SvoChunk& chunk, std::vector<SvoLevel>* bricks) {
   // Contours one level further than the octree: they say which children have one.
   const std::uint32_t held = chunk.levels_held();
   for (std::uint32_t k = 0; k < held && chunk.root_level + k <= max_level_ + 1; ++k) {
@@ -124,11 +136,48 @@ void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
       AppendTo(masks_[l], chunk.tree.masks[k]);
       if (shape_.solid) AppendTo(full_[l], chunk.tree.full[k]);
     }
-    if (shape_.brick_side == 0) continue;
-    AppendTo(levels_[l].opacity, std::move(bricks[k].opacity));
-    AppendTo(levels_[l].color, std::move(bricks[k].color));
-    AppendTo(levels_[l].normal, std::move(bricks[k].normal));
+    if (shape_.brick_side == 0 || bricks == nullptr) continue;
+    AppendTo(levels_[l].opacity, std::move((*bricks)[k].opacity));
+    AppendTo(levels_[l].color, std::move((*bricks)[k].color));
+    AppendTo(levels_[l].normal, std::move((*bricks)[k].normal));
   }
+}
+
+void SvoAssembler::Append(std::span<const SvoChunk* const> chunks) {
+  if (shape_.brick_side == 0) {
+    for (const SvoChunk* chunk : chunks) AppendLevels(*chunk, nullptr);
+    return;
+  }
+  // Each chunk's levels get their room at the end of the level's arrays, in order; then every
+  // (chunk, level) fills its own part.
+  struct Part {
+    const SvoChunk* chunk;
+    std::uint32_t k, level;
+    std::uint64_t first, nodes;
+  };
+  std::vector<Part> parts;
+  for (const SvoChunk* chunk : chunks) {
+    AppendLevels(*chunk, nullptr);
+    for (std::uint32_t k = 0; k < chunk->levels_held() && chunk->root_level + k <= max_level_;
+         ++k) {
+      const std::uint32_t l = chunk->root_level + k;
+      const std::uint64_t nodes = chunk->tree.NodeCount(l);
+      SvoLevel& level = levels_[l];
+      const std::uint64_t first = level.opacity.size() / (std::uint64_t{shape_.brick_side} *
+                                                          shape_.brick_side * shape_.brick_side);
+      ResizeBricks(level, first + nodes, shape_.brick_side, shape_.has_color, shape_.has_normal);
+      parts.push_back({chunk, k, l, first, nodes});
+    }
+  }
+  tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t i) {
+    const Part& p = parts[i];
+    const BrickSpans out = BricksOf(levels_[p.level], p.first, p.nodes, shape_.brick_side);
+    if (p.level < shape_.depth) {
+      AssembleBricks(p.chunk->tree, p.level, p.chunk->layouts[p.k], p.chunk->samples[p.k], out);
+    } else {
+      ChunkVoxelBricks(*p.chunk, shape_, out);
+    }
+  });
 }
 
 Svo SvoAssembler::Finish(const GridTransform& grid, VoxelMode mode, std::string metadata) {

@@ -30,6 +30,9 @@ class SvoAssembler {
   /// Appends the levels `chunk` holds, down to max_level, with their Bricks(chunk).
   void Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks);
   void Append(const SvoChunk& chunk) { Append(chunk, Bricks(chunk)); }
+  /// Appends `chunks` in order as Append does, their bricks assembled in parallel straight into
+  /// place.
+  void Append(std::span<const SvoChunk* const> chunks);
   Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
 
  private:
@@ -38,6 +41,10 @@ class SvoAssembler {
   std::vector<std::vector<std::uint8_t>> masks_, full_;
   std::vector<std::vector<std::uint32_t>> words_;
   std::vector<SvoLevel> levels_;
+
+  // Append's node records and contour words of one chunk; `bricks` moves in its bricks, where
+  // given.
+  void AppendLevels(const SvoChunk& chunk, std::vector<SvoLevel>* bricks);
 };
 
 /// What the voxel level's bricks of `chunk` are filtered from: its voxels' colours (or the one
@@ -45,7 +52,8 @@ class SvoAssembler {
 VoxelSamplesSource VoxelSamplesOf(const SvoChunk& chunk, const SvoShape& shape);
 
 /// The voxel bricks of a page (or of a whole tree, `halo` empty): side³ samples per voxel of
-/// `chunk` in its order, computed from its voxels and those of its halo.
+/// `chunk` in its order, computed from its voxels and those of its halo (`out` sized for them).
+void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, const BrickSpans& out);
 void ChunkVoxelBricks(const SvoChunk& chunk, const SvoShape& shape, SvoLevel& out);
 
 }  // namespace svokit

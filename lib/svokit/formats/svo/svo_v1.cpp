@@ -20,9 +20,9 @@ Tag LevelTag(const char (&kind)[3], std::uint32_t level) {
 }
 
 // A per-level array of exactly `count` elements; absent means empty, which only count 0 allows.
-template <class T>
-bool ReadLevelArray(const container::Frame& file, Tag tag, std::uint64_t count, std::vector<T>& out,
-                    IssueSink& sink, bool& usable) {
+template <class T, class A>
+bool ReadLevelArray(const container::Frame& file, Tag tag, std::uint64_t count,
+                    std::vector<T, A>& out, IssueSink& sink, bool& usable) {
   const auto section = Loaded(file, tag);
   const std::uint64_t size = section ? section->size() : 0;
   if (size != count * sizeof(T)) {

@@ -418,26 +418,24 @@ bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name,
   bool complete = true;
   const std::size_t batch = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   std::vector<std::optional<StatusOr<SvoChunk>>> decoded(batch);
-  std::vector<std::vector<SvoLevel>> bricks(batch);
   for (std::size_t first = 0; last + 1 >= v.page_level && first < v.pages.size(); first += batch) {
     const std::size_t count = std::min(batch, v.pages.size() - first);
-    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
-      decoded[i] = DecodePage(v, first + i, name, nullptr);
-      if (decoded[i]->ok()) bricks[i] = assembler.Bricks(**decoded[i]);
-    });
+    tbb::parallel_for(std::size_t{0}, count,
+                      [&](std::size_t i) { decoded[i] = DecodePage(v, first + i, name, nullptr); });
+    std::vector<const SvoChunk*> pages;
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t p = first + i;
-      StatusOr<SvoChunk> page = std::move(*decoded[i]);
-      decoded[i].reset();
-      if (!page.ok()) {
+      if (!decoded[i]->ok()) {
         (void)DecodePage(v, p, name, &sink);
         complete = false;
         if (sink.stops()) return false;
         continue;
       }
-      assembler.Append(*page, std::move(bricks[i]));
-      if (last == v.shape.depth) voxels.Add(p, *page);
+      pages.push_back(&**decoded[i]);
+      if (last == v.shape.depth) voxels.Add(p, **decoded[i]);
     }
+    assembler.Append(pages);
+    for (std::size_t i = 0; i < count; ++i) decoded[i].reset();
     if (stage != nullptr) stage->Advance(count);
   }
   return complete;
