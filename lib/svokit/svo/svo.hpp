@@ -56,7 +56,7 @@ struct SvoLevel {
   /// x + side·(y + side·z), sitting at node_min + (x, y, z)·node_size/(side − 1).
   /// (Resized without zero-filling: whoever sizes them writes every sample.)
   DefaultInitVector<std::uint8_t> opacity;  ///< 8-bit linear
-  DefaultInitVector<std::uint32_t> color;   ///< RGBA8: sRGB-encoded RGB, linear A; R in the low byte
+  DefaultInitVector<std::uint32_t> color;  ///< RGBA8: sRGB-encoded RGB, linear A; R in the low byte
   DefaultInitVector<std::uint16_t> normal;  ///< octahedral, 8 bits per axis (x low byte)
   /// ESVO contours of this level's nodes that have one, in node order (membership: the parents'
   /// contour masks; at level 0 the root has one when this holds one element).
