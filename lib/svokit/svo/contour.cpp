@@ -228,12 +228,12 @@ int Floor(double x) {
   return i - (x < i ? 1 : 0);
 }
 
-// The tightest quantized slab along integer normal n (non-zero, Euclidean length `norm`) holding
-// n·u ∈ [dmin, dmax], widened by the safety margin and rounded outward.
-Fit Quantize(double dmin, double dmax, int nx, int ny, int nz, double norm) {
+// The tightest quantized slab along integer normal n (non-zero) holding n·u ∈ [dmin, dmax], widened
+// by the safety margin and rounded outward.
+Fit Quantize(double dmin, double dmax, int nx, int ny, int nz) {
   Fit f;
   const double l1 = std::abs(nx) + std::abs(ny) + std::abs(nz), half = 0.5 * l1;
-  const double inv_norm = 1 / norm;
+  const double inv_norm = 1 / std::sqrt(double(nx * nx + ny * ny + nz * nz));
   // Geometry inside the cube never leaves [−L1/2, L1/2] along n: clamp before widening.
   const double margin = kSlabMargin * l1;
   const double lo = (std::max(dmin, -half) - margin) * (1 / kStep);
@@ -269,7 +269,7 @@ Fit EvalNormal(const std::vector<Vec3d>& u, int nx, int ny, int nz,
     dmax = std::max(dmax, d);
     if (std::min(dmax, half) - std::max(dmin, -half) >= width_bound) return f;
   }
-  return Quantize(dmin, dmax, nx, ny, nz, norm);
+  return Quantize(dmin, dmax, nx, ny, nz);
 }
 
 // The 26 integer neighbour offsets of a normal (each component −1, 0 or +1), padded to 28 lanes.
@@ -329,8 +329,7 @@ Fit LocalSearch(const std::vector<Vec3d>& u, std::vector<float>& uf, Fit best, i
       const double half = 0.5 * (std::abs(nx) + std::abs(ny) + std::abs(nz));
       const double width = std::min(double(mx[k]), half) - std::max(double(mn[k]), -half);
       if (width * width >= best.cost * best.cost * double(nx * nx + ny * ny + nz * nz)) continue;
-      const double cost =
-          Quantize(mn[k], mx[k], nx, ny, nz, std::sqrt(double(nx * nx + ny * ny + nz * nz))).cost;
+      const double cost = Quantize(mn[k], mx[k], nx, ny, nz).cost;
       if (cost < best.cost + 1e-6) est[std::size_t(n_est++)] = {cost, int(k)};
     }
     std::sort(est.begin(), est.begin() + n_est);
@@ -463,11 +462,8 @@ std::uint32_t FitNode(const Context& ctx, const Pieces& pieces, const Vec3d& cen
   if (!std::isfinite(best.cost)) return 0;
   if (search_pts != &s.u) best = EvalNormal(s.u, best.c.nx, best.c.ny, best.c.nz);
   if (!std::isfinite(best.cost)) return 0;
-  // The storage rule on ClippedSpan's extent fraction (without its Euclidean length).
-  const double l1 = std::abs(best.c.nx) + std::abs(best.c.ny) + std::abs(best.c.nz);
-  const double kept = std::clamp(best.c.High(), -0.5 * l1, 0.5 * l1) -
-                      std::clamp(best.c.Low(), -0.5 * l1, 0.5 * l1);
-  if (!(kept / l1 <= ctx.options.max_relative_thickness)) return 0;
+  const ContourSpan span = ClippedSpan(best.c);
+  if (!((span.high - span.low) / span.l1 <= ctx.options.max_relative_thickness)) return 0;
   return EncodeContour(best.c);
 }
 
@@ -586,10 +582,11 @@ std::vector<std::vector<std::uint32_t>> ContourFitter::FitSubtree(
   Scratch s;
   const double extent = std::ldexp(1.0, static_cast<int>(depth_));
   const double rlo = -eps_, rhi = extent + eps_;
+  // Six cuts of a triangle, each at most doubling its vertices.
+  Vec3d* a = s.a.Room(3 << 6);
+  Vec3d* b = s.b.Room(3 << 6);
   for (const std::uint32_t t : triangles) {
     const Triangle& tri = mesh_.triangles[t];
-    Vec3d* a = s.a.Room(3 << 6);
-    Vec3d* b = s.b.Room(3 << 6);
     a[0] = vox_[tri[0]], a[1] = vox_[tri[1]], a[2] = vox_[tri[2]];
     int n = 3;
     for (int axis = 0; axis < 3 && n > 0; ++axis) {
