@@ -19,16 +19,6 @@ void AppendTo(std::vector<T, A>& to, const std::vector<T, A>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
-// The first part moves in whole, unless room was reserved for all of them.
-template <class T, class A>
-void AppendTo(std::vector<T, A>& to, std::vector<T, A>&& from) {
-  if (to.empty() && to.capacity() <= from.size()) {
-    to = std::move(from);
-  } else {
-    AppendTo(to, static_cast<const std::vector<T, A>&>(from));
-  }
-}
-
 }  // namespace
 
 VoxelSamplesSource VoxelSamplesOf(const SvoChunk& chunk, const SvoShape& shape) {
@@ -102,26 +92,7 @@ void SvoAssembler::Reserve(std::span<const std::uint64_t> nodes) {
   }
 }
 
-std::vector<SvoLevel> SvoAssembler::Bricks(const SvoChunk& chunk) const {
-  std::vector<SvoLevel> bricks;
-  if (shape_.brick_side == 0) return bricks;
-  for (std::uint32_t k = 0; k < chunk.levels_held() && chunk.root_level + k <= max_level_; ++k) {
-    const std::uint32_t l = chunk.root_level + k;
-    SvoLevel& level = bricks.emplace_back();
-    if (l < shape_.depth) {
-      AssembleBricks(chunk.tree, l, chunk.layouts[k], chunk.samples[k], level);
-    } else {
-      ChunkVoxelBricks(chunk, shape_, level);
-    }
-  }
-  return bricks;
-}
-
-void SvoAssembler::Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks) {
-  AppendLevels(chunk, &bricks);
-}
-
-void SvoAssembler::AppendLevels(const SvoChunk& chunk, std::vector<SvoLevel>* bricks) {
+void SvoAssembler::AppendLevels(const SvoChunk& chunk) {
   // Contours one level further than the octree: they say which children have one.
   const std::uint32_t held = chunk.levels_held();
   for (std::uint32_t k = 0; k < held && chunk.root_level + k <= max_level_ + 1; ++k) {
@@ -136,16 +107,12 @@ void SvoAssembler::AppendLevels(const SvoChunk& chunk, std::vector<SvoLevel>* br
       AppendTo(masks_[l], chunk.tree.masks[k]);
       if (shape_.solid) AppendTo(full_[l], chunk.tree.full[k]);
     }
-    if (shape_.brick_side == 0 || bricks == nullptr) continue;
-    AppendTo(levels_[l].opacity, std::move((*bricks)[k].opacity));
-    AppendTo(levels_[l].color, std::move((*bricks)[k].color));
-    AppendTo(levels_[l].normal, std::move((*bricks)[k].normal));
   }
 }
 
 void SvoAssembler::Append(std::span<const SvoChunk* const> chunks) {
   if (shape_.brick_side == 0) {
-    for (const SvoChunk* chunk : chunks) AppendLevels(*chunk, nullptr);
+    for (const SvoChunk* chunk : chunks) AppendLevels(*chunk);
     return;
   }
   // Each chunk's levels get their room at the end of the level's arrays, in order; then every
@@ -157,7 +124,7 @@ void SvoAssembler::Append(std::span<const SvoChunk* const> chunks) {
   };
   std::vector<Part> parts;
   for (const SvoChunk* chunk : chunks) {
-    AppendLevels(*chunk, nullptr);
+    AppendLevels(*chunk);
     for (std::uint32_t k = 0; k < chunk->levels_held() && chunk->root_level + k <= max_level_;
          ++k) {
       const std::uint32_t l = chunk->root_level + k;

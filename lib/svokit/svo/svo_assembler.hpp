@@ -24,15 +24,13 @@ class SvoAssembler {
   /// Makes room for `nodes[l]` nodes of each level l (what a file says it holds), so appending
   /// chunks does not move what is in: a hint, ignored where the memory is not there.
   void Reserve(std::span<const std::uint64_t> nodes);
-  /// The bricks of the levels `chunk` holds, down to max_level: the costly part of Append, which
-  /// may run for several chunks at once (it only reads the assembler).
-  std::vector<SvoLevel> Bricks(const SvoChunk& chunk) const;
-  /// Appends the levels `chunk` holds, down to max_level, with their Bricks(chunk).
-  void Append(const SvoChunk& chunk, std::vector<SvoLevel> bricks);
-  void Append(const SvoChunk& chunk) { Append(chunk, Bricks(chunk)); }
-  /// Appends `chunks` in order as Append does, their bricks assembled in parallel straight into
-  /// place.
+  /// Appends the levels `chunks` hold, in order, down to max_level: their node masks and contour
+  /// words, and their bricks, assembled in parallel straight into place.
   void Append(std::span<const SvoChunk* const> chunks);
+  void Append(const SvoChunk& chunk) {
+    const SvoChunk* one = &chunk;
+    Append(std::span(&one, 1));
+  }
   Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
 
  private:
@@ -42,9 +40,8 @@ class SvoAssembler {
   std::vector<std::vector<std::uint32_t>> words_;
   std::vector<SvoLevel> levels_;
 
-  // Append's node records and contour words of one chunk; `bricks` moves in its bricks, where
-  // given.
-  void AppendLevels(const SvoChunk& chunk, std::vector<SvoLevel>* bricks);
+  // Append's node masks and contour words of one chunk.
+  void AppendLevels(const SvoChunk& chunk);
 };
 
 /// What the voxel level's bricks of `chunk` are filtered from: its voxels' colours (or the one
