@@ -106,14 +106,22 @@ class PageSampleCopier {
     }
   }
 
-  // Whether the 27 cubes around the level-l node `node_key` all lie inside the page's cube.
-  bool InsidePage(std::uint32_t l, std::uint64_t node_key) const {
-    const MortonCoord c = MortonDecode(node_key), page = MortonDecode(page_.root_key);
+  // Whether the level-l cell at c + (ox, oy, oz) lies inside the page's cube.
+  bool InPage(std::uint32_t l, const MortonCoord& c, int ox, int oy, int oz) const {
+    const MortonCoord page = MortonDecode(page_.root_key);
     const int shift = static_cast<int>(l - page_.root_level);
-    const auto inside = [shift](std::uint32_t v, std::uint32_t page_coord) {
-      return v > 0 && ((v - 1) >> shift) == page_coord && ((v + 1) >> shift) == page_coord;
+    const auto inside = [shift](std::uint32_t v, int o, std::uint32_t page_coord) {
+      const std::int64_t w = static_cast<std::int64_t>(v) + o;
+      return w >= 0 && (w >> shift) == static_cast<std::int64_t>(page_coord);
     };
-    return inside(c.x, page.x) && inside(c.y, page.y) && inside(c.z, page.z);
+    return inside(c.x, ox, page.x) && inside(c.y, oy, page.y) && inside(c.z, oz, page.z);
+  }
+
+  // Whether the 27 cells around the level-l node `node_key` all lie inside the page's cube (the
+  // page is a box: its two far corners do).
+  bool InsidePage(std::uint32_t l, std::uint64_t node_key) const {
+    const MortonCoord c = MortonDecode(node_key);
+    return InPage(l, c, -1, -1, -1) && InPage(l, c, 1, 1, 1);
   }
 
   // Node `local`'s orphans in the page's layout and its samples, copied from where the whole
@@ -137,7 +145,7 @@ class PageSampleCopier {
     const std::uint32_t side = svo_.frame.shape.brick_side;
     const std::uint32_t orphans = global_nb == nullptr
                                       ? whole.orphans[global]
-                                      : OrphanMask(side, InPage(*global_nb, l, node_key));
+                                      : OrphanMask(side, OnlyInPage(*global_nb, l, node_key));
     layout.orphans[local] = orphans;
     layout.first[local] = out.opacity.size();
     if (orphans == whole.orphans[global]) {
@@ -160,20 +168,13 @@ class PageSampleCopier {
 
   // The neighbourhood `nb` of the level-l node `node_key` with the nodes outside the page
   // removed.
-  Neighbourhood InPage(const Neighbourhood& nb, std::uint32_t l, std::uint64_t node_key) const {
-    const MortonCoord c = MortonDecode(node_key), page = MortonDecode(page_.root_key);
-    const int shift = static_cast<int>(l - page_.root_level);
-    const auto inside = [shift](std::uint32_t v, int o, std::uint32_t page_coord) {
-      const std::int64_t w = static_cast<std::int64_t>(v) + o;
-      return w >= 0 && (w >> shift) == static_cast<std::int64_t>(page_coord);
-    };
+  Neighbourhood OnlyInPage(const Neighbourhood& nb, std::uint32_t l, std::uint64_t node_key) const {
+    const MortonCoord c = MortonDecode(node_key);
     Neighbourhood out = nb;
     for (int oz = -1; oz <= 1; ++oz) {
       for (int oy = -1; oy <= 1; ++oy) {
         for (int ox = -1; ox <= 1; ++ox) {
-          if (!inside(c.x, ox, page.x) || !inside(c.y, oy, page.y) || !inside(c.z, oz, page.z)) {
-            out[NeighbourSlot(ox, oy, oz)] = -1;
-          }
+          if (!InPage(l, c, ox, oy, oz)) out[NeighbourSlot(ox, oy, oz)] = -1;
         }
       }
     }
@@ -187,23 +188,12 @@ class PageSampleCopier {
     const MortonCoord c = MortonDecode(node_key);
     const std::vector<std::uint8_t>& masks = svo_.whole.tree.masks[l];
     const std::vector<std::uint64_t>& first = svo_.whole.tree.first_child[l];
-    // A neighbour inside the page's cube has all its voxels in the page: only the page's
-    // border nodes look at their neighbours' voxels.
-    const MortonCoord page = MortonDecode(page_.root_key);
-    const int shift = static_cast<int>(l - page_.root_level);
-    const auto inside = [shift](std::int64_t v, std::uint32_t page_coord) {
-      return v >= 0 && (v >> shift) == static_cast<std::int64_t>(page_coord);
-    };
     for (int oz = -1; oz <= 1; ++oz) {
       for (int oy = -1; oy <= 1; ++oy) {
         for (int ox = -1; ox <= 1; ++ox) {
           const std::int64_t q = global_nb[NeighbourSlot(ox, oy, oz)];
-          if (q < 0) continue;
-          if (inside(static_cast<std::int64_t>(c.x) + ox, page.x) &&
-              inside(static_cast<std::int64_t>(c.y) + oy, page.y) &&
-              inside(static_cast<std::int64_t>(c.z) + oz, page.z)) {
-            continue;
-          }
+          // A neighbour inside the page's cube has all its voxels in the page.
+          if (q < 0 || InPage(l, c, ox, oy, oz)) continue;
           std::uint64_t voxel = first[q];
           for (unsigned ch = 0; ch < 8; ++ch) {
             if (!(masks[q] >> ch & 1u)) continue;
