@@ -376,7 +376,6 @@ class FinerWindow {
     }
     std::fill(present_.begin(), present_.end(), 0);
   }
-  int size() const { return n_; }
   // Point p (each component −1 .. n − 2).
   void Put(const int p[3], const PremultipliedSample& v) {
     const std::size_t i = Index(p[0] + 1, p[1] + 1, p[2] + 1);
