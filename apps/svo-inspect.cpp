@@ -19,6 +19,7 @@ struct InspectCli {
   std::string view = "front", size = "512x512", shade = "color";
   bool no_contours = false;
   std::vector<std::string> slice;
+  app::MemoryLimitOption memory_limit;
 
   void Add(CLI::App& cli) {
     app::AddFile(cli, "input", request.input, "Octree (.svo)")->required();
@@ -44,6 +45,9 @@ struct InspectCli {
                    "Read levels 0..L only: statistics cover them, renders and slices show level "
                    "L's nodes as leaves")
         ->option_text("L");
+    memory_limit.Add(cli,
+                     "Bytes of pages the statistics of a paged file hold at once (default: a few "
+                     "per thread); renders and slices read the levels they show whole");
   }
 
   // Every option is parsed before the file is read, so a typo costs nothing.
@@ -59,6 +63,9 @@ struct InspectCli {
     request.render.height = (*wh)[1];
     request.render.shade = *s;
     request.render.contours = !no_contours;
+    StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
+    if (!limit.ok()) return limit.status();
+    request.memory_limit = limit->value_or(0);
     if (slice.empty()) return Status::Ok();
     StatusOr<SliceSpec> spec = ParseSlice(slice[0]);
     if (!spec.ok()) return Status::BadInput("--{}", spec.status().message());

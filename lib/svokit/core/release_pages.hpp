@@ -31,6 +31,15 @@ inline void ReleasePages(const void* begin, const void* end) {
   if (lo < hi) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
 }
 
+/// Drops the pages of a read-only file mapping that overlap [begin, end) from the process: touched
+/// again, they are read back from the file (the page cache), so even pages shared with neighbouring
+/// ranges may go.
+inline void ReleaseMappedFilePages(const void* begin, const void* end) {
+  // WholePages of the swapped range is {end rounded up, begin rounded down}: the pages overlapped.
+  const auto [up, down] = release_pages_detail::WholePages(end, begin);
+  if (down < up) ::madvise(reinterpret_cast<void*>(down), up - down, MADV_DONTNEED);
+}
+
 /// Asks for small pages over the whole pages inside [begin, end), not yet touched: on VMs a fresh
 /// 2 MB page is usually one the host has never backed, while small pages come from the ones just
 /// freed. For memory of its own mapping only (the advice stays with the pages). Returns whether

@@ -55,20 +55,39 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   for (const std::filesystem::path* path : {&r.render_path, &r.slice_path}) {
     if (!path->empty()) SVOKIT_RETURN_IF_ERROR(CheckOutputPath(*path, {"png"}, r.input));
   }
-  StatusOr<Svo> svo = ReadSvoStage(progress, r.input, r.level);
-  if (!svo.ok()) return svo.status();
   InspectReport report;
   report.file = r.input.string();
-  report.file_bytes = std::filesystem::file_size(r.input);
+  report.levels = r.levels;
+  report.histograms = r.histograms;
   report.version = 1;
+  std::optional<SvoStats> stats;
+  // A paged file (version 2 or 3) is counted page by page; version 1 is read whole.
   if (StatusOr<SvoReader> reader = SvoReader::Open(r.input); reader.ok()) {
+    if (r.level && *r.level > reader->depth()) {
+      return Status::BadInput("{}: level {} exceeds the octree's depth {}", r.input.string(),
+                              *r.level, reader->depth());
+    }
     report.version = reader->version();
+    report.file_bytes = std::filesystem::file_size(r.input);
     StatusOr<SvoFileStats> file_stats = reader->FileStats(r.levels);
     if (!file_stats.ok()) return file_stats.status();
     report.file_stats = std::move(*file_stats);
+    Progress::Stage stage(progress, "statistics", 0);
+    StatusOr<SvoStats> counted =
+        ComputeSvoStats(*reader, r.level, SvoStreamOptions{.memory_limit = r.memory_limit}, &stage);
+    if (!counted.ok()) {
+      stage.Cancel();
+      return counted.status();
+    }
+    stats = std::move(*counted);
   }
-  report.levels = r.levels;
-  report.histograms = r.histograms;
+  std::optional<Svo> svo;
+  if (!stats || !r.render_path.empty() || !r.slice_path.empty()) {
+    StatusOr<Svo> read = ReadSvoStage(progress, r.input, r.level);
+    if (!read.ok()) return read.status();
+    svo = std::move(*read);
+    report.file_bytes = std::filesystem::file_size(r.input);
+  }
   if (!r.render_path.empty()) {
     StatusOr<RenderedPicture> picture = Render(r, *svo, progress);
     if (!picture.ok()) return picture.status();
@@ -79,8 +98,8 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
     if (!picture.ok()) return picture.status();
     report.slice = *picture;
   }
-  const SvoStats stats = RunStage(progress, "statistics", [&] { return ComputeSvoStats(*svo); });
-  return r.json ? FormatStatsJson(stats, report) : FormatStatsText(stats, report);
+  if (!stats) stats = RunStage(progress, "statistics", [&] { return ComputeSvoStats(*svo); });
+  return r.json ? FormatStatsJson(*stats, report) : FormatStatsText(*stats, report);
 }
 
 }  // namespace svokit

@@ -1,6 +1,6 @@
 #pragma once
-// svo-inspect's run: an octree read (down to a level), its statistics computed, and the pictures
-// asked for rendered and written, all in one report.
+// svo-inspect's run: an octree's statistics computed (a paged file's page by page, within a memory
+// bound), and the pictures asked for rendered from it read whole (down to a level), in one report.
 
 #include <cstdint>
 #include <filesystem>
@@ -17,9 +17,11 @@ namespace svokit {
 struct InspectRequest {
   std::filesystem::path input;
   std::optional<std::uint32_t> level;  ///< read levels 0..level only
-  bool levels = false;                 ///< the per-level table
+  /// Bytes of pages a paged file's statistics hold at once (0: a few pages per thread).
+  std::uint64_t memory_limit = 0;
+  bool levels = false;  ///< the per-level table
   bool histograms = false;
-  bool json = false;  ///< the report as one JSON object, else text
+  bool json = false;                  ///< the report as one JSON object, else text
   std::filesystem::path render_path;  ///< a PNG of the octree, with `render`; may be empty
   RenderOptions render;
   std::filesystem::path slice_path;  ///< a PNG of a slice of the grid, with `slice`; may be empty

@@ -6,10 +6,14 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "svokit/core/grid_transform.hpp"
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/svo/contour.hpp"
 #include "svokit/svo/svo.hpp"
 
@@ -50,6 +54,10 @@ struct SvoLevelStats {
 };
 
 struct BrickStats {
+  /// Samples as the file stores them: each lattice point once per chunk (a point on a page border
+  /// once in each page), the voxel level's bricks (which a reader derives) not at all; else every
+  /// brick's side³ samples, as read whole.
+  bool distinct = false;
   std::uint64_t samples = 0;
   std::uint64_t empty = 0;  ///< samples with opacity 0 (no colour, no normal stored)
   ValueRange opacity;       ///< over all samples
@@ -92,5 +100,12 @@ struct SvoStats {
 
 /// Statistics of the loaded levels of `svo` (parallel; the result does not depend on threads).
 SvoStats ComputeSvoStats(const Svo& svo);
+
+/// Statistics of levels 0 .. max_level of a paged file, read page by page within `options`' memory
+/// bound: ComputeSvoStats of the octree read whole, but for the bricks, which are the samples the
+/// file stores (BrickStats::distinct). The same whatever the bound or thread count.
+StatusOr<SvoStats> ComputeSvoStats(const SvoReader& reader, std::optional<std::uint32_t> max_level,
+                                   const SvoStreamOptions& options,
+                                   Progress::Stage* stage = nullptr);
 
 }  // namespace svokit

@@ -45,24 +45,44 @@ ContourSpan ClippedSpan(const Contour& c) {
   return s;
 }
 
+void ContourTally::Add(std::uint32_t word) {
+  if (word == 0) {
+    ++nodes;
+  } else {
+    AddSpan(ClippedSpan(DecodeContour(word)));
+  }
+}
+
+void ContourTally::AddSpan(const ContourSpan& s) {
+  ++nodes;
+  ++with_contour;
+  sum_relative += (s.high - s.low) / s.l2;
+  sum_extent += (s.high - s.low) / s.l1;
+}
+
+void ContourTally::Add(const ContourTally& other) {
+  nodes += other.nodes;
+  with_contour += other.with_contour;
+  sum_relative += other.sum_relative;
+  sum_extent += other.sum_extent;
+}
+
+ContourLevelStats ContourTally::Stats() const {
+  ContourLevelStats st{nodes, with_contour, 0, 0};
+  if (with_contour > 0) {
+    st.mean_relative_thickness = sum_relative / static_cast<double>(with_contour);
+    st.mean_extent_fraction = sum_extent / static_cast<double>(with_contour);
+  }
+  return st;
+}
+
 std::vector<ContourLevelStats> ComputeContourStats(
     const std::vector<std::vector<std::uint32_t>>& contours) {
-  std::vector<ContourLevelStats> stats(contours.size());
-  for (std::size_t level = 0; level < contours.size(); ++level) {
-    ContourLevelStats& st = stats[level];
-    double sum_rel = 0, sum_ext = 0;
-    for (const std::uint32_t w : contours[level]) {
-      ++st.nodes;
-      if (w == 0) continue;
-      const ContourSpan s = ClippedSpan(DecodeContour(w));
-      ++st.with_contour;
-      sum_rel += (s.high - s.low) / s.l2;
-      sum_ext += (s.high - s.low) / s.l1;
-    }
-    if (st.with_contour > 0) {
-      st.mean_relative_thickness = sum_rel / static_cast<double>(st.with_contour);
-      st.mean_extent_fraction = sum_ext / static_cast<double>(st.with_contour);
-    }
+  std::vector<ContourLevelStats> stats;
+  for (const std::vector<std::uint32_t>& level : contours) {
+    ContourTally tally;
+    for (const std::uint32_t w : level) tally.Add(w);
+    stats.push_back(tally.Stats());
   }
   return stats;
 }

@@ -90,6 +90,17 @@ struct ContourSpan {
 };
 ContourSpan ClippedSpan(const Contour& c);
 
+/// The sums behind one level's ContourLevelStats, which add up over parts of the level (pages): a
+/// word of 0 is a node without a contour.
+struct ContourTally {
+  std::uint64_t nodes = 0, with_contour = 0;
+  double sum_relative = 0, sum_extent = 0;
+  void Add(std::uint32_t word);
+  void AddSpan(const ContourSpan& span);  ///< a contour's: ClippedSpan of its word
+  void Add(const ContourTally& other);
+  ContourLevelStats Stats() const;
+};
+
 /// Stats per level of FitContours' result (one entry per level).
 std::vector<ContourLevelStats> ComputeContourStats(
     const std::vector<std::vector<std::uint32_t>>& contours);

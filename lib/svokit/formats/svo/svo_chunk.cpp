@@ -317,7 +317,9 @@ namespace {
 // A chunk's streams, decompressed, by kind (empty where absent).
 class StreamSet {
  public:
-  static StatusOr<StreamSet> Read(std::span<const std::uint8_t> bytes, const std::string& name) {
+  /// Streams whose kind has its bit in `skip` are not decompressed (they read as empty).
+  static StatusOr<StreamSet> Read(std::span<const std::uint8_t> bytes, const std::string& name,
+                                  std::uint32_t skip = 0) {
     StreamSet set;
     const std::uint8_t* p = bytes.data();
     const std::uint8_t* end = p + bytes.size();
@@ -365,7 +367,9 @@ class StreamSet {
         return Status::BadInput("{}: stream {} runs past the chunk", name, e.kind);
       }
       Bytes& out = set.streams_[e.kind];
-      if (e.codec == kStored) {
+      if (skip >> e.kind & 1u) {
+        // Not decompressed.
+      } else if (e.codec == kStored) {
         out.assign(p, p + e.stored);
       } else {
         if (ZSTD_getFrameContentSize(p, e.stored) != e.raw) {
@@ -647,20 +651,25 @@ Status DecodeSamples(const StreamSet& set, const SvoShape& shape, const ChunkFra
   const std::uint32_t sample_levels =
       shape.brick_side == 0 ? 0 : std::min(frame.levels, shape.depth - frame.root_level);
   std::uint64_t samples = 0;
-  for (std::uint32_t k = 0; k < sample_levels; ++k) {
+  const bool lay_out = frame.parts == ChunkParts::kAll;
+  for (std::uint32_t k = 0; lay_out && k < sample_levels; ++k) {
     chunk.layouts.push_back(LayOutSamples(chunk.tree, frame.root_level + k, shape.brick_side));
     samples += chunk.layouts.back().size();
   }
-  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kOpacity, samples, name));
+  if (!lay_out) {
+    samples = set[kOpacity].size();
+  } else {
+    SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kOpacity, samples, name));
+  }
   std::uint64_t filled = 0;
   for (const std::uint8_t o : set[kOpacity]) filled += o != 0;
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kColors, shape.has_color ? 4 * filled : 0, name));
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kNormals, shape.has_normal ? 2 * filled : 0, name));
   std::uint64_t sample = 0, nonempty = 0;
   std::uint8_t color[4] = {}, normal[2] = {};  // the previous non-empty sample's bytes
-  for (std::uint32_t k = 0; k < sample_levels; ++k) {
+  for (std::uint32_t k = 0; k < (lay_out ? sample_levels : std::min(sample_levels, 1u)); ++k) {
     LevelSamples& s = chunk.samples.emplace_back();
-    const std::uint64_t n = chunk.layouts[k].size();
+    const std::uint64_t n = lay_out ? chunk.layouts[k].size() : samples;
     s.opacity.assign(set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample),
                      set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample + n));
     s.color.assign(shape.has_color ? n : 0, 0);
@@ -757,7 +766,11 @@ Status DecodeHalo(const StreamSet& set, const SvoShape& shape, const ChunkFrame&
 
 StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoShape& shape,
                                const ChunkFrame& frame, const std::string& name) {
-  StatusOr<StreamSet> read = StreamSet::Read(bytes, name);
+  const bool counts_only = frame.parts == ChunkParts::kCounts;
+  constexpr std::uint32_t kAttributeStreams = 1u << kVoxelColors | 1u << kVoxelNormals |
+                                              1u << kHaloKeys | 1u << kHaloColors |
+                                              1u << kHaloNormals;
+  StatusOr<StreamSet> read = StreamSet::Read(bytes, name, counts_only ? kAttributeStreams : 0);
   if (!read.ok()) return read.status();
   const StreamSet& set = *read;
   SvoChunk chunk;
@@ -769,6 +782,7 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   SVOKIT_RETURN_IF_ERROR(DecodeFullMasks(set, shape, frame, name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeContours(set, shape, frame, *counts, name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeSamples(set, shape, frame, name, chunk));
+  if (counts_only) return chunk;
   SVOKIT_RETURN_IF_ERROR(DecodeVoxels(set, shape, frame, counts->back(), name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeHalo(set, shape, frame, name, chunk));
   return chunk;

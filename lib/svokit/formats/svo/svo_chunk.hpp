@@ -53,11 +53,17 @@ inline constexpr std::uint64_t kChunkLimit = std::uint64_t{4} << 30;
 /// What a decoder knows of a chunk before reading it: where its root is and which levels it holds
 /// (top chunk: root 0, levels 0 .. P − 1, masks down to P − 1; page: root at P, levels P ..
 /// depth, masks down to depth − 1).
+/// What a decode makes of a chunk: all of it, or what counting needs (statistics): no voxel
+/// attributes or halo, and the samples not laid out over the nodes, every level's in one
+/// LevelSamples (SvoChunk::layouts empty), their count unchecked against the tree.
+enum class ChunkParts { kAll, kCounts };
+
 struct ChunkFrame {
   std::uint32_t root_level = 0;
   std::uint64_t root_key = 0;
   std::uint32_t levels = 0;  ///< levels held: root_level .. root_level + levels − 1
   bool page = false;         ///< holds the voxel level, its voxels' attributes and halo
+  ChunkParts parts = ChunkParts::kAll;
 };
 
 /// Decodes and checks a chunk (sizes, counts, masks, contour words, halo keys): an error names

@@ -97,10 +97,11 @@ struct Version2 {
 /// Parses GRID, HEAD, PTAB and META; the first problem goes to `sink` and fails.
 StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink);
 /// The top chunk (empty when the page level is 0).
-StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name);
+StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name,
+                             ChunkParts parts = ChunkParts::kAll);
 /// Page `page`, its checksum verified; a problem also goes to `sink` when given.
 StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::string& name,
-                              IssueSink* sink = nullptr);
+                              IssueSink* sink = nullptr, ChunkParts parts = ChunkParts::kAll);
 /// Fills the page count and smallest, median and largest page of `stats` from the pages' sizes.
 void SetPageSizes(std::vector<std::uint64_t> sizes, SvoFileStats& stats);
 /// Completes `stats` of a file of `file_bytes`: its size, and the frame's share ("frame").

@@ -2,6 +2,7 @@
 
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/core/release_pages.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 #include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo_assembler.hpp"
@@ -11,6 +12,7 @@ namespace svokit {
 struct SvoReader::State {
   container::Frame frame;
   svo_detail::Version2 v;
+  bool mapped = false;  // the bytes are the reader's own mapping of the file
 };
 
 SvoReader::SvoReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -46,7 +48,7 @@ StatusOr<SvoReader> SvoReader::Open(const std::filesystem::path& path) {
       container::Frame::Open(path, kSvoFormat, &svo_detail::SectionsToLoad, &kAllLevels);
   StatusOr<svo_detail::Version2> v = ParseFrame(frame);
   if (!v.ok()) return v.status();
-  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v)}));
+  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v), true}));
 }
 
 StatusOr<SvoReader> SvoReader::FromBytes(std::span<const std::uint8_t> bytes,
@@ -55,7 +57,7 @@ StatusOr<SvoReader> SvoReader::FromBytes(std::span<const std::uint8_t> bytes,
       bytes, name, kSvoFormat, &svo_detail::SectionsToLoad, &kAllLevels);
   StatusOr<svo_detail::Version2> v = ParseFrame(frame);
   if (!v.ok()) return v.status();
-  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v)}));
+  return SvoReader(std::make_unique<State>(State{std::move(*frame), std::move(*v), false}));
 }
 
 const std::string& SvoReader::name() const {
@@ -160,15 +162,28 @@ StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
   return stats;
 }
 
-StatusOr<SvoChunk> SvoReader::Top() const {
-  return svo_detail::DecodeTop(state_->v, name());
+StatusOr<SvoChunk> SvoReader::Top(ChunkParts parts) const {
+  return svo_detail::DecodeTop(state_->v, name(), parts);
 }
 
-StatusOr<SvoChunk> SvoReader::Page(std::size_t i) const {
+StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts) const {
   if (i >= page_count()) {
     return Status::BadInput("{}: page {} of {} does not exist", name(), i, page_count());
   }
-  return svo_detail::DecodePage(state_->v, i, name());
+  return svo_detail::DecodePage(state_->v, i, name(), nullptr, parts);
+}
+
+StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
+  const svo_detail::Version2::Page& p = state_->v.pages.at(i);
+  return ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),
+                          fmt::format("{}: page {}", name(), i));
+}
+
+void SvoReader::ReleasePageBytes(std::size_t i) const {
+  if (!state_->mapped || i >= page_count()) return;
+  const svo_detail::Version2::Page& p = state_->v.pages[i];
+  const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
+  ReleaseMappedFilePages(begin, begin + p.size);
 }
 
 SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,

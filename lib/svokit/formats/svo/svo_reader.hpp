@@ -63,10 +63,17 @@ class SvoReader {
   /// by level (SvoFileStats::levels), which decodes every chunk.
   StatusOr<SvoFileStats> FileStats(bool by_level = false) const;
 
+  /// What page i's streams hold, stored and decoded, from its stream directory (nothing is
+  /// decompressed).
+  StatusOr<ChunkBytes> PageStreamBytes(std::size_t i) const;
+
   /// The top chunk (no levels when the page level is 0).
-  StatusOr<SvoChunk> Top() const;
+  StatusOr<SvoChunk> Top(ChunkParts parts = ChunkParts::kAll) const;
   /// Page i, checked.
-  StatusOr<SvoChunk> Page(std::size_t i) const;
+  StatusOr<SvoChunk> Page(std::size_t i, ChunkParts parts = ChunkParts::kAll) const;
+  /// Gives page i's mapped file bytes back to the kernel (they are read again if touched), so a
+  /// pass over every page holds only the pages in flight; nothing for bytes given to FromBytes.
+  void ReleasePageBytes(std::size_t i) const;
 
  private:
   struct State;

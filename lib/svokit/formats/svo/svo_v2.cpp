@@ -329,13 +329,13 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   return v;
 }
 
-StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name) {
+StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name, ChunkParts parts) {
   if (v.page_level == 0) return SvoChunk{};
-  return DecodeChunk(v.top, v.shape, {0, 0, v.page_level, false}, name + ": top chunk");
+  return DecodeChunk(v.top, v.shape, {0, 0, v.page_level, false, parts}, name + ": top chunk");
 }
 
 StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::string& name,
-                              IssueSink* sink) {
+                              IssueSink* sink, ChunkParts parts) {
   const Version2::Page& e = v.pages[page];
   const std::span<const std::uint8_t> bytes = v.page_bytes.subspan(e.offset, e.size);
   const std::string page_name = fmt::format("{}: page {}", name, page);
@@ -345,8 +345,9 @@ StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::st
     }
     return Status::BadInput("{}: checksum mismatch (file is corrupt)", page_name);
   }
-  StatusOr<SvoChunk> chunk = DecodeChunk(
-      bytes, v.shape, {v.page_level, e.key, v.shape.depth - v.page_level + 1, true}, page_name);
+  StatusOr<SvoChunk> chunk =
+      DecodeChunk(bytes, v.shape,
+                  {v.page_level, e.key, v.shape.depth - v.page_level + 1, true, parts}, page_name);
   if (!chunk.ok()) {
     if (sink != nullptr) {
       sink->Add("page_decode", name, "{}", chunk.status().message().substr(name.size() + 2));

@@ -1,0 +1,207 @@
+#include "svokit/formats/svo/svo_stream.hpp"
+
+#include <limits>
+
+#include "svokit/formats/svo/svo_chunk.hpp"
+
+namespace svokit {
+
+namespace {
+
+// Bytes a decode derives per node above the voxels, besides its mask byte: the child offset (8)
+// and the sample layout's orphan mask and first index (4 + 8).
+constexpr std::uint64_t kDerivedBytesPerNode = 20;
+
+template <class V>
+std::uint64_t Bytes(const V& v) {
+  return v.capacity() * sizeof(typename V::value_type);
+}
+
+template <class V>
+std::uint64_t NestedBytes(const std::vector<V>& levels) {
+  std::uint64_t n = Bytes(levels);
+  for (const V& v : levels) n += Bytes(v);
+  return n;
+}
+
+}  // namespace
+
+StatusOr<std::uint64_t> PageDecodedBytes(const SvoReader& reader, std::size_t i) {
+  StatusOr<ChunkBytes> streams = reader.PageStreamBytes(i);
+  if (!streams.ok()) return streams.status();
+  std::uint64_t raw = 0, masks = 0;
+  for (const auto& [name, sizes] : streams->by_name) {
+    raw += sizes.first;
+    if (name == "masks") masks += sizes.first;
+  }
+  return raw + kDerivedBytesPerNode * masks;
+}
+
+std::uint64_t ChunkHeldBytes(const SvoChunk& c) {
+  std::uint64_t n = sizeof(SvoChunk) + NestedBytes(c.tree.masks) + NestedBytes(c.tree.full) +
+                    NestedBytes(c.tree.first_child) + NestedBytes(c.contours) + Bytes(c.colors) +
+                    Bytes(c.normals) + Bytes(c.halo_keys) + Bytes(c.halo_colors) +
+                    Bytes(c.halo_normals) + Bytes(c.layouts) + Bytes(c.samples);
+  for (const SampleLayout& l : c.layouts) n += Bytes(l.orphans) + Bytes(l.first);
+  for (const LevelSamples& s : c.samples) n += Bytes(s.opacity) + Bytes(s.color) + Bytes(s.normal);
+  return n;
+}
+
+StatusOr<SvoStreamPlan> PlanStream(
+    const SvoReader& reader, const SvoStreamOptions& options,
+    const std::function<std::uint64_t(std::uint64_t, std::uint64_t)>& per_page) {
+  SvoStreamPlan plan;
+  if (options.box) {
+    plan.pages = reader.PagesIn(*options.box);
+  } else {
+    plan.pages.resize(reader.page_count());
+    for (std::size_t i = 0; i < plan.pages.size(); ++i) plan.pages[i] = i;
+  }
+  std::uint64_t item = 1;
+  for (const std::size_t i : plan.pages) {
+    StatusOr<std::uint64_t> bytes = PageDecodedBytes(reader, i);
+    if (!bytes.ok()) return bytes.status();
+    plan.largest_page = std::max(plan.largest_page, *bytes);
+    item = std::max(item, per_page ? per_page(*bytes, reader.page(i).voxels) : *bytes);
+  }
+  if (options.memory_limit != 0 && options.memory_limit < item) {
+    const std::uint64_t mib = (item + (1 << 20) - 1) >> 20;
+    return Status::BadInput(
+        "{}: a memory limit of {} MiB is too small to read this file: its largest page needs {} "
+        "MiB (give {}M or more)",
+        reader.name(), options.memory_limit >> 20, mib, mib);
+  }
+  StatusOr<std::size_t> in_flight =
+      InFlightWithin(options.memory_limit, 0, item, item, "its largest page");
+  if (!in_flight.ok()) return in_flight.status();
+  plan.in_flight = *in_flight;
+  return plan;
+}
+
+SvoPageCache::SvoPageCache(const SvoReader& reader, std::uint64_t capacity)
+    : reader_(reader), capacity_(capacity) {}
+
+StatusOr<std::shared_ptr<const SvoChunk>> SvoPageCache::Page(std::size_t i) {
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto it = entries_.find(i); it != entries_.end()) {
+      ++hits_;
+      uses_.splice(uses_.begin(), uses_, it->second.use);
+      return it->second.chunk;
+    }
+    ++misses_;
+  }
+  StatusOr<SvoChunk> decoded = reader_.Page(i);
+  reader_.ReleasePageBytes(i);
+  if (!decoded.ok()) return decoded.status();
+  auto chunk = std::make_shared<const SvoChunk>(std::move(*decoded));
+  const std::uint64_t bytes = ChunkHeldBytes(*chunk);
+  std::lock_guard lock(mutex_);
+  if (const auto it = entries_.find(i); it != entries_.end()) return it->second.chunk;  // a race
+  uses_.push_front(i);
+  entries_.emplace(i, Entry{chunk, bytes, uses_.begin()});
+  held_ += bytes;
+  while (held_ > capacity_ && uses_.size() > 1) {
+    const auto last = entries_.find(uses_.back());
+    held_ -= last->second.bytes;
+    entries_.erase(last);
+    uses_.pop_back();
+  }
+  return chunk;
+}
+
+std::uint64_t SvoPageCache::held_bytes() const {
+  std::lock_guard lock(mutex_);
+  return held_;
+}
+std::uint64_t SvoPageCache::hits() const {
+  std::lock_guard lock(mutex_);
+  return hits_;
+}
+std::uint64_t SvoPageCache::misses() const {
+  std::lock_guard lock(mutex_);
+  return misses_;
+}
+
+namespace {
+
+// The keys of `level` in `chunk` (root_level ≤ level ≤ its last level).
+std::vector<std::uint64_t> ChunkLevelKeys(const SvoChunk& chunk, std::uint32_t level) {
+  return std::move(TreeLevelKeys(chunk.tree, chunk.root_key, level).back());
+}
+
+SvoVoxelPage VoxelPageOf(std::size_t page, SvoChunk& chunk, std::uint32_t level,
+                         const SvoShape& shape) {
+  SvoVoxelPage out;
+  out.page = page;
+  out.level = level;
+  out.keys = ChunkLevelKeys(chunk, level);
+  if (level == shape.depth) {
+    out.colors = shape.shared_color.empty() ? std::move(chunk.colors)
+                                            : DefaultInitVector<HalfRgba>(1, shape.shared_color[0]);
+    out.normals = std::move(chunk.normals);
+  }
+  return out;
+}
+
+}  // namespace
+
+Status ForEachVoxelPage(const SvoReader& reader, std::uint32_t level,
+                        const SvoStreamOptions& options,
+                        const std::function<Status(SvoVoxelPage&)>& visit, Progress::Stage* stage) {
+  if (level > reader.depth()) {
+    return Status::BadInput("{}: level {} is below the octree's depth {}", reader.name(), level,
+                            reader.depth());
+  }
+  if (level < reader.page_level()) {
+    StatusOr<SvoChunk> top = reader.Top();
+    if (!top.ok()) return top.status();
+    SvoVoxelPage voxels =
+        VoxelPageOf(std::numeric_limits<std::size_t>::max(), *top, level, reader.shape());
+    return visit(voxels);
+  }
+  // A page in flight holds its decode and its keys (8 bytes a node, at most a node per voxel).
+  StatusOr<SvoStreamPlan> plan = PlanStream(
+      reader, options, [](std::uint64_t page, std::uint64_t voxels) { return page + 8 * voxels; });
+  if (!plan.ok()) return plan.status();
+  return StreamPages<SvoVoxelPage>(
+      reader, *plan,
+      [&](std::size_t page, SvoChunk chunk) -> StatusOr<SvoVoxelPage> {
+        return VoxelPageOf(page, chunk, level, reader.shape());
+      },
+      [&](std::size_t, SvoVoxelPage voxels) { return visit(voxels); }, stage);
+}
+
+Status ForEachLevelPage(const SvoReader& reader, std::uint32_t level, bool bricks,
+                        const SvoStreamOptions& options,
+                        const std::function<Status(std::size_t page, SvoChunkLevel&)>& visit,
+                        Progress::Stage* stage) {
+  if (level > reader.depth()) {
+    return Status::BadInput("{}: level {} is below the octree's depth {}", reader.name(), level,
+                            reader.depth());
+  }
+  SvoShape shape = reader.shape();
+  if (!bricks) shape.brick_side = 0;
+  if (level < reader.page_level()) {
+    StatusOr<SvoChunk> top = reader.Top();
+    if (!top.ok()) return top.status();
+    SvoChunkLevel nodes = AssembleChunkLevel(*top, shape, level);
+    return visit(std::numeric_limits<std::size_t>::max(), nodes);
+  }
+  // A page in flight holds its decode, and per node of the level (at most a node per voxel) its
+  // key, mask and contour and, with bricks, side³ samples of up to 7 bytes.
+  const std::uint64_t per_node =
+      13 + 7 * std::uint64_t{shape.brick_side} * shape.brick_side * shape.brick_side;
+  StatusOr<SvoStreamPlan> plan = PlanStream(
+      reader, options,
+      [per_node](std::uint64_t page, std::uint64_t voxels) { return page + per_node * voxels; });
+  if (!plan.ok()) return plan.status();
+  return StreamPages<SvoChunkLevel>(
+      reader, *plan,
+      [&](std::size_t, SvoChunk chunk) -> StatusOr<SvoChunkLevel> {
+        return AssembleChunkLevel(chunk, shape, level);
+      },
+      [&](std::size_t page, SvoChunkLevel nodes) { return visit(page, nodes); }, stage);
+}
+
+}  // namespace svokit

@@ -1,0 +1,137 @@
+#pragma once
+// Reading a paged .svo within a memory bound. StreamPages decodes pages in parallel and hands them
+// on in key order, no more in flight than fit the bound; SvoPageCache keeps decoded pages for
+// reads in any order (a renderer's pages near the camera), least recently used first out, bounded
+// in bytes; ForEachVoxelPage and ForEachLevelPage give a level's voxels or nodes page by page. A
+// page's file bytes are given back to the kernel once decoded, so a pass over a whole file holds
+// no more than its pages in flight.
+
+#include <cstdint>
+#include <functional>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "svokit/core/box.hpp"
+#include "svokit/core/parallel.hpp"
+#include "svokit/core/progress.hpp"
+#include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
+
+namespace svokit {
+
+/// Which pages a streamed read visits, and the bytes it may hold.
+struct SvoStreamOptions {
+  /// Bytes of decoded pages held at once (besides the top chunk); 0: one page per thread, twice.
+  std::uint64_t memory_limit = 0;
+  std::optional<Box3d> box;  ///< only the pages whose cube meets it (world units)
+};
+
+/// Bytes page i of `reader` takes decoded: its streams' decoded bytes (from its stream directory,
+/// nothing decompressed) and the child offsets a decode adds (8 bytes per node above the voxels).
+StatusOr<std::uint64_t> PageDecodedBytes(const SvoReader& reader, std::size_t i);
+
+/// Bytes `chunk` holds (its arrays' sizes): what a cache entry costs.
+std::uint64_t ChunkHeldBytes(const SvoChunk& chunk);
+
+/// The pages a streamed read visits, in key order, and how many may be in flight.
+struct SvoStreamPlan {
+  std::vector<std::size_t> pages;
+  ChunkParts parts = ChunkParts::kAll;  ///< what each page is decoded into
+  std::size_t in_flight = 1;
+  std::uint64_t largest_page = 0;  ///< PageDecodedBytes of the largest visited page
+};
+/// The plan for `options` when each page in flight holds per_page(its decoded bytes, its voxels)
+/// bytes in all (the page and what is made of it); a limit below the largest page's is an error
+/// naming the smallest limit that works.
+StatusOr<SvoStreamPlan> PlanStream(
+    const SvoReader& reader, const SvoStreamOptions& options,
+    const std::function<std::uint64_t(std::uint64_t, std::uint64_t)>& per_page = nullptr);
+
+/// Every page of `plan`, decoded and turned into make(page index, chunk) → StatusOr<Made> in
+/// parallel, then handed to take(page index, Made) → Status in page order. Stops at the first
+/// error (a page that fails to decode, make's, take's) and returns it. `stage` advances per page.
+template <class Made, class MakeFn, class TakeFn>
+Status StreamPages(const SvoReader& reader, const SvoStreamPlan& plan, const MakeFn& make,
+                   const TakeFn& take, Progress::Stage* stage = nullptr) {
+  struct Item {
+    std::size_t page = 0;
+    StatusOr<Made> made = Status::Ok();
+  };
+  if (stage != nullptr) stage->SetTotal(std::max<std::size_t>(plan.pages.size(), 1));
+  return ParallelInOrder<Item>(
+      0, plan.pages.size(), plan.in_flight,
+      [&](std::size_t k) {
+        const std::size_t page = plan.pages[k];
+        StatusOr<SvoChunk> chunk = reader.Page(page, plan.parts);
+        reader.ReleasePageBytes(page);
+        if (!chunk.ok()) return Item{page, chunk.status()};
+        return Item{page, make(page, std::move(*chunk))};
+      },
+      [&](Item item) -> Status {
+        if (!item.made.ok()) return item.made.status();
+        SVOKIT_RETURN_IF_ERROR(take(item.page, std::move(*item.made)));
+        if (stage != nullptr) stage->Advance();
+        return Status::Ok();
+      });
+}
+
+/// Decoded pages of one file, kept while they fit `capacity` bytes (ChunkHeldBytes), the least
+/// recently used given up first; the page asked for is always kept, even alone over capacity.
+/// Thread-safe: pages are decoded outside the lock, shared with whoever holds them.
+class SvoPageCache {
+ public:
+  SvoPageCache(const SvoReader& reader, std::uint64_t capacity);
+
+  StatusOr<std::shared_ptr<const SvoChunk>> Page(std::size_t i);
+
+  std::uint64_t capacity() const { return capacity_; }
+  std::uint64_t held_bytes() const;
+  std::uint64_t hits() const;
+  std::uint64_t misses() const;
+
+ private:
+  struct Entry {
+    std::shared_ptr<const SvoChunk> chunk;
+    std::uint64_t bytes = 0;
+    std::list<std::size_t>::iterator use;
+  };
+  const SvoReader& reader_;
+  std::uint64_t capacity_;
+  mutable std::mutex mutex_;
+  std::unordered_map<std::size_t, Entry> entries_;
+  std::list<std::size_t> uses_;  ///< most recent first
+  std::uint64_t held_ = 0, hits_ = 0, misses_ = 0;
+};
+
+/// One page's voxels (of the whole tree, or of level `level` read as leaves): Morton keys at that
+/// level, ascending, and with the voxel level the voxels' colours (empty when the file has none;
+/// one entry when every voxel shares it) and normals (empty without).
+struct SvoVoxelPage {
+  std::size_t page = 0;
+  std::uint32_t level = 0;
+  std::vector<std::uint64_t> keys;
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
+};
+
+/// The nodes of `level` page by page, in key order (levels above the page level come from the top
+/// chunk, as one call with page = SIZE_MAX): as SvoVoxelPage, with the voxels' attributes when
+/// `level` is the depth. Within `options`' memory bound.
+Status ForEachVoxelPage(const SvoReader& reader, std::uint32_t level,
+                        const SvoStreamOptions& options,
+                        const std::function<Status(SvoVoxelPage&)>& visit,
+                        Progress::Stage* stage = nullptr);
+
+/// The nodes of `level` page by page as a renderer uploads them (keys, masks, contours and, with
+/// `bricks`, the brick pool assembled), in key order; the top chunk's levels as one call.
+Status ForEachLevelPage(const SvoReader& reader, std::uint32_t level, bool bricks,
+                        const SvoStreamOptions& options,
+                        const std::function<Status(std::size_t page, SvoChunkLevel&)>& visit,
+                        Progress::Stage* stage = nullptr);
+
+}  // namespace svokit
