@@ -11,6 +11,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/export.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 
 int main(int argc, char** argv) {
   using namespace svokit;
@@ -22,34 +23,57 @@ int main(int argc, char** argv) {
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
+  app::MemoryLimitOption memory_limit;
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
   app::AddFile(cli, "-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
   cli.add_option("--level", level,
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
                  "(default: the voxels)")
       ->option_text("L");
+  memory_limit.Add(cli,
+                   "Bytes of pages held at once (default: a few per thread); .vox and solids "
+                   "read the octree whole");
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
     if (Status s = CheckOutputPath(output, ExportExtensions(), input); !s.ok()) {
       return app::Fail(tool, s);
     }
+    StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
+    if (!limit.ok()) return app::Fail(tool, limit.status());
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-
-    StatusOr<Svo> svo = ReadSvoStage(progress, input, level);
-    if (!svo.ok()) return app::Fail(tool, svo.status());
-
     ExportOptions options;
     options.level = level;
-    const Status written =
-        RunStage(progress, "export", [&] { return ExportSvo(*svo, output, options); });
-    if (!written.ok()) return app::Fail(tool, written);
 
-    const std::uint32_t exported = level.value_or(svo->depth);
-    fmt::print("octree      {} (depth {})\n", input.string(), svo->depth);
-    fmt::print("level       {} ({} nodes of {:.9g})\n", exported, svo->levels[exported].node_count,
-               svo->NodeSize(exported));
+    // A paged file streams its pages into the writer; version 1, .vox and solids read whole.
+    std::uint32_t depth = 0;
+    std::uint64_t nodes = 0;
+    double node_size = 0;
+    StatusOr<SvoReader> reader = SvoReader::Open(input);
+    if (reader.ok() && ExportStreams(*reader, output)) {
+      depth = reader->depth();
+      const std::uint32_t exported = level.value_or(depth);
+      Progress::Stage stage(progress, "export", 0);
+      const Status written = ExportSvoPages(*reader, output, options, limit->value_or(0), &stage);
+      if (!written.ok()) {
+        stage.Cancel();
+        return app::Fail(tool, written);
+      }
+      nodes = reader->NodeCount(exported);
+      node_size = reader->grid().voxel_size() * static_cast<double>(1u << (depth - exported));
+    } else {
+      StatusOr<Svo> svo = ReadSvoStage(progress, input, level);
+      if (!svo.ok()) return app::Fail(tool, svo.status());
+      const Status written =
+          RunStage(progress, "export", [&] { return ExportSvo(*svo, output, options); });
+      if (!written.ok()) return app::Fail(tool, written);
+      depth = svo->depth;
+      nodes = svo->levels[level.value_or(depth)].node_count;
+      node_size = svo->NodeSize(level.value_or(depth));
+    }
+    fmt::print("octree      {} (depth {})\n", input.string(), depth);
+    fmt::print("level       {} ({} nodes of {:.9g})\n", level.value_or(depth), nodes, node_size);
     fmt::print("output      {}\n", output.string());
     return 0;
   });

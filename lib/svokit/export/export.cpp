@@ -4,6 +4,7 @@
 #include <array>
 
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/export/voxel_writers.hpp"
 
@@ -32,25 +33,30 @@ const std::vector<std::string>& ExportExtensions() {
   return kExtensions;
 }
 
-VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
-  VoxelSet set;
-  const std::uint32_t shift = svo.depth - level;
-  std::array<std::uint32_t, 3> dims = svo.grid.dims();
+namespace {
+
+// The voxels of a level's nodes on the octree's origin: dims the leaf grid's rounded up to whole
+// nodes.
+GridTransform LevelGrid(const GridTransform& grid, std::uint32_t depth, std::uint32_t level) {
+  const std::uint32_t shift = depth - level;
+  std::array<std::uint32_t, 3> dims = grid.dims();
   for (std::uint32_t& d : dims) d = ((d - 1) >> shift) + 1;
-  set.grid = GridTransform(svo.grid.origin(), svo.NodeSize(level), dims);
-  set.mode = svo.mode;
-  const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
-  set.keys.assign(keys.begin(), keys.end());
-  const std::vector<std::uint32_t> samples = NodeSamples(svo.brick_side);
-  if (samples.empty()) return set;
-  if (svo.has_color) set.colors.resize(set.keys.size());
-  if (svo.has_normal) set.normals.resize(set.keys.size());
+  return GridTransform(grid.origin(), grid.voxel_size() * static_cast<double>(1u << shift), dims);
+}
+
+// Each node's colour and normal from `bricks` (its level's pool, in the order of set.keys).
+void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_color, bool has_normal,
+                        VoxelSet& set) {
+  const std::vector<std::uint32_t> samples = NodeSamples(side);
+  if (samples.empty()) return;
+  if (has_color) set.colors.resize(set.keys.size());
+  if (has_normal) set.normals.resize(set.keys.size());
   ParallelChunks(set.keys.size(), 4096, [&](std::size_t begin, std::size_t end) {
     std::vector<BrickSample> s(samples.size());
     for (std::size_t i = begin; i < end; ++i) {
       float total = 0;
       for (std::size_t k = 0; k < samples.size(); ++k) {
-        s[k] = svo.Sample(level, i, samples[k]);
+        s[k] = LevelSample(bricks, side * side * side, has_color, has_normal, i, samples[k]);
         total += s[k].opacity;
       }
       Rgba color{0, 0, 0, 0};
@@ -62,13 +68,24 @@ VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
                  color.a + w * b.color.a};
         normal = normal + b.normal * w;
       }
-      if (svo.has_color) set.colors[i] = color;
-      if (svo.has_normal) {
+      if (has_color) set.colors[i] = color;
+      if (has_normal) {
         const float len = Length(normal);
         set.normals[i] = len > 0 ? normal / len : normal;
       }
     }
   });
+}
+
+}  // namespace
+
+VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
+  VoxelSet set;
+  set.grid = LevelGrid(svo.grid, svo.depth, level);
+  set.mode = svo.mode;
+  const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
+  set.keys.assign(keys.begin(), keys.end());
+  FillNodeAttributes(svo.levels[level], svo.brick_side, svo.has_color, svo.has_normal, set);
   return set;
 }
 
@@ -138,7 +155,11 @@ StatusOr<VoxelSet> WithInteriorVoxels(VoxelSet voxels, const InteriorCubes& inte
 
 }  // namespace
 
-Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options) {
+namespace {
+
+// The format `path` names, if it is one, and not a directory; the level, if the octree has it.
+StatusOr<std::string> CheckExport(const std::filesystem::path& path, std::uint32_t level,
+                                  std::uint32_t depth) {
   const std::string ext = LowerExtension(path);
   const auto& known = ExportExtensions();
   if (std::find(known.begin(), known.end(), ext) == known.end()) {
@@ -149,26 +170,91 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
   if (std::filesystem::is_directory(path, ec)) {
     return Status::BadInput("{}: is a directory, not a file", path.string());
   }
-  const std::uint32_t level = options.level.value_or(svo.depth);
-  if (level > svo.depth) {
+  if (level > depth) {
     return Status::BadInput("{}: level {} does not exist (the octree has levels 0 to {})",
-                            path.string(), level, svo.depth);
+                            path.string(), level, depth);
   }
+  return ext;
+}
+
+}  // namespace
+
+Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options) {
+  const std::uint32_t level = options.level.value_or(svo.depth);
+  StatusOr<std::string> ext = CheckExport(path, level, svo.depth);
+  if (!ext.ok()) return ext.status();
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
   }
   VoxelSet voxels = LevelVoxels(svo, level);
   const InteriorCubes interior = LevelInterior(svo, level);
   const InteriorCubes* solid = svo.solid ? &interior : nullptr;
-  if (ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
-  if (ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
-  if (ext == "vox") {
+  if (*ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
+  if (*ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
+  if (*ext == "vox") {
     if (solid == nullptr) return WriteVoxelsVox(voxels, path);
     StatusOr<VoxelSet> all = WithInteriorVoxels(std::move(voxels), interior, path);
     return all.ok() ? WriteVoxelsVox(*all, path) : all.status();
   }
-  if (ext == "ply") return WriteVoxelsPly(voxels, path);
+  if (*ext == "ply") return WriteVoxelsPly(voxels, path);
   return WriteVoxelsXyz(voxels, path);
+}
+
+bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path) {
+  return !reader.shape().solid && LowerExtension(path) != "vox";
+}
+
+Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
+                      const ExportOptions& options, std::uint64_t memory_limit,
+                      Progress::Stage* stage) {
+  const SvoShape& shape = reader.shape();
+  const std::uint32_t level = options.level.value_or(reader.depth());
+  if (level > reader.depth()) {  // worded as the readers word it
+    return Status::BadInput("{}: level {} exceeds the octree's depth {}", reader.name(), level,
+                            reader.depth());
+  }
+  StatusOr<std::string> ext = CheckExport(path, level, reader.depth());
+  if (!ext.ok()) return ext.status();
+  if (!ExportStreams(reader, path)) {
+    return Status::BadInput("{}: a .vox or a solid's export takes the octree whole", path.string());
+  }
+  const bool colors = shape.brick_side != 0 && shape.has_color;
+  const bool normals = shape.brick_side != 0 && shape.has_normal;
+  const VoxelFileHeader header{LevelGrid(reader.grid(), reader.depth(), level), colors, normals,
+                               reader.NodeCount(level)};
+  StatusOr<std::unique_ptr<VoxelFileWriter>> writer =
+      *ext == "vdb"      ? OpenVdbWriter(header, nullptr, path)
+      : *ext == "binvox" ? OpenBinvoxWriter(header, nullptr, path)
+      : *ext == "ply"    ? OpenPlyWriter(header, path)
+                         : OpenXyzWriter(header, path);
+  if (!writer.ok()) return writer.status();
+  // binvox runs along x: pages go by slabs of page cubes along x, each slab written out once in.
+  SvoStreamOptions stream{.memory_limit = memory_limit};
+  const bool by_slabs = *ext == "binvox";
+  if (by_slabs) stream.order = SvoPageOrder::kSlabsAlongX;
+  const std::uint64_t page_side =
+      level < reader.page_level() ? 0 : std::uint64_t{1} << (level - reader.page_level());
+  std::vector<std::uint64_t> x_done(reader.page_count(), 0);
+  if (by_slabs) {
+    const std::vector<std::size_t> order = PageOrder(reader, SvoPageOrder::kSlabsAlongX);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const std::uint64_t x = MortonDecode(reader.page(order[k]).key).x;
+      const bool last = k + 1 == order.size() || MortonDecode(reader.page(order[k + 1]).key).x != x;
+      x_done[order[k]] = last ? (x + 1) * page_side : x * page_side;
+    }
+  }
+  SVOKIT_RETURN_IF_ERROR(ForEachLevelPage(
+      reader, level, shape.brick_side != 0 && (colors || normals), stream,
+      [&](std::size_t page, SvoChunkLevel& nodes) {
+        VoxelSet part;
+        part.grid = header.grid;
+        part.mode = reader.mode();
+        part.keys.assign(nodes.keys.begin(), nodes.keys.end());
+        FillNodeAttributes(nodes.bricks, shape.brick_side, colors, normals, part);
+        return (*writer)->Add(part, page < x_done.size() ? x_done[page] : ~std::uint64_t{0});
+      },
+      stage));
+  return (*writer)->Finish();
 }
 
 }  // namespace svokit

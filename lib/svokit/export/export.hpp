@@ -1,6 +1,7 @@
 #pragma once
-// svo-export's writers: an Svo (or one of its coarser levels) as OpenVDB grids, binvox,
-// MagicaVoxel .vox, PLY points or xyz text, chosen by the output extension.
+// svo-export's writers: an Svo (or one of its coarser levels), or a paged file read page by page,
+// as OpenVDB grids, binvox, MagicaVoxel .vox, PLY points or xyz text, chosen by the output
+// extension.
 //
 // Every format goes through one VoxelSet: the nodes of the exported level as voxels of that
 // level's node size, on the octree's origin, so all writers agree on coordinates and attributes.
@@ -11,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
@@ -29,6 +32,18 @@ const std::vector<std::string>& ExportExtensions();
 /// Writes `svo` to `path` in the format its extension names (.vdb, .binvox, .vox, .ply, .xyz),
 /// atomically; an unknown extension or an impossible level is a bad-input error.
 Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options);
+
+/// Whether ExportSvoPages writes `path` from `reader` page by page: every format but .vox (whose
+/// palette and models need every voxel) for an octree without full leaves.
+bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path);
+
+/// ExportSvo of a paged file read page by page, holding at most `memory_limit` bytes of pages
+/// (0: a few per thread) besides what the output's writer holds (an OpenVDB grid; a binvox slab's
+/// runs): the same file as ExportSvo of the octree read whole. Errors that need only the header
+/// (format, level) come before any page is read.
+Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
+                      const ExportOptions& options, std::uint64_t memory_limit,
+                      Progress::Stage* stage = nullptr);
 
 /// The nodes of `level` (≤ svo.depth, and loaded) as voxels: grid origin = the octree's, voxel
 /// size = NodeSize(level), dims = the leaf grid's rounded up to whole nodes; keys = LevelKeys.

@@ -14,6 +14,7 @@
 
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/morton.hpp"
 #include "svokit/export/voxel_writers.hpp"
 
 namespace svokit {
@@ -64,77 +65,106 @@ Status ReplaceUuid(const AtomicFileWriter& file) {
 
 }  // namespace
 
-Status WriteVoxelsVdb(const VoxelSet& voxels, const InteriorCubes* interior,
-                      const std::filesystem::path& path) {
-  InitializeOpenVdb();
-  const double h = voxels.grid.voxel_size();
-  const Vec3d& o = voxels.grid.origin();
-  // OpenVDB's index coordinates are voxel centres: index (i, j, k) ↦ origin + (i + ½)·h.
-  openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
-  transform->postTranslate(openvdb::Vec3d(o.x + 0.5 * h, o.y + 0.5 * h, o.z + 0.5 * h));
+namespace {
 
-  auto occupancy = openvdb::BoolGrid::create(false);
-  occupancy->setName("occupancy");
-  auto color = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
-  color->setName("color");
-  color->setVectorType(openvdb::VEC_INVARIANT);
-  color->insertMeta("color_space", openvdb::StringMetadata("linear sRGB"));
-  auto normal = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
-  normal->setName("normal");
-  normal->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
-
-  auto occupied = occupancy->getAccessor();
-  auto colored = color->getAccessor();
-  auto oriented = normal->getAccessor();
-  for (std::size_t i = 0; i < voxels.size(); ++i) {
-    const MortonCoord c = MortonDecode(voxels.keys[i]);
-    const openvdb::Coord ijk(static_cast<openvdb::Int32>(c.x), static_cast<openvdb::Int32>(c.y),
-                             static_cast<openvdb::Int32>(c.z));
-    occupied.setValueOn(ijk, true);
-    if (voxels.has_colors()) {
-      const Rgba rgba = voxels.color(i);
-      colored.setValueOn(ijk, openvdb::Vec3f(rgba.r, rgba.g, rgba.b));
-    }
-    if (voxels.has_normals()) {
-      const Vec3f& n = voxels.normals[i];
-      oriented.setValueOn(ijk, openvdb::Vec3f(n.x, n.y, n.z));
-    }
+// The grids filled part by part through their accessors, written when finished.
+class VdbWriter : public VoxelFileWriter {
+ public:
+  VdbWriter(const VoxelFileHeader& header, const InteriorCubes* interior,
+            const std::filesystem::path& path)
+      : header_(header), interior_(interior), path_(path) {
+    InitializeOpenVdb();
+    occupancy_->setName("occupancy");
+    color_->setName("color");
+    color_->setVectorType(openvdb::VEC_INVARIANT);
+    color_->insertMeta("color_space", openvdb::StringMetadata("linear sRGB"));
+    normal_->setName("normal");
+    normal_->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
   }
 
-  if (interior != nullptr) {
-    for (std::uint32_t l = 0; l < interior->levels.size(); ++l) {
-      const auto side = static_cast<openvdb::Int32>(1u << (interior->depth - l));
-      for (const std::uint64_t key : interior->levels[l]) {
-        const MortonCoord c = MortonDecode(key);
-        const openvdb::Coord lo(static_cast<openvdb::Int32>(c.x) * side,
-                                static_cast<openvdb::Int32>(c.y) * side,
-                                static_cast<openvdb::Int32>(c.z) * side);
-        // sparseFill makes a tile of every whole, aligned node: a cube costs its surface's nodes.
-        occupancy->tree().sparseFill(openvdb::CoordBBox(lo, lo.offsetBy(side - 1)), true, true);
+  Status Add(const VoxelSet& part, std::uint64_t) override {
+    for (std::size_t i = 0; i < part.size(); ++i) {
+      const MortonCoord c = MortonDecode(part.keys[i]);
+      const openvdb::Coord ijk(static_cast<openvdb::Int32>(c.x), static_cast<openvdb::Int32>(c.y),
+                               static_cast<openvdb::Int32>(c.z));
+      occupied_.setValueOn(ijk, true);
+      if (header_.colors) {
+        const Rgba rgba = part.color(i);
+        colored_.setValueOn(ijk, openvdb::Vec3f(rgba.r, rgba.g, rgba.b));
+      }
+      if (header_.normals) {
+        const Vec3f& n = part.normals[i];
+        oriented_.setValueOn(ijk, openvdb::Vec3f(n.x, n.y, n.z));
       }
     }
+    return Status::Ok();
   }
 
-  openvdb::GridPtrVec grids{occupancy};
-  if (voxels.has_colors()) grids.push_back(color);
-  if (voxels.has_normals()) grids.push_back(normal);
-  for (const openvdb::GridBase::Ptr& grid : grids) grid->setTransform(transform);
+  Status Finish() override {
+    if (interior_ != nullptr) {
+      for (std::uint32_t l = 0; l < interior_->levels.size(); ++l) {
+        const auto side = static_cast<openvdb::Int32>(1u << (interior_->depth - l));
+        for (const std::uint64_t key : interior_->levels[l]) {
+          const MortonCoord c = MortonDecode(key);
+          const openvdb::Coord lo(static_cast<openvdb::Int32>(c.x) * side,
+                                  static_cast<openvdb::Int32>(c.y) * side,
+                                  static_cast<openvdb::Int32>(c.z) * side);
+          // sparseFill makes a tile of every whole, aligned node: a cube costs its surface's nodes.
+          occupancy_->tree().sparseFill(openvdb::CoordBBox(lo, lo.offsetBy(side - 1)), true, true);
+        }
+      }
+    }
+    const double h = header_.grid.voxel_size();
+    const Vec3d& o = header_.grid.origin();
+    // OpenVDB's index coordinates are voxel centres: index (i, j, k) ↦ origin + (i + ½)·h.
+    openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
+    transform->postTranslate(openvdb::Vec3d(o.x + 0.5 * h, o.y + 0.5 * h, o.z + 0.5 * h));
+    openvdb::GridPtrVec grids{occupancy_};
+    if (header_.colors) grids.push_back(color_);
+    if (header_.normals) grids.push_back(normal_);
+    for (const openvdb::GridBase::Ptr& grid : grids) grid->setTransform(transform);
 
-  AtomicFileWriter temp(path);
-  SVOKIT_RETURN_IF_ERROR(temp.Open());
-  openvdb::MetaMap meta;
-  meta.insertMeta("creator", openvdb::StringMetadata(std::string("svokit ") + SVOKIT_VERSION));
-  std::ofstream out(temp.temp_path(), std::ios::binary | std::ios::trunc);
-  try {
-    VdbArchive().Write(out, grids, meta);
-  } catch (const openvdb::Exception& e) {
-    return Status::Internal("{}: OpenVDB could not write the grids ({})", path.string(), e.what());
+    AtomicFileWriter temp(path_);
+    SVOKIT_RETURN_IF_ERROR(temp.Open());
+    openvdb::MetaMap meta;
+    meta.insertMeta("creator", openvdb::StringMetadata(std::string("svokit ") + SVOKIT_VERSION));
+    std::ofstream out(temp.temp_path(), std::ios::binary | std::ios::trunc);
+    try {
+      VdbArchive().Write(out, grids, meta);
+    } catch (const openvdb::Exception& e) {
+      return Status::Internal("{}: OpenVDB could not write the grids ({})", path_.string(),
+                              e.what());
+    }
+    // io::File does not look at its stream after writing: a full disk would pass unnoticed.
+    if (!out.flush()) return temp.Failure("cannot write", errno);
+    out.close();
+    SVOKIT_RETURN_IF_ERROR(ReplaceUuid(temp));
+    return temp.Commit();
   }
-  // io::File does not look at its stream after writing: a full disk would pass unnoticed.
-  if (!out.flush()) return temp.Failure("cannot write", errno);
-  out.close();
-  SVOKIT_RETURN_IF_ERROR(ReplaceUuid(temp));
-  return temp.Commit();
+
+ private:
+  VoxelFileHeader header_;
+  const InteriorCubes* interior_;
+  std::filesystem::path path_;
+  openvdb::BoolGrid::Ptr occupancy_ = openvdb::BoolGrid::create(false);
+  openvdb::Vec3fGrid::Ptr color_ = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
+  openvdb::Vec3fGrid::Ptr normal_ = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
+  openvdb::BoolGrid::Accessor occupied_ = occupancy_->getAccessor();
+  openvdb::Vec3fGrid::Accessor colored_ = color_->getAccessor();
+  openvdb::Vec3fGrid::Accessor oriented_ = normal_->getAccessor();
+};
+
+}  // namespace
+
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbWriter(const VoxelFileHeader& header,
+                                                         const InteriorCubes* interior,
+                                                         const std::filesystem::path& path) {
+  return std::unique_ptr<VoxelFileWriter>(std::make_unique<VdbWriter>(header, interior, path));
+}
+
+Status WriteVoxelsVdb(const VoxelSet& voxels, const InteriorCubes* interior,
+                      const std::filesystem::path& path) {
+  return WriteWhole(OpenVdbWriter(HeaderOf(voxels), interior, path), voxels);
 }
 
 }  // namespace svokit

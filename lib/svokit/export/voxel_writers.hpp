@@ -1,15 +1,54 @@
 #pragma once
 // Writers of voxels in other tools' formats, one file each: binvox.cpp, vox.cpp, points.cpp (PLY
 // points and xyz text), vdb.cpp (OpenVDB, in the svokit_export library so that only the tools that
-// write .vdb load OpenVDB). Each writes atomically: a complete file or none.
+// write .vdb load OpenVDB). Each writes atomically: a complete file or none. All but .vox also take
+// their voxels a part at a time (VoxelFileWriter), so a file read page by page is never whole.
 
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 
 #include "svokit/core/status.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
+
+/// What a writer needs before the first voxel: the grid, which attributes come, and how many voxels
+/// (PLY states it first).
+struct VoxelFileHeader {
+  GridTransform grid;
+  bool colors = false, normals = false;
+  std::uint64_t count = 0;
+};
+
+/// One of these formats written from voxels given a part at a time (a page's), all on the header's
+/// grid, keys ascending within a part (and across parts for xyz, which lists them in Morton
+/// order). Nothing is at the path until Finish() succeeds.
+class VoxelFileWriter {
+ public:
+  virtual ~VoxelFileWriter() = default;
+  /// `x_done`: every voxel with x < x_done has been given once this part is (binvox, whose order
+  /// runs along x, writes them out then and holds only the rest).
+  virtual Status Add(const VoxelSet& part, std::uint64_t x_done) = 0;
+  virtual Status Finish() = 0;
+};
+/// The header of a whole set, and the set written as the one part of `writer`'s file.
+VoxelFileHeader HeaderOf(const VoxelSet& set);
+Status WriteWhole(StatusOr<std::unique_ptr<VoxelFileWriter>> writer, const VoxelSet& set);
+
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenPlyWriter(const VoxelFileHeader& header,
+                                                         const std::filesystem::path& path);
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenXyzWriter(const VoxelFileHeader& header,
+                                                         const std::filesystem::path& path);
+/// binvox and OpenVDB also fill a solid's `interior` cubes (null for none), as the whole-set
+/// writers below describe.
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenBinvoxWriter(const VoxelFileHeader& header,
+                                                            const InteriorCubes* interior,
+                                                            const std::filesystem::path& path);
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbWriter(const VoxelFileHeader& header,
+                                                         const InteriorCubes* interior,
+                                                         const std::filesystem::path& path);
 
 /// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
 /// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).

@@ -34,14 +34,18 @@ std::vector<std::uint64_t> Svo::LevelKeys(std::uint32_t level) const {
   return keys;
 }
 
-BrickSample Svo::Sample(std::uint32_t level, std::uint64_t index, std::uint32_t sample) const {
-  const SvoLevel& lv = levels[level];
-  const std::uint64_t at = index * brick_samples() + sample;
+BrickSample LevelSample(const SvoLevel& lv, std::uint32_t brick_samples, bool has_color,
+                        bool has_normal, std::uint64_t index, std::uint32_t sample) {
+  const std::uint64_t at = index * brick_samples + sample;
   BrickSample s;
   s.opacity = DecodeUnorm8(lv.opacity[at]);
   if (has_color) s.color = DecodeColor(lv.color[at]);
   if (has_normal) s.normal = DecodeNormal(lv.normal[at]);
   return s;
+}
+
+BrickSample Svo::Sample(std::uint32_t level, std::uint64_t index, std::uint32_t sample) const {
+  return LevelSample(levels[level], brick_samples(), has_color, has_normal, index, sample);
 }
 
 SvoLevelBytes LevelBytes(const Svo& svo, std::uint32_t level) {

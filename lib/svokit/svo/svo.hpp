@@ -68,6 +68,11 @@ struct SvoLevel {
   bool operator==(const SvoLevel&) const = default;
 };
 
+/// Sample `sample` of node `index` of a level's bricks (`brick_samples` samples a node), decoded;
+/// colour and normal only when the bricks carry them.
+BrickSample LevelSample(const SvoLevel& lv, std::uint32_t brick_samples, bool has_color,
+                        bool has_normal, std::uint64_t index, std::uint32_t sample);
+
 struct Svo {
   GridTransform grid;  ///< the voxel grid (leaf voxel size, origin)
   VoxelMode mode = VoxelMode::kConservative;

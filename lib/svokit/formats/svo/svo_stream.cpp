@@ -1,7 +1,9 @@
 #include "svokit/formats/svo/svo_stream.hpp"
 
+#include <algorithm>
 #include <limits>
 
+#include "svokit/core/morton.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
 
 namespace svokit {
@@ -24,7 +26,21 @@ std::uint64_t NestedBytes(const std::vector<V>& levels) {
   return n;
 }
 
+// Pages by their cube's x, then by key (a stable sort of pages in key order).
+void SortBySlabs(const SvoReader& reader, std::vector<std::size_t>& pages) {
+  std::stable_sort(pages.begin(), pages.end(), [&](std::size_t a, std::size_t b) {
+    return MortonDecode(reader.page(a).key).x < MortonDecode(reader.page(b).key).x;
+  });
+}
+
 }  // namespace
+
+std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order) {
+  std::vector<std::size_t> pages(reader.page_count());
+  for (std::size_t i = 0; i < pages.size(); ++i) pages[i] = i;
+  if (order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, pages);
+  return pages;
+}
 
 StatusOr<std::uint64_t> PageDecodedBytes(const SvoReader& reader, std::size_t i) {
   StatusOr<ChunkBytes> streams = reader.PageStreamBytes(i);
@@ -51,12 +67,8 @@ StatusOr<SvoStreamPlan> PlanStream(
     const SvoReader& reader, const SvoStreamOptions& options,
     const std::function<std::uint64_t(std::uint64_t, std::uint64_t)>& per_page) {
   SvoStreamPlan plan;
-  if (options.box) {
-    plan.pages = reader.PagesIn(*options.box);
-  } else {
-    plan.pages.resize(reader.page_count());
-    for (std::size_t i = 0; i < plan.pages.size(); ++i) plan.pages[i] = i;
-  }
+  plan.pages = options.box ? reader.PagesIn(*options.box) : PageOrder(reader, SvoPageOrder::kKeys);
+  if (options.order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, plan.pages);
   std::uint64_t item = 1;
   for (const std::size_t i : plan.pages) {
     StatusOr<std::uint64_t> bytes = PageDecodedBytes(reader, i);

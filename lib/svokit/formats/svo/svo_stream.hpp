@@ -24,12 +24,20 @@
 
 namespace svokit {
 
-/// Which pages a streamed read visits, and the bytes it may hold.
+/// The order a streamed read visits pages in: by key (Morton order), or by slabs of page cubes
+/// along x (ascending x, then by key), the order of formats that run along x (binvox).
+enum class SvoPageOrder { kKeys, kSlabsAlongX };
+
+/// Which pages a streamed read visits, in which order, and the bytes it may hold.
 struct SvoStreamOptions {
   /// Bytes of decoded pages held at once (besides the top chunk); 0: one page per thread, twice.
   std::uint64_t memory_limit = 0;
   std::optional<Box3d> box;  ///< only the pages whose cube meets it (world units)
+  SvoPageOrder order = SvoPageOrder::kKeys;
 };
+
+/// Every page of `reader`, in `order`.
+std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order);
 
 /// Bytes page i of `reader` takes decoded: its streams' decoded bytes (from its stream directory,
 /// nothing decompressed) and the child offsets a decode adds (8 bytes per node above the voxels).
