@@ -1,6 +1,7 @@
 #include "svokit/formats/svo/svo_file.hpp"
 
 #include "svokit/formats/svo/svo_detail.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 
 namespace svokit {
 
@@ -106,6 +107,14 @@ StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint
 
 StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
                            std::optional<std::uint32_t> max_level) {
+  // A paged file's header says its depth: a level below it is refused before any page is read.
+  if (max_level) {
+    if (StatusOr<SvoReader> paged = SvoReader::Open(path);
+        paged.ok() && *max_level > paged->depth()) {
+      return Status::BadInput("{}: level {} exceeds the octree's depth {}", path.string(),
+                              *max_level, paged->depth());
+    }
+  }
   // Units: the pages, once the file says how many.
   Progress::Stage stage(progress, "read", 1);
   StatusOr<Svo> svo = ReadSvo(path, max_level, &stage);
