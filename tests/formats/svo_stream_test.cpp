@@ -214,5 +214,26 @@ TEST(SvoPageCache, StaysWithinCapacityAndServesTheSamePages) {
   EXPECT_EQ(small.misses(), 2u);
 }
 
+TEST(SvoReadArrays, OpacityAloneIsTheFullReadsOpacity) {
+  StatusOr<Svo> all = ReadSvo(test::PagedTorus().path);
+  StatusOr<Svo> opacity =
+      ReadSvo(test::PagedTorus().path, std::nullopt, nullptr, {.colors = false, .normals = false});
+  StatusOr<Svo> normals =
+      ReadSvo(test::PagedTorus().path, std::nullopt, nullptr, {.colors = false, .normals = true});
+  ASSERT_TRUE(all.ok() && opacity.ok() && normals.ok());
+  EXPECT_TRUE(all->has_color && all->has_normal);
+  EXPECT_FALSE(opacity->has_color || opacity->has_normal);
+  EXPECT_TRUE(!normals->has_color && normals->has_normal);
+  for (std::uint32_t l = 0; l <= all->depth; ++l) {
+    const SvoLevel &a = all->levels[l], &o = opacity->levels[l], &n = normals->levels[l];
+    EXPECT_TRUE(o.opacity == a.opacity) << l;
+    EXPECT_TRUE(o.color.empty() && o.normal.empty()) << l;
+    EXPECT_TRUE(n.normal == a.normal) << l;
+    EXPECT_TRUE(n.color.empty()) << l;
+    EXPECT_EQ(o.contours, a.contours) << l;
+    EXPECT_EQ(o.nodes, a.nodes) << l;
+  }
+}
+
 }  // namespace
 }  // namespace svokit

@@ -170,7 +170,9 @@ StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
     }
   }
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, {}));
-  StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt);
+  // Cones read opacity alone; the octree's own bake starts at each voxel's normal.
+  StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt,
+                                   {.colors = false, .normals = !r.output.empty()});
   if (!svo.ok()) return svo.status();
   AoBakeReport report;
   report.depth = svo->depth;

@@ -71,7 +71,7 @@ struct VoxelAttributeArrays {
 /// advances by each page; `voxels`, when given, receives the voxels' attributes.
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
                     IssueSink& sink, Svo& svo, Progress::Stage* stage = nullptr,
-                    VoxelAttributeArrays* voxels = nullptr);
+                    VoxelAttributeArrays* voxels = nullptr, SvoReadArrays arrays = {});
 
 /// The `AOCC` section of `svo`'s levels' ambient occlusion (svo_ao.cpp).
 std::vector<std::uint8_t> EncodeAoSection(const Svo& svo);

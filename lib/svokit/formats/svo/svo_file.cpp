@@ -28,23 +28,24 @@ namespace {
 using namespace svo_detail;
 
 bool Decode(const container::Frame& file, std::optional<std::uint32_t> max_level, IssueSink& sink,
-            Svo& svo, Progress::Stage* stage = nullptr, VoxelAttributeArrays* voxels = nullptr) {
+            Svo& svo, Progress::Stage* stage = nullptr, VoxelAttributeArrays* voxels = nullptr,
+            SvoReadArrays arrays = {}) {
   if (file.version() == 1) return DecodeVersion1(file, max_level, sink, svo);
-  return DecodeVersion2(file, max_level, sink, svo, stage, voxels) &&
+  return DecodeVersion2(file, max_level, sink, svo, stage, voxels, arrays) &&
          DecodeAo(file, max_level.value_or(svo.depth), sink, svo);
 }
 
 // The strict readers: a frame with issues fails on its first, an octree on its first issue.
 StatusOr<Svo> DecodeStrict(const StatusOr<container::Frame>& opened,
-                           std::optional<std::uint32_t> max_level,
-                           Progress::Stage* stage = nullptr) {
+                           std::optional<std::uint32_t> max_level, Progress::Stage* stage = nullptr,
+                           SvoReadArrays arrays = {}) {
   if (!opened.ok()) return opened.status();
   if (!opened->issues().empty()) {
     return Status(StatusCode::kBadInput, opened->issues().front().message);
   }
   IssueSink sink(/*stop_at_first=*/true);
   Svo svo;
-  if (!Decode(*opened, max_level, sink, svo, stage) || !sink.empty()) {
+  if (!Decode(*opened, max_level, sink, svo, stage, nullptr, arrays) || !sink.empty()) {
     return Status(StatusCode::kBadInput, sink.empty() ? opened->name() + ": inconsistent octree"
                                                       : sink.issues().front().message);
   }
@@ -99,14 +100,14 @@ StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& 
 }
 
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path, std::optional<std::uint32_t> max_level,
-                      Progress::Stage* stage) {
+                      Progress::Stage* stage, SvoReadArrays arrays) {
   const std::uint32_t last = max_level.value_or(kMaxDepth);
   return DecodeStrict(container::Frame::Open(path, kSvoFormat, &SectionsToLoad, &last), max_level,
-                      stage);
+                      stage, arrays);
 }
 
 StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
-                           std::optional<std::uint32_t> max_level) {
+                           std::optional<std::uint32_t> max_level, SvoReadArrays arrays) {
   // A paged file's header says its depth: a level below it is refused before any page is read.
   if (max_level) {
     if (StatusOr<SvoReader> paged = SvoReader::Open(path);
@@ -117,7 +118,7 @@ StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path
   }
   // Units: the pages, once the file says how many.
   Progress::Stage stage(progress, "read", 1);
-  StatusOr<Svo> svo = ReadSvo(path, max_level, &stage);
+  StatusOr<Svo> svo = ReadSvo(path, max_level, &stage, arrays);
   if (!svo.ok()) stage.Cancel();
   if (svo.ok() && max_level && *max_level > svo->depth) {
     return Status::BadInput("{}: level {} exceeds the octree's depth {}", path.string(), *max_level,

@@ -124,13 +124,18 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
 StatusOr<Svo> DecodeSvo(std::span<const std::uint8_t> bytes, const std::string& name,
                         std::optional<std::uint32_t> max_level = std::nullopt);
+/// Which brick arrays a read of a paged file assembles besides opacity: a consumer that needs
+/// opacity alone (cone tracing) skips deriving the rest. Version 1 files hold every array.
+struct SvoReadArrays {
+  bool colors = true, normals = true;
+};
 StatusOr<Svo> ReadSvo(const std::filesystem::path& path,
                       std::optional<std::uint32_t> max_level = std::nullopt,
-                      Progress::Stage* stage = nullptr);
+                      Progress::Stage* stage = nullptr, SvoReadArrays arrays = {});
 /// ReadSvo as the "read" stage of `progress`; a `max_level` below the octree's depth is bad
-/// input.
+/// input (for a paged file, before any page is read).
 StatusOr<Svo> ReadSvoStage(Progress& progress, const std::filesystem::path& path,
-                           std::optional<std::uint32_t> max_level);
+                           std::optional<std::uint32_t> max_level, SvoReadArrays arrays = {});
 
 /// One violated invariant: `kind` is a stable key (svo-validate's README section lists them),
 /// `message` one line naming the file, the same text the strict readers fail with.

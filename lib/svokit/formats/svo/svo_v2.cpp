@@ -529,7 +529,7 @@ bool CheckHalos(const PageVoxels& voxels, const std::string& name, IssueSink& si
 
 bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> max_level,
                     IssueSink& sink, Svo& svo, Progress::Stage* stage,
-                    VoxelAttributeArrays* attributes) {
+                    VoxelAttributeArrays* attributes, SvoReadArrays arrays) {
   const std::string& name = file.name();
   StatusOr<Version2> parsed = ParseVersion2(file, sink);
   if (!parsed.ok()) return false;
@@ -537,7 +537,11 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
   const std::uint32_t last = std::min(v.shape.depth, max_level.value_or(v.shape.depth));
   StatusOr<SvoChunk> top = DecodeTopOfPages(v, name, sink);
   if (!top.ok()) return false;
-  SvoAssembler assembler(v.shape, last);
+  // The arrays not asked for are not assembled (the file's own flags stay in `v`).
+  SvoShape assembled = v.shape;
+  assembled.has_color = assembled.has_color && arrays.colors;
+  assembled.has_normal = assembled.has_normal && arrays.normals;
+  SvoAssembler assembler(assembled, last);
   // HEAD's counts (checked once the pages are in), bounded by what the chunks can hold: the top
   // chunk's levels are decoded, and a page holds at most 8^k nodes k levels below its root.
   std::vector<std::uint64_t> nodes(last + 1);
