@@ -10,7 +10,7 @@
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/bake/bake_svo.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 
 namespace {
 

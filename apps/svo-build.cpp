@@ -8,7 +8,7 @@
 #include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/pipeline/chain.hpp"
 
 namespace {

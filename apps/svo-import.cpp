@@ -7,7 +7,7 @@
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/mesh/mesh_report.hpp"

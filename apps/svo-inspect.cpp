@@ -7,7 +7,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/run.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/inspect/inspect_svo.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/pipeline/svo_parts.hpp"
 
 int main(int argc, char** argv) {

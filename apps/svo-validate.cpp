@@ -11,7 +11,7 @@
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/validate/validate.hpp"

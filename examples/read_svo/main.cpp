@@ -1,17 +1,15 @@
-// read_svo: prints an .svo's node count per level, or a .vfrag's voxel count and grid, through
-// svokit's readers (an example of a program built against the installed library). With --box it
-// streams a version-2 .svo as a renderer does: the top levels, then the pages meeting the box,
-// each level's bricks assembled into a brick pool.
+// read_svo: prints an .svo's node count per level through svokit's reader library (an example of
+// a program built against the installed svokit::reader alone). With --box it streams a version-2
+// .svo as a renderer does: the top levels, then the pages meeting the box, each level's bricks
+// assembled into a brick pool.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
-#include "svokit/formats/vfrag/vfrag.hpp"
 
 namespace {
 
@@ -55,7 +53,7 @@ int StreamPages(const std::filesystem::path& path, const svokit::Box3d& box) {
 
 int main(int argc, char** argv) {
   if (argc != 2 && !(argc == 9 && std::string(argv[2]) == "--box")) {
-    std::fprintf(stderr, "usage: %s FILE.svo|FILE.vfrag [--box X0 Y0 Z0 X1 Y1 Z1]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s FILE.svo [--box X0 Y0 Z0 X1 Y1 Z1]\n", argv[0]);
     return 2;
   }
   const std::filesystem::path path = argv[1];
@@ -64,16 +62,6 @@ int main(int argc, char** argv) {
     box.lo = {std::atof(argv[3]), std::atof(argv[4]), std::atof(argv[5])};
     box.hi = {std::atof(argv[6]), std::atof(argv[7]), std::atof(argv[8])};
     return StreamPages(path, box);
-  }
-  if (svokit::LowerExtension(path) == "vfrag") {
-    const svokit::StatusOr<svokit::VoxelSet> set = svokit::ReadVfrag(path);
-    if (!set.ok()) return Fail(set.status());
-    const auto& dims = set->grid.dims();
-    const auto& origin = set->grid.origin();
-    std::printf("voxels %zu\ngrid %u %u %u\nvoxel_size %.17g\norigin %.17g %.17g %.17g\n",
-                set->size(), dims[0], dims[1], dims[2], set->grid.voxel_size(), origin.x, origin.y,
-                origin.z);
-    return 0;
   }
   const svokit::StatusOr<svokit::Svo> svo = svokit::ReadSvo(path);
   if (!svo.ok()) return Fail(svo.status());

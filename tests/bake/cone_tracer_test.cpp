@@ -9,7 +9,7 @@
 
 #include "svokit/bake/ao_bake.hpp"
 #include "svokit/bake/ray_ao.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "tests/bake/bake_scenes.hpp"
 
 namespace svokit::test {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/export/export.hpp"
 #include "tests/formats/paged_torus.hpp"
 

@@ -15,7 +15,7 @@
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"

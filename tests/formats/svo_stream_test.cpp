@@ -4,6 +4,7 @@
 // refused with the smallest that works.
 
 #include "svokit/formats/svo/svo_stream.hpp"
+#include "svokit/core/thread_limit.hpp"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 
 #include "svokit/formats/svm/svm.hpp"
 #include "svokit/formats/svo/svo_file.hpp"

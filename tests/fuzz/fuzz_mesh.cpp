@@ -3,7 +3,7 @@
 // "#mtl" are the material library fuzz.mtl (seeds name it with `mtllib fuzz.mtl`); for glTF, the
 // bytes after a line "#bin" are its buffer fuzz.bin. A texture t.png is always there to name.
 
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "tests/fuzz/fuzz_target.hpp"

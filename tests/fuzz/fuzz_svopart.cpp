@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <string>
 
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_part.hpp"
 #include "svokit/pipeline/svo_parts.hpp"

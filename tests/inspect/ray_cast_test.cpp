@@ -12,7 +12,7 @@
 #include <limits>
 #include <random>
 
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit {

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "svokit/core/morton.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/inspect/stats.hpp"
 #include "svokit/inspect/stats_report.hpp"
 #include "tests/formats/paged_torus.hpp"

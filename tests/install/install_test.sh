@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Installs a build into a temporary prefix, builds examples/read_svo against that prefix alone
-# (find_package(svokit)), and checks the installed tools and the example against each other:
-# the example's per-level node counts against svo-inspect --json (parsed by python3), and the
-# installed mesh2svo's TIFF texture decoding through the installed plugin.
+# Installs a build into a temporary prefix and builds examples/read_svo against that prefix alone:
+# against svokit::reader (find_package(svokit COMPONENTS reader)) in Debug and in Release, through
+# pkg-config (svokit-reader.pc), and against the whole library (svokit::svokit, with every other
+# component found). The reader's consumers must name none of the build stages' dependencies, and
+# their configure must print no warning. Then checks the installed tools and the examples against
+# each other: the per-level node counts against svo-inspect --json (parsed by python3), every
+# consumer's output alike, and the installed mesh2svo's TIFF texture decoding through the plugin.
 # Usage: install_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
 src="$(cd "$1" && pwd)"
@@ -21,30 +24,81 @@ cmake --install "$build" --prefix "$prefix" >"$work/install.log" ||
 
 # The layout: tools, libraries, plugin, package files, and every header of lib/svokit.
 for f in bin/svo-import bin/svo-voxelize bin/svo-build bin/mesh2svo bin/svo-export \
-  bin/svo-inspect bin/svo-validate lib/libsvokit.a lib/libsvokit_oiio.so \
+  bin/svo-inspect bin/svo-validate lib/libsvokit.a lib/libsvokit_reader.a lib/libsvokit_oiio.so \
   lib/cmake/svokit/svokitConfig.cmake lib/cmake/svokit/svokitConfigVersion.cmake \
-  lib/cmake/svokit/svokitTargets.cmake; do
+  lib/cmake/svokit/svokitTargets.cmake lib/cmake/svokit/svokitReaderTargets.cmake \
+  lib/pkgconfig/svokit-reader.pc; do
   [ -e "$prefix/$f" ] || fail "not installed: $f"
 done
 while IFS= read -r header; do
   [ -f "$prefix/include/$header" ] || fail "header not installed: include/$header"
 done < <(cd "$src/lib" && find svokit -name '*.hpp')
-# The package refers to the prefix only, never to the tree it was built from.
-if grep -rlF -e "$src" -e "$build" "$prefix/lib/cmake"; then
-  fail "the installed CMake package names the source or build tree"
+# The packages refer to the prefix only, never to the tree it was built from.
+if grep -rlF -e "$src" -e "$build" "$prefix/lib/cmake" "$prefix/lib/pkgconfig"; then
+  fail "the installed CMake or pkg-config package names the source or build tree"
 fi
 
-# The example, against the prefix only (no package registry, no build tree).
+# What a reader's consumer must not see: the build stages' dependencies.
+foreign='cgal|draco|openmesh|openimageio|oiio|openvdb|tbb|embree'
+# The example against svokit::reader, from the prefix only (no package registry, no build tree),
+# in each configuration; its compile and link commands as the build ran them (-v).
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-cmake -S "$src/examples/read_svo" -B "$work/example" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
-  -DCMAKE_CXX_FLAGS="-Wall -Wextra -Werror" >"$work/configure.log" 2>&1 ||
-  { cat "$work/configure.log" >&2; fail "configuring examples/read_svo against $prefix"; }
-found="$(sed -n 's/^svokit_DIR:PATH=//p' "$work/example/CMakeCache.txt")"
-[ "$found" = "$prefix/lib/cmake/svokit" ] || fail "find_package(svokit) found '$found'"
-cmake --build "$work/example" >"$work/build.log" 2>&1 ||
-  { cat "$work/build.log" >&2; fail "building examples/read_svo against $prefix"; }
+for config in Debug Release; do
+  dir="$work/example-$config"
+  cmake -S "$src/examples/read_svo" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=$config \
+    -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
+    -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -DCMAKE_CXX_FLAGS="-Wall -Wextra -Werror" \
+    >"$dir.configure.log" 2>&1 ||
+    { cat "$dir.configure.log" >&2; fail "configuring examples/read_svo ($config) against $prefix"; }
+  found="$(sed -n 's/^svokit_DIR:PATH=//p' "$dir/CMakeCache.txt")"
+  [ "$found" = "$prefix/lib/cmake/svokit" ] || fail "find_package(svokit) found '$found'"
+  if grep -n "CMake Warning" "$dir.configure.log"; then
+    fail "find_package(svokit COMPONENTS reader) warned ($config)"
+  fi
+  if grep -inE "^[A-Za-z_]*($foreign)[A-Za-z_]*_DIR:" "$dir/CMakeCache.txt"; then
+    fail "find_package(svokit COMPONENTS reader) looked for a build stage's dependency ($config)"
+  fi
+  cmake --build "$dir" --verbose >"$dir.build.log" 2>&1 ||
+    { cat "$dir.build.log" >&2; fail "building examples/read_svo ($config) against $prefix"; }
+  # The commands, with this test's own folder names taken out (they are random).
+  commands="$(sed "s|$work|WORK|g" "$dir.build.log" "$dir/compile_commands.json")"
+  if grep -inE "$foreign" <<<"$commands"; then
+    fail "the reader's consumer ($config) compiles or links with a build stage's dependency"
+  fi
+done
+
+# The same program through pkg-config alone.
+pc_flags="$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs svokit-reader)" ||
+  fail "pkg-config --cflags --libs svokit-reader"
+if grep -inE "$foreign" <<<"${pc_flags//$work/WORK}"; then
+  fail "svokit-reader.pc names a build stage's dependency: $pc_flags"
+fi
+# shellcheck disable=SC2086  # the flags are words
+c++ -std=c++20 -O2 -Wall -Wextra -Werror "$src/examples/read_svo/main.cpp" -o "$work/read_svo_pc" \
+  $pc_flags >"$work/pkg-config.log" 2>&1 ||
+  { cat "$work/pkg-config.log" >&2; fail "building examples/read_svo with pkg-config's flags"; }
+
+# And against the whole library: no components is svokit::svokit, and the other components load.
+mkdir "$work/whole"
+cat >"$work/whole/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.20)
+project(whole LANGUAGES CXX)
+find_package(svokit 0.1 REQUIRED)
+find_package(svokit 0.1 REQUIRED COMPONENTS export validate bake)
+foreach(target svokit::reader svokit::svokit svokit::svokit_export svokit::svokit_validate
+               svokit::svokit_bake)
+  if(NOT TARGET \${target})
+    message(FATAL_ERROR "no \${target}")
+  endif()
+endforeach()
+add_executable(read_svo "$src/examples/read_svo/main.cpp")
+target_link_libraries(read_svo PRIVATE svokit::svokit)
+CMAKE
+cmake -S "$work/whole" -B "$work/whole/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF >"$work/whole.log" 2>&1 &&
+  cmake --build "$work/whole/build" >>"$work/whole.log" 2>&1 ||
+  { cat "$work/whole.log" >&2; fail "building examples/read_svo against svokit::svokit"; }
 
 # The installed tools on the torus textured with a TIFF, which only the plugin decodes.
 # LD_DEBUG=files logs every dlopen attempt ("dynamically loaded by") and, for the file that opens,
@@ -58,16 +112,24 @@ grep -F "file=$prefix/lib/libsvokit_oiio.so " "$work/mesh2svo.err" | grep -q "ge
   fail "installed mesh2svo did not load $prefix/lib/libsvokit_oiio.so:
 $(grep -F "libsvokit_oiio.so [0];  generating link map" "$work/mesh2svo.err")"
 "$bin/svo-voxelize" "$src/data/uv-torus.obj" -r 32 -o "$work/torus.vfrag" -q >/dev/null ||
-  fail "installed svo-voxelize"
+  fail "installed svo-voxelize"  # runs from the prefix
 "$bin/svo-inspect" --json --levels "$work/torus.svo" >"$work/inspect.json" 2>/dev/null ||
   fail "installed svo-inspect"
-"$work/example/read_svo" "$work/torus.svo" >"$work/svo.txt" || fail "read_svo torus.svo"
-"$work/example/read_svo" "$work/torus.vfrag" >"$work/vfrag.txt" || fail "read_svo torus.vfrag"
-# Streamed: the top chunk and every page meeting a box around the whole grid.
-"$work/example/read_svo" "$work/torus.svo" --box -1e9 -1e9 -1e9 1e9 1e9 1e9 >"$work/stream.txt" ||
-  fail "read_svo torus.svo --box"
+# Every consumer reads the file whole, then streams the top chunk and every page meeting a box
+# around the whole grid; all of them print the same.
+for reader in example-Release/read_svo example-Debug/read_svo read_svo_pc whole/build/read_svo; do
+  out="$work/$(tr / _ <<<"$reader").txt"
+  "$work/$reader" "$work/torus.svo" >"$out" || fail "$reader torus.svo"
+  "$work/$reader" "$work/torus.svo" --box -1e9 -1e9 -1e9 1e9 1e9 1e9 >>"$out" ||
+    fail "$reader torus.svo --box"
+done
+release="$work/example-Release_read_svo.txt"
+for out in "$work"/example-Debug_read_svo.txt "$work"/read_svo_pc.txt "$work"/whole_build_read_svo.txt; do
+  cmp -s "$release" "$out" || fail "$(basename "$out") differs from the Release build's output:
+$(diff "$release" "$out" | head -20)"
+done
 
-python3 - "$work/inspect.json" "$work/svo.txt" "$work/vfrag.txt" "$work/stream.txt" <<'PY'
+python3 - "$work/inspect.json" "$release" <<'PY'
 import json, sys
 inspect = json.load(open(sys.argv[1]))
 def fields(path):
@@ -76,28 +138,21 @@ def fields(path):
         key, *values = line.split()
         out.setdefault(key, []).append(values)
     return out
-svo, vfrag, stream = fields(sys.argv[2]), fields(sys.argv[3]), fields(sys.argv[4])
+out = fields(sys.argv[2])
 errors = []
 want = [(level["level"], level["nodes"]) for level in inspect["levels"]]
-got = [(int(l), int(n)) for l, _, n in svo["level"]]
+got = [(int(l), int(n)) for l, _, n in out["level"]]
 if got != want:
     errors.append(f"per-level nodes: read_svo {got}, svo-inspect {want}")
-streamed = [(int(l), int(n)) for l, _, n, _, _ in stream["streamed"]]
+streamed = [(int(l), int(n)) for l, _, n, _, _ in out["streamed"]]
 if streamed != want:
     errors.append(f"per-level nodes streamed page by page: read_svo {streamed}, svo-inspect {want}")
-if any(int(s) != 27 * int(n) for _, _, n, _, s in stream["streamed"]):
-    errors.append(f"streamed brick pools are not 27 samples per node: {stream['streamed']}")
-if int(svo["depth"][0][0]) != inspect["octree"]["depth"] or len(want) != inspect["octree"]["depth"] + 1:
-    errors.append(f"depth: read_svo {svo['depth'][0][0]}, svo-inspect {inspect['octree']['depth']}")
-if int(svo["voxels"][0][0]) != inspect["voxels"]:
-    errors.append(f"voxels: read_svo {svo['voxels'][0][0]}, svo-inspect {inspect['voxels']}")
-# The .vfrag of the same mesh, resolution and mode holds the .svo's voxels on the same grid.
-if int(vfrag["voxels"][0][0]) != inspect["voxels"]:
-    errors.append(f".vfrag voxels: read_svo {vfrag['voxels'][0][0]}, .svo {inspect['voxels']}")
-if [int(d) for d in vfrag["grid"][0]] != inspect["grid"]["dims"]:
-    errors.append(f".vfrag grid: read_svo {vfrag['grid'][0]}, .svo {inspect['grid']['dims']}")
-if float(vfrag["voxel_size"][0][0]) != inspect["grid"]["voxel_size"]:
-    errors.append(f".vfrag voxel size: read_svo {vfrag['voxel_size'][0][0]}, .svo {inspect['grid']['voxel_size']}")
+if any(int(s) != 27 * int(n) for _, _, n, _, s in out["streamed"]):
+    errors.append(f"streamed brick pools are not 27 samples per node: {out['streamed']}")
+if int(out["depth"][0][0]) != inspect["octree"]["depth"] or len(want) != inspect["octree"]["depth"] + 1:
+    errors.append(f"depth: read_svo {out['depth'][0][0]}, svo-inspect {inspect['octree']['depth']}")
+if int(out["voxels"][0][0]) != inspect["voxels"]:
+    errors.append(f"voxels: read_svo {out['voxels'][0][0]}, svo-inspect {inspect['voxels']}")
 # The texture decoded: without it every voxel has the material's white base colour (Kd 1 1 1).
 lo, hi = inspect["bricks"]["color_range"]["min"], inspect["bricks"]["color_range"]["max"]
 if max(h - l for l, h in zip(lo[:3], hi[:3])) < 0.25:
@@ -106,4 +161,5 @@ for e in errors:
     print("FAIL:", e, file=sys.stderr)
 sys.exit(1 if errors else 0)
 PY
-echo "install test: $(grep -c '^level' "$work/svo.txt") levels agree, texture decoded by $prefix/lib/libsvokit_oiio.so"
+echo "install test: $(grep -c '^level' "$release") levels agree in 4 consumers, texture decoded by \
+$prefix/lib/libsvokit_oiio.so"

@@ -10,7 +10,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "svokit/mesh/importers.hpp"
 #include "svokit/mesh/side_files.hpp"

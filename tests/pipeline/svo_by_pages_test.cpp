@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"

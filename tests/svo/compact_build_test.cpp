@@ -12,7 +12,7 @@
 #include <set>
 
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/compact_build.hpp"

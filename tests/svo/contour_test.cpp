@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/validate/contour_surface.hpp"

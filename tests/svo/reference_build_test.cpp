@@ -11,7 +11,7 @@
 #include <set>
 
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/svo/build_options.hpp"

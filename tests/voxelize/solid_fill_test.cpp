@@ -33,7 +33,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
 #include "svokit/voxelize/voxel_space.hpp"

@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "svokit/voxelize/voxelize.hpp"

@@ -23,7 +23,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/morton.hpp"
-#include "svokit/core/parallel.hpp"
+#include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/mesh/mesh_report.hpp"
 #include "svokit/voxelize/triangle_voxelizer.hpp"

@@ -4,6 +4,7 @@
 // them. On VMs the first touch of fresh pages is the cost of a big array, and a zero fill makes
 // it serial; the parallel writes that follow then touch the pages instead.
 
+#include <cstdint>
 #include <memory>
 #include <new>
 #include <utility>
@@ -37,3 +38,11 @@ template <class T>
 using DefaultInitVector = std::vector<T, DefaultInitAllocator<T>>;
 
 }  // namespace svokit
+
+// Compiled once, optimized, in the library (default_init.cpp; half.hpp and octahedral.hpp do the
+// same for theirs): a program built without optimization would otherwise free and size the
+// reader's arrays with unoptimized copies that call a function per element.
+extern template class std::vector<std::uint8_t, svokit::DefaultInitAllocator<std::uint8_t>>;
+extern template class std::vector<std::uint16_t, svokit::DefaultInitAllocator<std::uint16_t>>;
+extern template class std::vector<std::uint32_t, svokit::DefaultInitAllocator<std::uint32_t>>;
+extern template class std::vector<std::uint64_t, svokit::DefaultInitAllocator<std::uint64_t>>;

@@ -5,7 +5,9 @@
 
 #include <bit>
 #include <cstdint>
+#include <vector>
 
+#include "svokit/core/default_init.hpp"
 #include "svokit/core/vec.hpp"
 
 namespace svokit {
@@ -81,3 +83,7 @@ struct HalfVec3 {
 static_assert(sizeof(HalfRgba) == 8 && sizeof(HalfVec3) == 6, "stored as raw binary16 arrays");
 
 }  // namespace svokit
+
+// Compiled once, optimized, in the library (half.cpp), as default_init.hpp says.
+extern template class std::vector<svokit::Half, svokit::DefaultInitAllocator<svokit::Half>>;
+extern template class std::vector<svokit::HalfRgba, svokit::DefaultInitAllocator<svokit::HalfRgba>>;

@@ -1,34 +1,70 @@
 #pragma once
-// Parallel helpers on TBB. Work is split into chunks whose boundaries depend only on the problem
-// size, never on the thread count, and results are combined in chunk order: deterministic output.
+// Parallel helpers on svokit's own thread pool (parallel.cpp), which needs nothing but the standard
+// library: the reader library runs on it without TBB. Work is split into chunks whose boundaries
+// depend only on the problem size, never on the thread count, and results are combined in chunk
+// order: deterministic output. ThreadLimit (thread_limit.hpp) limits this pool and TBB together.
 
 #include <algorithm>
 #include <cstddef>
-#include <memory>
+#include <cstdint>
+#include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
-
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_pipeline.h>
-#include <tbb/task_arena.h>
 
 #include "svokit/core/status.hpp"
 
 namespace svokit {
 
-/// Limits TBB to `threads` worker threads for this object's lifetime (0 = all cores).
-class ThreadLimit {
+namespace parallel_detail {
+
+/// A callable by reference, for the type-erased entry points below: one body of pool code serves
+/// every caller's lambda, and none of it is compiled into the caller.
+template <class Signature>
+class FunctionRef;
+template <class R, class... Args>
+class FunctionRef<R(Args...)> {
  public:
-  explicit ThreadLimit(std::size_t threads) {
-    if (threads > 0) {
-      control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                       threads);
-    }
-  }
+  template <class F>
+  FunctionRef(const F& f)  // NOLINT: implicit, as a lambda is passed
+      : object_(&f), call_([](const void* o, Args... args) -> R {
+          return (*static_cast<const F*>(o))(std::forward<Args>(args)...);
+        }) {}
+  R operator()(Args... args) const { return call_(object_, std::forward<Args>(args)...); }
 
  private:
-  std::unique_ptr<tbb::global_control> control_;
+  const void* object_;
+  R (*call_)(const void*, Args...);
+};
+
+/// Runs task(i) for every i in [0, count) on the pool's threads and the caller's; returns when
+/// all have, rethrowing the first exception a task threw.
+void RunTasks(std::size_t count, FunctionRef<void(std::size_t)> task);
+
+/// ParallelInOrder's engine: make(i, slot) for items [first, end) in parallel, item i into slot
+/// i % slots, at most `slots` made and not yet taken; take(slot) in item order on the caller's
+/// thread, stopping at its first error.
+Status RunInOrder(std::size_t first, std::size_t end, std::size_t slots,
+                  FunctionRef<void(std::size_t, std::size_t)> make,
+                  FunctionRef<Status(std::size_t)> take);
+
+}  // namespace parallel_detail
+
+/// The threads a parallel run may use, the caller's included: the cores this process may run on,
+/// within the most restrictive PoolThreadLimit alive.
+std::size_t Concurrency();
+
+/// Limits the pool to `threads` threads, the caller's included, for this object's lifetime (0 =
+/// all cores); the most restrictive limit alive wins. ThreadLimit limits TBB as well.
+class PoolThreadLimit {
+ public:
+  explicit PoolThreadLimit(std::size_t threads);
+  ~PoolThreadLimit();
+  PoolThreadLimit(const PoolThreadLimit&) = delete;
+  PoolThreadLimit& operator=(const PoolThreadLimit&) = delete;
+
+ private:
+  std::size_t threads_;
 };
 
 /// Calls body(begin, end) on fixed chunks of [0, n) in parallel.
@@ -36,8 +72,8 @@ template <class Body>
 void ParallelChunks(std::size_t n, std::size_t chunk, const Body& body) {
   chunk = std::max<std::size_t>(chunk, 1);
   const std::size_t chunks = (n + chunk - 1) / chunk;
-  tbb::parallel_for(std::size_t{0}, chunks,
-                    [&](std::size_t c) { body(c * chunk, std::min(n, (c + 1) * chunk)); });
+  parallel_detail::RunTasks(chunks,
+                            [&](std::size_t c) { body(c * chunk, std::min(n, (c + 1) * chunk)); });
 }
 
 /// Deterministic reduction: map(begin, end) → T per fixed chunk in parallel, then
@@ -47,17 +83,16 @@ T OrderedReduce(std::size_t n, std::size_t chunk, T init, const Map& map, const 
   chunk = std::max<std::size_t>(chunk, 1);
   const std::size_t chunks = (n + chunk - 1) / chunk;
   std::vector<T> parts(chunks, init);
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    parts[c] = map(c * chunk, std::min(n, (c + 1) * chunk));
-  });
+  parallel_detail::RunTasks(
+      chunks, [&](std::size_t c) { parts[c] = map(c * chunk, std::min(n, (c + 1) * chunk)); });
   for (auto& p : parts) combine(init, p);
   return init;
 }
 
-/// The most items a streaming run (ParallelInOrder) keeps in flight: twice the worker threads,
-/// so every thread has the next one while the slowest is handed on.
+/// The most items a streaming run (ParallelInOrder) keeps in flight: twice the threads, so every
+/// thread has the next one while the slowest is handed on.
 inline std::size_t MostInFlight() {
-  return 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  return 2 * Concurrency();
 }
 
 /// How many items of `item` bytes a streaming run (ParallelInOrder) may have in flight within
@@ -86,20 +121,15 @@ inline StatusOr<std::size_t> InFlightWithin(std::uint64_t limit, std::uint64_t f
 template <class Made, class MakeFn, class TakeFn>
 Status ParallelInOrder(std::size_t first, std::size_t end, std::size_t in_flight,
                        const MakeFn& make, const TakeFn& take) {
-  Status failed;
-  std::size_t next = first;
-  tbb::parallel_pipeline(
-      std::max<std::size_t>(in_flight, 1),
-      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                          [&](tbb::flow_control& fc) -> std::size_t {
-                                            if (next == end || !failed.ok()) fc.stop();
-                                            return next++;
-                                          }) &
-          tbb::make_filter<std::size_t, Made>(tbb::filter_mode::parallel, make) &
-          tbb::make_filter<Made, void>(tbb::filter_mode::serial_in_order, [&](Made made) {
-            if (failed.ok()) failed = take(std::move(made));
-          }));
-  return failed;
+  if (end <= first) return {};
+  std::vector<std::optional<Made>> slots(std::clamp<std::size_t>(in_flight, 1, end - first));
+  return parallel_detail::RunInOrder(
+      first, end, slots.size(), [&](std::size_t i, std::size_t s) { slots[s].emplace(make(i)); },
+      [&](std::size_t s) {
+        Status taken = take(std::move(*slots[s]));
+        slots[s].reset();
+        return taken;
+      });
 }
 
 }  // namespace svokit

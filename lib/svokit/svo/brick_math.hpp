@@ -83,14 +83,9 @@ inline void StoreSample(const EncodedSample& e, std::uint64_t at, LevelSamples& 
   if (!out.normal.empty()) out.normal[at] = e.normal;
 }
 
-/// A sample whose opacity rounds to 0 is empty: no colour, no normal.
-inline EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {
-  const std::uint8_t opacity = EncodeUnorm8(p.opacity);
-  if (opacity == 0) return {};
-  const BrickSample s = Unpremultiply(p);
-  return {opacity, color ? EncodeColor(s.color) : 0u,
-          normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
-}
+/// A sample whose opacity rounds to 0 is empty: no colour, no normal. Out of line
+/// (sample_filter.cpp): too large to be inlined, and a program's own copy must not stand in for it.
+EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p);
 
 /// Premultiply(decoded sample), without the straight sample in between (the same products: absent
 /// colour and normal stay 0).

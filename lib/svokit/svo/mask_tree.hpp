@@ -15,9 +15,8 @@
 #include <vector>
 
 #include "svokit/core/bit_count.hpp"
+#include "svokit/core/parallel.hpp"
 #include "svokit/core/progress.hpp"
-
-#include <tbb/parallel_for.h>
 
 namespace svokit {
 
@@ -113,28 +112,25 @@ void ForEachNeighbourhood(const MaskTree& tree, std::uint32_t level, const Body&
   std::uint32_t top = tree.first_level;
   while (top < level && tree.NodeCount(top) < 1024) ++top;
   const std::vector<Neighbourhood> start = LevelNeighbourhoods(tree, top);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size(), 16),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      std::uint64_t visited = 0;
-                      const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t i,
-                                             const Neighbourhood& nb) -> void {
-                        if (l == level) {
-                          body(i, nb);
-                          ++visited;
-                          return;
-                        }
-                        const std::uint8_t m = tree.masks[l - tree.first_level][i];
-                        std::uint64_t child = tree.first_child[l - tree.first_level][i];
-                        const ChildNeighbourhoods children(tree, l, nb);
-                        for (unsigned c = 0; c < 8; ++c) {
-                          if (m >> c & 1u) self(self, l + 1, child++, children[c]);
-                        }
-                      };
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        visit(visit, top, i, start[i]);
-                      }
-                      if (stage != nullptr) stage->Advance(visited);
-                    });
+  ParallelChunks(start.size(), 16, [&](std::size_t begin, std::size_t end) {
+    std::uint64_t visited = 0;
+    const auto visit = [&](const auto& self, std::uint32_t l, std::uint64_t i,
+                           const Neighbourhood& nb) -> void {
+      if (l == level) {
+        body(i, nb);
+        ++visited;
+        return;
+      }
+      const std::uint8_t m = tree.masks[l - tree.first_level][i];
+      std::uint64_t child = tree.first_child[l - tree.first_level][i];
+      const ChildNeighbourhoods children(tree, l, nb);
+      for (unsigned c = 0; c < 8; ++c) {
+        if (m >> c & 1u) self(self, l + 1, child++, children[c]);
+      }
+    };
+    for (std::size_t i = begin; i != end; ++i) visit(visit, top, i, start[i]);
+    if (stage != nullptr) stage->Advance(visited);
+  });
 }
 
 }  // namespace svokit

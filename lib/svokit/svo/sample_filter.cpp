@@ -570,4 +570,16 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
               ResizeBricks(out, kept, side, !source.colors.empty(), !source.normals.empty()), keep);
 }
 
+namespace brick_math {
+
+EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {
+  const std::uint8_t opacity = EncodeUnorm8(p.opacity);
+  if (opacity == 0) return {};
+  const BrickSample s = Unpremultiply(p);
+  return {opacity, color ? EncodeColor(s.color) : 0u,
+          normal ? EncodeNormal(s.normal) : std::uint16_t{0}};
+}
+
+}  // namespace brick_math
+
 }  // namespace svokit

@@ -75,4 +75,27 @@ std::string LevelTable(const Svo& svo) {
   return out;
 }
 
+std::uint32_t EncodeContour(const Contour& c) {
+  const auto field = [](int v, int bits) {
+    return static_cast<std::uint32_t>(v) & ((1u << bits) - 1u);
+  };
+  return field(c.thickness, 7) << 25 | field(c.position, 7) << 18 | field(c.nx, 6) << 12 |
+         field(c.ny, 6) << 6 | field(c.nz, 6);
+}
+
+Contour DecodeContour(std::uint32_t word) {
+  // Sign-extend a `bits`-wide two's complement field.
+  const auto sfield = [word](int shift, int bits) {
+    const int v = static_cast<int>((word >> shift) & ((1u << bits) - 1u));
+    return v >= (1 << (bits - 1)) ? v - (1 << bits) : v;
+  };
+  Contour c;
+  c.thickness = static_cast<int>(word >> 25);
+  c.position = sfield(18, 7);
+  c.nx = sfield(12, 6);
+  c.ny = sfield(6, 6);
+  c.nz = sfield(0, 6);
+  return c;
+}
+
 }  // namespace svokit

@@ -6,8 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include <tbb/parallel_for.h>
-
+#include "svokit/core/parallel.hpp"
 #include "svokit/svo/sample_filter.hpp"
 
 namespace svokit {
@@ -136,13 +135,15 @@ void SvoAssembler::Append(std::span<const SvoChunk* const> chunks) {
       parts.push_back({chunk, k, l, first, nodes});
     }
   }
-  tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t i) {
-    const Part& p = parts[i];
-    const BrickSpans out = BricksOf(levels_[p.level], p.first, p.nodes, shape_.brick_side);
-    if (p.level < shape_.depth) {
-      AssembleBricks(p.chunk->tree, p.level, p.chunk->layouts[p.k], p.chunk->samples[p.k], out);
-    } else {
-      ChunkVoxelBricks(*p.chunk, shape_, out);
+  ParallelChunks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Part& p = parts[i];
+      const BrickSpans out = BricksOf(levels_[p.level], p.first, p.nodes, shape_.brick_side);
+      if (p.level < shape_.depth) {
+        AssembleBricks(p.chunk->tree, p.level, p.chunk->layouts[p.k], p.chunk->samples[p.k], out);
+      } else {
+        ChunkVoxelBricks(*p.chunk, shape_, out);
+      }
     }
   });
 }

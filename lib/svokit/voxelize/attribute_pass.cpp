@@ -12,6 +12,7 @@
 #include <tbb/concurrent_queue.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "svokit/core/key_gaps.hpp"
 #include "svokit/core/morton.hpp"

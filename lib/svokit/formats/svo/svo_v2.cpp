@@ -8,9 +8,6 @@
 #include <memory>
 #include <optional>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include "svokit/core/bit_count.hpp"
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
@@ -417,12 +414,14 @@ StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, 
 bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name, IssueSink& sink,
                  SvoAssembler& assembler, PageVoxels& voxels, Progress::Stage* stage) {
   bool complete = true;
-  const std::size_t batch = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const std::size_t batch = 4 * Concurrency();
   std::vector<std::optional<StatusOr<SvoChunk>>> decoded(batch);
   for (std::size_t first = 0; last + 1 >= v.page_level && first < v.pages.size(); first += batch) {
     const std::size_t count = std::min(batch, v.pages.size() - first);
-    tbb::parallel_for(std::size_t{0}, count,
-                      [&](std::size_t i) { decoded[i] = DecodePage(v, first + i, name, nullptr); });
+    ParallelChunks(count, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        decoded[i] = DecodePage(v, first + i, name, nullptr);
+    });
     std::vector<const SvoChunk*> pages;
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t p = first + i;
