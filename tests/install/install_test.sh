@@ -3,7 +3,8 @@
 # against svokit::reader (find_package(svokit COMPONENTS reader)) in Debug and in Release, through
 # pkg-config (svokit-reader.pc), and against the whole library (svokit::svokit, with every other
 # component found). The reader's consumers must name none of the build stages' dependencies, and
-# their configure must print no warning. Then checks the installed tools and the examples against
+# their configure must print no warning; so must examples/voxel_colors and pages_near_camera (the
+# streaming reader's consumers). Then checks the installed tools and the examples against
 # each other: the per-level node counts against svo-inspect --json (parsed by python3), every
 # consumer's output alike, and the installed mesh2svo's TIFF texture decoding through the plugin.
 # Usage: install_test.sh SOURCE_DIR BUILD_DIR
@@ -44,13 +45,15 @@ foreign='cgal|draco|openmesh|openimageio|oiio|openvdb|tbb|embree'
 # in each configuration; its compile and link commands as the build ran them (-v).
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-for config in Debug Release; do
+for build in read_svo:Debug read_svo:Release voxel_colors:Release pages_near_camera:Release; do
+  example="${build%:*}" config="${build#*:}"
   dir="$work/example-$config"
-  cmake -S "$src/examples/read_svo" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=$config \
+  [ "$example" = read_svo ] || dir="$work/$example"
+  cmake -S "$src/examples/$example" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=$config \
     -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
     -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -DCMAKE_CXX_FLAGS="-Wall -Wextra -Werror" \
     >"$dir.configure.log" 2>&1 ||
-    { cat "$dir.configure.log" >&2; fail "configuring examples/read_svo ($config) against $prefix"; }
+    { cat "$dir.configure.log" >&2; fail "configuring examples/$example ($config) against $prefix"; }
   found="$(sed -n 's/^svokit_DIR:PATH=//p' "$dir/CMakeCache.txt")"
   [ "$found" = "$prefix/lib/cmake/svokit" ] || fail "find_package(svokit) found '$found'"
   if grep -n "CMake Warning" "$dir.configure.log"; then
@@ -60,11 +63,11 @@ for config in Debug Release; do
     fail "find_package(svokit COMPONENTS reader) looked for a build stage's dependency ($config)"
   fi
   cmake --build "$dir" --verbose >"$dir.build.log" 2>&1 ||
-    { cat "$dir.build.log" >&2; fail "building examples/read_svo ($config) against $prefix"; }
+    { cat "$dir.build.log" >&2; fail "building examples/$example ($config) against $prefix"; }
   # The commands, with this test's own folder names taken out (they are random).
   commands="$(sed "s|$work|WORK|g" "$dir.build.log" "$dir/compile_commands.json")"
   if grep -inE "$foreign" <<<"$commands"; then
-    fail "the reader's consumer ($config) compiles or links with a build stage's dependency"
+    fail "the reader's consumer $example ($config) compiles or links with a build stage's dependency"
   fi
 done
 
@@ -128,6 +131,18 @@ for out in "$work"/example-Debug_read_svo.txt "$work"/read_svo_pc.txt "$work"/wh
   cmp -s "$release" "$out" || fail "$(basename "$out") differs from the Release build's output:
 $(diff "$release" "$out" | head -20)"
 done
+
+# The streaming examples: every voxel once, with its colour and normal; a camera's pages through a
+# cache of 1 MiB.
+"$work/voxel_colors/voxel_colors" "$work/torus.svo" --memory-limit 64 >"$work/voxels.txt" ||
+  fail "voxel_colors torus.svo"
+"$work/pages_near_camera/pages_near_camera" "$work/torus.svo" 4 1e9 1 >"$work/camera.txt" ||
+  fail "pages_near_camera torus.svo"
+grep -q "^stop 3 pages 1 " "$work/camera.txt" ||
+  fail "pages_near_camera: $(cat "$work/camera.txt")"
+voxels_listed="$(awk 'NF == 9 { n++ } END { print n + 0 }' "$work/voxels.txt")"
+[ "$voxels_listed" = "$(sed -n 's/^voxels \([0-9]*\)$/\1/p' "$release")" ] ||
+  fail "voxel_colors listed $voxels_listed voxels with colour and normal, read_svo $(grep '^voxels' "$release")"
 
 python3 - "$work/inspect.json" "$release" <<'PY'
 import json, sys
