@@ -90,11 +90,11 @@ void BrickLines(std::string& out, const SvoStats& st) {
   }
   const BrickStats& b = st.bricks;
   Line(out, "bricks",
-       fmt::format(
-           "{0}x{0}x{0}{1}{2}, {3} {4}, {5:.1f} % empty", st.brick_side,
-           st.has_color ? ", colour" : "", st.has_normal ? ", normals" : "", b.samples,
-           b.distinct ? "samples stored (above the voxels, each lattice point once a page)" : "samples",
-           100.0 * Share(b.empty, b.samples)));
+       fmt::format("{0}x{0}x{0}{1}{2}, {3} {4}, {5:.1f} % empty", st.brick_side,
+                   st.has_color ? ", colour" : "", st.has_normal ? ", normals" : "", b.samples,
+                   b.distinct ? "samples stored (above the voxels, each lattice point once a page)"
+                              : "samples",
+                   100.0 * Share(b.empty, b.samples)));
   Line(out, "opacity",
        fmt::format("{:.3f} .. {:.3f}, mean {:.3f}", b.opacity.min, b.opacity.max, b.opacity.mean));
   if (st.has_color) {
