@@ -98,19 +98,18 @@ inline std::size_t MostInFlight() {
 /// How many items of `item` bytes a streaming run (ParallelInOrder) may have in flight within
 /// `limit` bytes (0: no limit), besides `fixed` bytes it holds throughout: as many as fit, at most
 /// MostInFlight(). A limit below fixed + `least` (what the run needs at its peak, at
-/// least one item) is an error naming the smallest limit that works; `needs` says what needs it
-/// ("its bins and one page").
+/// least one item) is an error naming the smallest limit that works; `input` says what the run
+/// works through ("this mesh and grid"), `needs` what needs it ("its bins and one page").
 inline StatusOr<std::size_t> InFlightWithin(std::uint64_t limit, std::uint64_t fixed,
                                             std::uint64_t item, std::uint64_t least,
-                                            std::string_view needs) {
+                                            std::string_view input, std::string_view needs) {
   const std::size_t most = MostInFlight();
   if (limit == 0) return most;
   if (limit < fixed + least) {
     const std::uint64_t mib = (fixed + least + (1 << 20) - 1) >> 20;
     return Status::BadInput(
-        "a memory limit of {} MiB is too small for this mesh and grid: {} need {} MiB (give "
-        "{}M or more)",
-        limit >> 20, needs, mib, mib);
+        "a memory limit of {} MiB is too small for {}: {} need {} MiB (give {}M or more)",
+        limit >> 20, input, needs, mib, mib);
   }
   return std::clamp<std::size_t>((limit - fixed) / item, 1, most);
 }

@@ -157,9 +157,8 @@ StatusOr<VoxelSet> WithInteriorVoxels(VoxelSet voxels, const InteriorCubes& inte
 
 namespace {
 
-// The format `path` names, if it is one, and not a directory; the level, if the octree has it.
-StatusOr<std::string> CheckExport(const std::filesystem::path& path, std::uint32_t level,
-                                  std::uint32_t depth) {
+// The format `path` names, if it is one, and not a directory.
+StatusOr<std::string> CheckExport(const std::filesystem::path& path) {
   const std::string ext = LowerExtension(path);
   const auto& known = ExportExtensions();
   if (std::find(known.begin(), known.end(), ext) == known.end()) {
@@ -170,10 +169,6 @@ StatusOr<std::string> CheckExport(const std::filesystem::path& path, std::uint32
   if (std::filesystem::is_directory(path, ec)) {
     return Status::BadInput("{}: is a directory, not a file", path.string());
   }
-  if (level > depth) {
-    return Status::BadInput("{}: level {} does not exist (the octree has levels 0 to {})",
-                            path.string(), level, depth);
-  }
   return ext;
 }
 
@@ -181,8 +176,12 @@ StatusOr<std::string> CheckExport(const std::filesystem::path& path, std::uint32
 
 Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const ExportOptions& options) {
   const std::uint32_t level = options.level.value_or(svo.depth);
-  StatusOr<std::string> ext = CheckExport(path, level, svo.depth);
+  StatusOr<std::string> ext = CheckExport(path);
   if (!ext.ok()) return ext.status();
+  if (level > svo.depth) {
+    return Status::BadInput("{}: level {} does not exist (the octree has levels 0 to {})",
+                            path.string(), level, svo.depth);
+  }
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
   }
@@ -213,7 +212,7 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
     return Status::BadInput("{}: level {} exceeds the octree's depth {}", reader.name(), level,
                             reader.depth());
   }
-  StatusOr<std::string> ext = CheckExport(path, level, reader.depth());
+  StatusOr<std::string> ext = CheckExport(path);
   if (!ext.ok()) return ext.status();
   if (!ExportStreams(reader, path)) {
     return Status::BadInput("{}: a .vox or a solid's export takes the octree whole", path.string());

@@ -133,12 +133,10 @@ struct LevelTally {
   ContourTally contours;                       // over the words of the nodes that have one
   std::array<std::uint64_t, 10> contour_extent{};
 
-  void AddMasks(std::span<const std::uint8_t> masks) {
-    for (const std::uint8_t m : masks) {
-      const int k = std::popcount(static_cast<unsigned>(m));
-      children += static_cast<std::uint64_t>(k);
-      if (k > 0) ++by_children[static_cast<std::size_t>(k - 1)];
-    }
+  void AddMask(std::uint8_t mask) {
+    const int k = std::popcount(static_cast<unsigned>(mask));
+    children += static_cast<std::uint64_t>(k);
+    if (k > 0) ++by_children[static_cast<std::size_t>(k - 1)];
   }
   void AddContours(std::span<const std::uint32_t> words) {
     for (const std::uint32_t w : words) {
@@ -242,7 +240,7 @@ SvoStats ComputeSvoStats(const Svo& svo) {
         t.leaves += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(n.leaf_mask)));
       }
     }
-    for (const SvoNode& n : lv.nodes) t.AddMasks(std::span(&n.child_mask, 1));
+    for (const SvoNode& n : lv.nodes) t.AddMask(n.child_mask);
     t.AddContours(lv.contours);
   }
   FinishStats(tallies, svo.brick_side == 0 ? SampleCounts() : CountSamples(svo), false, st);
@@ -266,7 +264,9 @@ ChunkTally TallyChunk(const SvoChunk& chunk, const SvoShape& shape, std::uint32_
     LevelTally& t = out.levels[l];
     t.nodes = chunk.tree.NodeCount(l);
     if (l == shape.depth) t.leaves = t.nodes;
-    if (l < shape.depth) t.AddMasks(chunk.tree.masks[k]);
+    if (l < shape.depth) {
+      for (const std::uint8_t m : chunk.tree.masks[k]) t.AddMask(m);
+    }
     t.AddContours(chunk.contours[k]);
     if (shape.brick_side != 0 && k < chunk.samples.size()) {
       const LevelSamples& s = chunk.samples[k];

@@ -289,7 +289,7 @@ Status PagePlan::SetLimit(std::uint64_t fixed, std::uint64_t memory_limit, const
                                mesh_->triangles.size())
                  : fmt::format("{} and one page", what);
   const StatusOr<std::size_t> in_flight =
-      InFlightWithin(memory_limit, fixed, page, std::max(page, top), needs);
+      InFlightWithin(memory_limit, fixed, page, std::max(page, top), "this mesh and grid", needs);
   if (!in_flight.ok()) return in_flight.status();
   in_flight_ = *in_flight;
   return Status::Ok();

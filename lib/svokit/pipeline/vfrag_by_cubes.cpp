@@ -20,8 +20,8 @@ StatusOr<std::uint64_t> WriteVfragByCubes(const RegionVoxelizer& voxelizer, cons
   // surface's voxels across it with their keys and attributes (~24 B a voxel).
   const std::uint64_t fixed = voxelizer.bytes() + bins.bytes();
   const std::uint64_t cube = std::uint64_t{24} * 4 << (2 * kCubeBits);
-  const StatusOr<std::size_t> in_flight =
-      InFlightWithin(memory_limit, fixed, cube, cube, "its bins and one cube");
+  const StatusOr<std::size_t> in_flight = InFlightWithin(
+      memory_limit, fixed, cube, cube, "this mesh and grid", "its bins and one cube");
   if (!in_flight.ok()) return in_flight.status();
 
   const VoxelizeOptions& options = voxelizer.options();

@@ -170,20 +170,20 @@ StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts) const {
   if (i >= page_count()) {
     return Status::BadInput("{}: page {} of {} does not exist", name(), i, page_count());
   }
-  return svo_detail::DecodePage(state_->v, i, name(), nullptr, parts);
+  StatusOr<SvoChunk> page = svo_detail::DecodePage(state_->v, i, name(), nullptr, parts);
+  // Bytes given to FromBytes are the caller's, not a mapping of the reader's own.
+  if (state_->mapped) {
+    const svo_detail::Version2::Page& p = state_->v.pages[i];
+    const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
+    ReleaseMappedFilePages(begin, begin + p.size);
+  }
+  return page;
 }
 
 StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
   const svo_detail::Version2::Page& p = state_->v.pages.at(i);
   return ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),
                           fmt::format("{}: page {}", name(), i));
-}
-
-void SvoReader::ReleasePageBytes(std::size_t i) const {
-  if (!state_->mapped || i >= page_count()) return;
-  const svo_detail::Version2::Page& p = state_->v.pages[i];
-  const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
-  ReleaseMappedFilePages(begin, begin + p.size);
 }
 
 SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,

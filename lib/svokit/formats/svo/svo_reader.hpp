@@ -69,11 +69,9 @@ class SvoReader {
 
   /// The top chunk (no levels when the page level is 0).
   StatusOr<SvoChunk> Top(ChunkParts parts = ChunkParts::kAll) const;
-  /// Page i, checked.
+  /// Page i, checked. Its mapped file bytes go back to the kernel once it is decoded (read again
+  /// if touched), so a pass over every page holds only the pages in flight.
   StatusOr<SvoChunk> Page(std::size_t i, ChunkParts parts = ChunkParts::kAll) const;
-  /// Gives page i's mapped file bytes back to the kernel (they are read again if touched), so a
-  /// pass over every page holds only the pages in flight; nothing for bytes given to FromBytes.
-  void ReleasePageBytes(std::size_t i) const;
 
  private:
   struct State;

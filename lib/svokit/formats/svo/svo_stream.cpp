@@ -76,16 +76,9 @@ StatusOr<SvoStreamPlan> PlanStream(
     plan.largest_page = std::max(plan.largest_page, *bytes);
     item = std::max(item, per_page ? per_page(*bytes, reader.page(i).voxels) : *bytes);
   }
-  if (options.memory_limit != 0 && options.memory_limit < item) {
-    const std::uint64_t mib = (item + (1 << 20) - 1) >> 20;
-    return Status::BadInput(
-        "{}: a memory limit of {} MiB is too small to read this file: its largest page needs {} "
-        "MiB (give {}M or more)",
-        reader.name(), options.memory_limit >> 20, mib, mib);
-  }
-  StatusOr<std::size_t> in_flight =
-      InFlightWithin(options.memory_limit, 0, item, item, "its largest page");
-  if (!in_flight.ok()) return in_flight.status();
+  StatusOr<std::size_t> in_flight = InFlightWithin(options.memory_limit, 0, item, item, "this file",
+                                                   "the pages in flight (one at least)");
+  if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
   plan.in_flight = *in_flight;
   return plan;
 }
@@ -104,7 +97,6 @@ StatusOr<std::shared_ptr<const SvoChunk>> SvoPageCache::Page(std::size_t i) {
     ++misses_;
   }
   StatusOr<SvoChunk> decoded = reader_.Page(i);
-  reader_.ReleasePageBytes(i);
   if (!decoded.ok()) return decoded.status();
   auto chunk = std::make_shared<const SvoChunk>(std::move(*decoded));
   const std::uint64_t bytes = ChunkHeldBytes(*chunk);
@@ -137,6 +129,13 @@ std::uint64_t SvoPageCache::misses() const {
 
 namespace {
 
+// A level deeper than the octree is refused, as ReadSvoStage words it.
+Status CheckLevel(const SvoReader& reader, std::uint32_t level) {
+  if (level <= reader.depth()) return Status::Ok();
+  return Status::BadInput("{}: level {} exceeds the octree's depth {}", reader.name(), level,
+                          reader.depth());
+}
+
 // The keys of `level` in `chunk` (root_level ≤ level ≤ its last level).
 std::vector<std::uint64_t> ChunkLevelKeys(const SvoChunk& chunk, std::uint32_t level) {
   return std::move(TreeLevelKeys(chunk.tree, chunk.root_key, level).back());
@@ -161,10 +160,7 @@ SvoVoxelPage VoxelPageOf(std::size_t page, SvoChunk& chunk, std::uint32_t level,
 Status ForEachVoxelPage(const SvoReader& reader, std::uint32_t level,
                         const SvoStreamOptions& options,
                         const std::function<Status(SvoVoxelPage&)>& visit, Progress::Stage* stage) {
-  if (level > reader.depth()) {
-    return Status::BadInput("{}: level {} is below the octree's depth {}", reader.name(), level,
-                            reader.depth());
-  }
+  SVOKIT_RETURN_IF_ERROR(CheckLevel(reader, level));
   if (level < reader.page_level()) {
     StatusOr<SvoChunk> top = reader.Top();
     if (!top.ok()) return top.status();
@@ -188,10 +184,7 @@ Status ForEachLevelPage(const SvoReader& reader, std::uint32_t level, bool brick
                         const SvoStreamOptions& options,
                         const std::function<Status(std::size_t page, SvoChunkLevel&)>& visit,
                         Progress::Stage* stage) {
-  if (level > reader.depth()) {
-    return Status::BadInput("{}: level {} is below the octree's depth {}", reader.name(), level,
-                            reader.depth());
-  }
+  SVOKIT_RETURN_IF_ERROR(CheckLevel(reader, level));
   SvoShape shape = reader.shape();
   if (!bricks) shape.brick_side = 0;
   if (level < reader.page_level()) {

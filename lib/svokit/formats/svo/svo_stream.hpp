@@ -3,8 +3,8 @@
 // on in key order, no more in flight than fit the bound; SvoPageCache keeps decoded pages for
 // reads in any order (a renderer's pages near the camera), least recently used first out, bounded
 // in bytes; ForEachVoxelPage and ForEachLevelPage give a level's voxels or nodes page by page. A
-// page's file bytes are given back to the kernel once decoded, so a pass over a whole file holds
-// no more than its pages in flight.
+// page's file bytes are given back to the kernel once decoded (SvoReader::Page), so a pass over a
+// whole file holds no more than its pages in flight.
 
 #include <cstdint>
 #include <functional>
@@ -76,7 +76,6 @@ Status StreamPages(const SvoReader& reader, const SvoStreamPlan& plan, const Mak
       [&](std::size_t k) {
         const std::size_t page = plan.pages[k];
         StatusOr<SvoChunk> chunk = reader.Page(page, plan.parts);
-        reader.ReleasePageBytes(page);
         if (!chunk.ok()) return Item{page, chunk.status()};
         return Item{page, make(page, std::move(*chunk))};
       },
