@@ -22,6 +22,7 @@ struct BakeCli {
   std::string method = "cones";
   std::optional<double> distance;
   std::uint32_t rays = 1024;
+  app::MemoryLimitOption memory_limit;
 
   void Add(CLI::App& cli) {
     ConeOptions& cones = request.cones;
@@ -81,6 +82,9 @@ struct BakeCli {
                    "error against that (at most 65536)")
         ->check(app::AtMost(kMaxAoRays))
         ->option_text("N");
+    memory_limit.Add(cli,
+                     "Bytes of decoded pages the cones read through, e.g. 512M (default 256M): "
+                     "pages are read as cones reach them and kept, least recently used first out");
   }
 
   // Option combinations refused before any work; then the request is complete.
@@ -108,6 +112,9 @@ struct BakeCli {
     if (!r.texture_out.empty() && (r.texture_size < 1 || r.texture_size > 16384)) {
       return Status::BadInput("--size {}: must be 1..16384", r.texture_size);
     }
+    StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
+    if (!limit.ok()) return limit.status();
+    request.memory_limit = limit->value_or(0);
     request.cones.distance = distance.value_or(0);
     if (method == "rays") request.rays = rays;
     return Status::Ok();
@@ -124,6 +131,9 @@ void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress
       "cones       {} (aperture x{}), distance {:.6g}, falloff {}, offset {} voxel diagonals{}\n",
       c.cones, c.aperture, c.distance, c.falloff, c.offset,
       c.jitter_seed ? fmt::format(", jitter seed {}", *c.jitter_seed) : std::string());
+  fmt::print("pages       {} read by the cones, at most {:.1f} MiB held of {:.0f} MiB\n",
+             report.pages_decoded, static_cast<double>(report.cache_peak) / (1 << 20),
+             static_cast<double>(report.cache_capacity) / (1 << 20));
   if (report.octree) {
     fmt::print("voxels      {} traced, mean AO {:.4f}\n", report.octree->count,
                report.octree->mean_ao);

@@ -1,4 +1,5 @@
 // What svo-bake bakes into: node AO as the mean of the voxels below (recomputed from the keys),
+// the same file at every memory limit down to the least accepted,
 // the AOCC section read back whole and down to a level, UV texels and their dilated gutters, and
 // the check that a mesh is the octree's.
 
@@ -7,6 +8,7 @@
 #include <map>
 
 #include "svokit/bake/ao_bake.hpp"
+#include "svokit/bake/bake_svo.hpp"
 #include "svokit/core/bytes.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/mesh_import.hpp"
@@ -20,11 +22,12 @@
 namespace svokit::test {
 namespace {
 
-// The sample torus (UVs, a texture) at 48³, written as a file, read back and baked at its voxels.
+// The sample torus (UVs, a texture) at 48³, written as a file, baked into a copy by svo-bake's
+// run, both read back; and its voxels traced again on their own.
 struct BakedTorus {
   TempDir dir;
-  std::filesystem::path plain;
-  Svo svo;
+  std::filesystem::path plain, baked;
+  Svo svo;  ///< the baked file, read whole
   std::vector<float> voxel_ao;
 };
 const BakedTorus& Torus48() {
@@ -41,24 +44,41 @@ const BakedTorus& Torus48() {
         BuildCompactSvo(std::move(*voxels), &*mesh, BuildOptions{}, R"({"source":"torus"})");
     EXPECT_TRUE(compact.ok());
     b->plain = b->dir / "plain.svo";
+    b->baked = b->dir / "baked.svo";
     EXPECT_TRUE(WriteSvo(*compact, b->plain).ok());
-    StatusOr<Svo> read = ReadSvo(b->plain);
+    AoBakeRequest request;
+    request.input = b->plain;
+    request.output = b->baked;
+    request.cones.distance = 2.5;
+    const StatusOr<AoBakeReport> report = BakeSvoAo(request);
+    EXPECT_TRUE(report.ok()) << report.status().message();
+    StatusOr<Svo> read = ReadSvo(b->baked);
     EXPECT_TRUE(read.ok());
-    BakedTorus* out = b;
     b->svo = std::move(*read);
-    ConeOptions options;
-    options.distance = 2.5;
-    StatusOr<ConeTracer> tracer = ConeTracer::Make(b->svo, options);
-    StatusOr<std::vector<AoPoint>> points = VoxelPoints(b->svo);
-    EXPECT_TRUE(tracer.ok() && points.ok());
+    // The one page's voxels (48³ is below a page), traced apart from the bake.
+    StatusOr<SvoReader> reader = SvoReader::Open(b->plain);
+    EXPECT_TRUE(reader.ok() && reader->page_count() == 1);
+    StatusOr<std::unique_ptr<TraceOctree>> octree = TraceOctree::Open(*reader, 0);
+    EXPECT_TRUE(octree.ok());
+    StatusOr<ConeTracer> tracer = ConeTracer::Make(**octree, request.cones);
+    StatusOr<SvoChunk> page = reader->Page(0);
+    EXPECT_TRUE(tracer.ok() && page.ok());
+    StatusOr<std::vector<AoPoint>> points = VoxelPoints(*page, reader->shape(), reader->grid());
+    EXPECT_TRUE(points.ok());
     b->voxel_ao = tracer->Occlusion(*points);
-    SetNodeAo(b->voxel_ao, b->svo);
-    return out;
+    return b;
   }();
   return baked;
 }
 
-TEST(SetNodeAo, ANodeHoldsTheMeanOfItsVoxels) {
+// Every level's AO of `svo`.
+std::vector<std::vector<std::uint8_t>> AoLevels(const Svo& svo) {
+  std::vector<std::vector<std::uint8_t>> ao;
+  for (const SvoLevel& level : svo.levels) ao.push_back(level.ao);
+  return ao;
+}
+
+TEST(NodeAo, ANodeHoldsTheMeanOfItsVoxels) {
   const Svo& svo = Torus48().svo;
   ASSERT_TRUE(svo.has_ao);
   const std::vector<std::uint64_t> voxels = svo.LevelKeys(svo.depth);
@@ -90,7 +110,7 @@ TEST(AoSection, ReadsBackWholeAndDownToALevel) {
   const std::filesystem::path plain = Torus48().plain, out = dir / "baked.svo";
   BakeSettings bake;
   bake.distance = 2;
-  ASSERT_TRUE(WriteBakedSvo(plain, baked, bake, out).ok());
+  ASSERT_TRUE(WriteBakedSvo(plain, AoLevels(baked), bake, out).ok());
   StatusOr<Svo> whole = ReadSvo(out);
   ASSERT_TRUE(whole.ok()) << whole.status().message();
   ASSERT_TRUE(whole->has_ao);
@@ -104,7 +124,7 @@ TEST(AoSection, ReadsBackWholeAndDownToALevel) {
   // The plain file has none; baking again replaces the section.
   EXPECT_FALSE(ReadSvo(plain)->has_ao);
   bake.cones = 5;
-  ASSERT_TRUE(WriteBakedSvo(out, baked, bake, dir / "again.svo").ok());
+  ASSERT_TRUE(WriteBakedSvo(out, AoLevels(baked), bake, dir / "again.svo").ok());
   StatusOr<Svo> again = ReadSvo(dir / "again.svo");
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->levels.back().ao, baked.levels.back().ao);
@@ -251,22 +271,20 @@ TEST(CheckMeshMatchesOctree, OnlyTheOctreesOwnMeshPasses) {
        }())}};
   for (int form = 0; form < 2; ++form) {
     SCOPED_TRACE(forms[0][form]);
-    Svo svo = Torus48().svo;
-    svo.metadata = forms[0][form];
-    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+    const GridTransform& grid = Torus48().svo.grid;
+    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, grid, forms[0][form], "uv-torus.obj").ok());
     Mesh moved = *torus;
     for (Vec3d& p : moved.positions) p.x += 1e-3;
-    const Status s = CheckMeshMatchesOctree(moved, svo, "moved.obj");
+    const Status s = CheckMeshMatchesOctree(moved, grid, forms[0][form], "moved.obj");
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.message().find("moved.obj"), std::string::npos);
-    EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), svo, "sphere").ok());
+    EXPECT_FALSE(CheckMeshMatchesOctree(Icosphere(2), grid, forms[0][form], "sphere").ok());
     // Same bounds, another triangle count (one triangle dropped, its corners still used).
-    svo.metadata = forms[1][form];
-    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, svo, "uv-torus.obj").ok());
+    EXPECT_TRUE(CheckMeshMatchesOctree(*torus, grid, forms[1][form], "uv-torus.obj").ok());
     Mesh fewer = *torus;
     fewer.triangles.pop_back();
     fewer.material_ids.pop_back();
-    const Status count = CheckMeshMatchesOctree(fewer, svo, "fewer.obj");
+    const Status count = CheckMeshMatchesOctree(fewer, grid, forms[1][form], "fewer.obj");
     ASSERT_FALSE(count.ok());
     EXPECT_NE(count.message().find("has 2303 triangles, the octree's 2304"), std::string::npos)
         << count.message();

@@ -6,8 +6,17 @@
 #include <functional>
 #include <numbers>
 
+#include <memory>
+#include <optional>
+
 #include "svokit/bake/cone_tracer.hpp"
+#include "svokit/bake/trace_octree.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/build_options.hpp"
+#include "svokit/svo/compact_build.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
 #include "tests/inspect/scenes.hpp"
 
 namespace svokit::test {
@@ -33,9 +42,52 @@ inline Mesh BoxMesh(double a, double h) {
   return m;
 }
 
-/// An octree with 3³ bricks and normals (no contours: the tracer reads bricks only).
-inline Svo BakeScene(const Mesh& mesh, std::uint32_t resolution) {
-  return BuildScene(mesh, resolution, /*attributes=*/true, /*contours=*/false);
+/// An octree as svo-bake reads it: a file (in memory) opened for tracing.
+struct TraceScene {
+  std::vector<std::uint8_t> bytes;
+  std::optional<SvoReader> reader;
+  std::unique_ptr<TraceOctree> octree;
+  const GridTransform& grid() const { return reader->grid(); }
+};
+
+/// The file of `mesh` voxelized at `resolution` with colours and normals, built with `options`
+/// (3³ bricks; no contours: the tracer reads bricks only), a solid with `solid`, its pages read
+/// through a cache of `memory_limit` bytes (0: unbounded; no octree to trace without bricks).
+inline std::unique_ptr<TraceScene> BakeScene(const Mesh& mesh, std::uint32_t resolution,
+                                             std::uint64_t memory_limit = 0,
+                                             BuildOptions options = {.contours = false},
+                                             bool solid = false) {
+  auto scene = std::make_unique<TraceScene>();
+  auto grid = GridTransform::FitResolution(mesh.Bounds(), resolution);
+  EXPECT_TRUE(grid.ok());
+  if (!grid.ok()) return scene;
+  VoxelizeOptions vo;
+  vo.colors = vo.normals = true;
+  StatusOr<VoxelSet> voxels = Voxelize(mesh, *grid, vo);
+  EXPECT_TRUE(voxels.ok()) << voxels.status().message();
+  if (!voxels.ok()) return scene;
+  std::optional<InteriorCubes> interior;
+  if (solid) {
+    StatusOr<InteriorCubes> filled = FillInterior(mesh, *grid, voxels->keys);
+    EXPECT_TRUE(filled.ok()) << filled.status().message();
+    if (!filled.ok()) return scene;
+    interior.emplace(std::move(*filled));
+    options.interior = &*interior;
+  }
+  StatusOr<CompactSvo> svo =
+      BuildCompactSvo(std::move(*voxels), &mesh, options, R"({"source":"test"})");
+  EXPECT_TRUE(svo.ok()) << svo.status().message();
+  if (!svo.ok()) return scene;
+  scene->bytes = EncodeSvo(*svo);
+  StatusOr<SvoReader> reader = SvoReader::FromBytes(scene->bytes, "scene.svo");
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  if (!reader.ok()) return scene;
+  scene->reader.emplace(std::move(*reader));
+  if (options.brick_side == 0) return scene;  // nothing to trace
+  StatusOr<std::unique_ptr<TraceOctree>> octree = TraceOctree::Open(*scene->reader, memory_limit);
+  EXPECT_TRUE(octree.ok()) << octree.status().message();
+  if (octree.ok()) scene->octree = std::move(*octree);
+  return scene;
 }
 
 /// The exact cosine-weighted AO of a point whose rays leave at distance exit(d) along unit d

@@ -25,8 +25,8 @@ ConeOptions Options(std::uint32_t cones, double distance, double falloff) {
   return o;
 }
 
-float Cones(const Svo& svo, const ConeOptions& options, const AoPoint& point) {
-  StatusOr<ConeTracer> tracer = ConeTracer::Make(svo, options);
+float Cones(const TraceOctree& octree, const ConeOptions& options, const AoPoint& point) {
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(octree, options);
   EXPECT_TRUE(tracer.ok()) << tracer.status().message();
   return tracer.ok() ? tracer->Occlusion(point, 0) : -1.f;
 }
@@ -39,17 +39,17 @@ float Rays(const Mesh& mesh, double distance, double falloff, const AoPoint& poi
   return reference->Occlusion(points, {4096, distance, falloff, 7})[0];
 }
 
-const Svo& Plane256() {
-  static const Svo svo = BakeScene(PlaneMesh(), 256);
-  return svo;
+const TraceOctree& Plane256() {
+  static const auto scene = BakeScene(PlaneMesh(), 256);
+  return *scene->octree;
 }
-const Svo& Box256() {
-  static const Svo svo = BakeScene(BoxMesh(1, 1), 256);
-  return svo;
+const TraceOctree& Box256() {
+  static const auto scene = BakeScene(BoxMesh(1, 1), 256);
+  return *scene->octree;
 }
-const Svo& Sphere256() {
-  static const Svo svo = BakeScene(Icosphere(5), 256);
-  return svo;
+const TraceOctree& Sphere256() {
+  static const auto scene = BakeScene(Icosphere(5), 256);
+  return *scene->octree;
 }
 
 TEST(ConeTracer, APlaneOccludesNothingAboveIt) {
@@ -120,11 +120,11 @@ TEST(ConeTracer, AgreesWithRayTracedAoOnARealMesh) {
   }
   StatusOr<Mesh> mesh = ImportMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();
-  const Svo svo = BakeScene(*mesh, 512);
-  const Box3d bounds = svo.grid.GridBounds();
+  const auto scene = BakeScene(*mesh, 512);
+  const Box3d bounds = scene->grid().GridBounds();
   const double distance = 0.25 * Length(bounds.hi - bounds.lo);
   ConeOptions options = Options(8, distance, 1);
-  StatusOr<ConeTracer> tracer = ConeTracer::Make(svo, options);
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(*scene->octree, options);
   ASSERT_TRUE(tracer.ok());
   StatusOr<RayAoReference> reference = RayAoReference::Make(*mesh);
   ASSERT_TRUE(reference.ok());
@@ -172,7 +172,7 @@ TEST(ConeTracer, TheResultDoesNotDependOnTheThreadCount) {
 }
 
 TEST(ConeTracer, BadOptionsAreRefused) {
-  const Svo& svo = Plane256();
+  const TraceOctree& svo = Plane256();
   EXPECT_FALSE(ConeTracer::Make(svo, Options(4, 1, 0)).ok());
   EXPECT_FALSE(ConeTracer::Make(svo, Options(8, 0, 0)).ok());
   EXPECT_FALSE(ConeTracer::Make(svo, Options(8, -1, 0)).ok());
@@ -181,11 +181,12 @@ TEST(ConeTracer, BadOptionsAreRefused) {
   ConeOptions aperture = Options(8, 1, 0);
   aperture.aperture = 0;
   EXPECT_FALSE(ConeTracer::Make(svo, aperture).ok());
-  Svo bare = svo;
-  bare.brick_side = 0;
-  const StatusOr<ConeTracer> none = ConeTracer::Make(bare, Options(8, 1, 0));
+  // A file without bricks has nothing to trace.
+  const auto bare = BakeScene(PlaneMesh(), 64, 0, {.brick_side = 0, .contours = false});
+  const StatusOr<std::unique_ptr<TraceOctree>> none = TraceOctree::Open(*bare->reader, 0);
   ASSERT_FALSE(none.ok());
-  EXPECT_NE(none.status().message().find("no bricks"), std::string::npos);
+  EXPECT_NE(none.status().message().find("scene.svo: the octree has no bricks"), std::string::npos)
+      << none.status().message();
 }
 
 TEST(ConeConstellation, ConesCoverTheHemisphereAboveTheSurface) {

@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -36,10 +37,13 @@
 #include "svokit/bake/ao_bake.hpp"
 #include "svokit/bake/cone_tracer.hpp"
 #include "svokit/bake/ray_ao.hpp"
+#include "svokit/bake/trace_octree.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/mesh/image_codec.hpp"
 #include "svokit/svo/build_options.hpp"
-#include "svokit/svo/reference_build.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 
 namespace {
@@ -91,8 +95,15 @@ std::pair<std::vector<float>, double> Timed(int runs, const Fn& fn) {
   std::exit(2);
 }
 
-// The octree of `mesh` at 2^depth voxels along its longest axis: colours, normals, 3³ bricks.
-Svo Build(const Mesh& mesh, std::uint32_t depth) {
+// The octree of `mesh` at 2^depth voxels along its longest axis (colours, normals, 3³ bricks),
+// as svo-bake reads it: its file (in memory) opened for tracing, every page kept once read.
+struct Octree {
+  std::vector<std::uint8_t> bytes;
+  std::optional<SvoReader> reader;
+  std::unique_ptr<TraceOctree> trace;
+  std::uint64_t voxels = 0;
+};
+std::unique_ptr<Octree> Build(const Mesh& mesh, std::uint32_t depth) {
   auto grid = GridTransform::FitResolution(mesh.Bounds(), std::uint32_t{1} << depth);
   if (!grid.ok()) Fail(grid.status().message());
   VoxelizeOptions vo;
@@ -101,13 +112,22 @@ Svo Build(const Mesh& mesh, std::uint32_t depth) {
   if (!voxels.ok()) Fail(voxels.status().message());
   BuildOptions bo;
   bo.contours = false;
-  auto svo = BuildReferenceSvo(*voxels, nullptr, bo, R"({"source":"ao_bench"})");
+  auto svo = BuildCompactSvo(std::move(*voxels), nullptr, bo, R"({"source":"ao_bench"})");
   if (!svo.ok()) Fail(svo.status().message());
-  return std::move(*svo);
+  auto octree = std::make_unique<Octree>();
+  octree->bytes = EncodeSvo(*svo);
+  auto reader = SvoReader::FromBytes(octree->bytes, "ao_bench.svo");
+  if (!reader.ok()) Fail(reader.status().message());
+  octree->reader.emplace(std::move(*reader));
+  auto trace = TraceOctree::Open(*octree->reader, 0);
+  if (!trace.ok()) Fail(trace.status().message());
+  octree->trace = std::move(*trace);
+  octree->voxels = octree->reader->NodeCount(depth);
+  return octree;
 }
 
-ConeOptions DefaultCones(const Svo& svo, std::uint32_t cones) {
-  const Box3d b = svo.grid.GridBounds();
+ConeOptions DefaultCones(const Octree& octree, std::uint32_t cones) {
+  const Box3d b = octree.reader->grid().GridBounds();
   ConeOptions o;
   o.cones = cones;
   o.distance = kDistanceFraction * Length(b.hi - b.lo);
@@ -115,8 +135,8 @@ ConeOptions DefaultCones(const Svo& svo, std::uint32_t cones) {
   return o;
 }
 
-ConeTracer MakeTracer(const Svo& svo, const ConeOptions& options) {
-  auto tracer = ConeTracer::Make(svo, options);
+ConeTracer MakeTracer(const Octree& octree, const ConeOptions& options) {
+  auto tracer = ConeTracer::Make(*octree.trace, options);
   if (!tracer.ok()) Fail(tracer.status().message());
   return std::move(*tracer);
 }
@@ -344,7 +364,8 @@ int main(int argc, char** argv) {
     if (!embree.ok()) Fail(embree.status().message());
     const std::span<const AoPoint> points = l.points;
     for (std::uint32_t depth = l.spec.depth_lo; depth <= l.spec.depth_hi; ++depth) {
-      const Svo svo = Build(l.mesh, depth);
+      const std::unique_ptr<Octree> built = Build(l.mesh, depth);
+      const Octree& svo = *built;
       const ConeOptions base = DefaultCones(svo, 8);
       const RayAoOptions truth_options{reference_rays, base.distance, kFalloff, 0};
       const std::vector<float> truth = embree->Occlusion(points, truth_options);
@@ -356,8 +377,8 @@ int main(int argc, char** argv) {
         fmt::print(
             "{:<18} {:>5} {:>5} {:>5} {:>9} {:>8.4f} {:>8.4f} {:>8.4f} {:>7.4f} {:>7.4f} "
             "{:>13.0f}\n",
-            l.spec.name, depth, count, 1u << depth, svo.voxel_count(), e.mean, e.p95, e.max,
-            MeanAo(ao), MeanAo(truth), static_cast<double>(points.size()) / t);
+            l.spec.name, depth, count, 1u << depth, svo.voxels, e.mean, e.p95, e.max, MeanAo(ao),
+            MeanAo(truth), static_cast<double>(points.size()) / t);
         std::fflush(stdout);
         if (count == 8) cones8 = std::move(ao);
       }

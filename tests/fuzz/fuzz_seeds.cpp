@@ -211,14 +211,15 @@ std::vector<std::uint8_t> BakedSvo(const std::vector<std::uint8_t>& bytes) {
   auto svo = svokit::DecodeSvo(bytes, "seed");
   auto frame = svokit::container::Frame::FromBytes(bytes, "seed", svokit::kSvoFormat);
   if (!svo.ok() || !frame.ok()) return bytes;
-  for (svokit::SvoLevel& level : svo->levels) {
-    level.ao.resize(level.node_count);
-    for (std::size_t i = 0; i < level.ao.size(); ++i)
-      level.ao[i] = static_cast<std::uint8_t>(37 * i);
+  std::vector<std::vector<std::uint8_t>> ao;
+  for (const svokit::SvoLevel& level : svo->levels) {
+    std::vector<std::uint8_t>& bytes_of_level = ao.emplace_back(level.node_count);
+    for (std::size_t i = 0; i < bytes_of_level.size(); ++i)
+      bytes_of_level[i] = static_cast<std::uint8_t>(37 * i);
   }
   svokit::container::Writer writer(svokit::kSvoFormat, frame->flags());
   for (const auto& section : frame->sections()) writer.AddSectionView(section.tag, section.bytes);
-  writer.AddSection(svokit::container::MakeTag("AOCC"), svokit::svo_detail::EncodeAoSection(*svo));
+  writer.AddSection(svokit::container::MakeTag("AOCC"), svokit::svo_detail::EncodeAoSection(ao));
   return writer.Serialize();
 }
 

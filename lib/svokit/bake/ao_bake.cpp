@@ -13,6 +13,7 @@
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/provenance.hpp"
 #include "svokit/svo/sample_codec.hpp"
+#include "svokit/svo/svo_assembler.hpp"
 
 namespace svokit {
 
@@ -27,18 +28,17 @@ Vec3d Normalized(const Vec3d& v) {
 
 // The unit normal a voxel's brick holds: the centre sample's (side 3), or the opacity-weighted
 // mean of the corners' (side 2).
-Vec3d VoxelNormal(const Svo& svo, std::uint64_t voxel) {
-  const SvoLevel& level = svo.levels[svo.depth];
-  const std::uint32_t samples = svo.brick_samples();
+Vec3d VoxelNormal(const SvoLevel& bricks, std::uint32_t side, std::uint64_t voxel) {
+  const std::uint32_t samples = side * side * side;
   const std::uint64_t first = voxel * samples;
-  if (svo.brick_side == 3) {
-    const Vec3f n = DecodeNormal(level.normal[first + 13]);
+  if (side == 3) {
+    const Vec3f n = DecodeNormal(bricks.normal[first + 13]);
     return {n.x, n.y, n.z};
   }
   Vec3d sum{0, 0, 0};
   for (std::uint32_t s = 0; s < samples; ++s) {
-    const Vec3f n = DecodeNormal(level.normal[first + s]);
-    sum = sum + Vec3d{n.x, n.y, n.z} * DecodeUnorm8(level.opacity[first + s]);
+    const Vec3f n = DecodeNormal(bricks.normal[first + s]);
+    sum = sum + Vec3d{n.x, n.y, n.z} * DecodeUnorm8(bricks.opacity[first + s]);
   }
   return Normalized(sum);
 }
@@ -68,49 +68,57 @@ double MeanAo(std::span<const float> ao) {
   return ao.empty() ? 0 : sum / static_cast<double>(ao.size());
 }
 
-StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo) {
-  if (!svo.has_normal || svo.brick_side == 0) {
+StatusOr<std::vector<AoPoint>> VoxelPoints(const SvoChunk& page, const SvoShape& shape,
+                                           const GridTransform& grid) {
+  if (!shape.has_normal || shape.brick_side == 0) {
     return Status::BadInput(
         "the octree's voxels have no normals to bake along (voxelize it with normals)");
   }
-  const std::vector<std::uint64_t> keys = svo.LevelKeys(svo.depth);
+  // The voxel bricks' normals and opacity: colours are not derived.
+  SvoShape normals_only = shape;
+  normals_only.has_color = false;
+  normals_only.shared_color.clear();
+  SvoLevel bricks;
+  ChunkVoxelBricks(page, normals_only, bricks);
+  const std::vector<std::uint64_t> keys = ChunkVoxelKeys(page);
   std::vector<AoPoint> points(keys.size());
   ParallelChunks(keys.size(), 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const MortonCoord c = MortonDecode(keys[i]);
-      points[i] = {svo.grid.VoxelCenter(
-                       {static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)}),
-                   VoxelNormal(svo, i)};
+      points[i] = {
+          grid.VoxelCenter({static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)}),
+          VoxelNormal(bricks, shape.brick_side, i)};
     }
   });
   return points;
 }
 
-void SetNodeAo(std::span<const float> voxel_ao, Svo& svo) {
-  // Sums and counts of the encoded voxel AO below each node, level by level from the voxels up.
-  std::vector<std::uint64_t> sum(voxel_ao.size()), count(voxel_ao.size(), 1);
-  for (std::size_t i = 0; i < voxel_ao.size(); ++i) sum[i] = EncodeAo(voxel_ao[i]);
-  svo.levels[svo.depth].ao.resize(voxel_ao.size());
-  for (std::size_t i = 0; i < voxel_ao.size(); ++i) {
-    svo.levels[svo.depth].ao[i] = static_cast<std::uint8_t>(sum[i]);
-  }
-  for (std::uint32_t l = svo.depth; l-- > 0;) {
-    SvoLevel& level = svo.levels[l];
-    std::vector<std::uint64_t> up_sum(level.node_count), up_count(level.node_count);
-    level.ao.resize(level.node_count);
-    for (std::uint64_t i = 0; i < level.node_count; ++i) {
-      const SvoNode& node = level.nodes[i];
-      const std::uint32_t children = static_cast<std::uint32_t>(std::popcount(node.child_mask));
-      for (std::uint32_t c = 0; c < children; ++c) {
-        up_sum[i] += sum[node.first_child + c];
-        up_count[i] += count[node.first_child + c];
+std::vector<std::vector<std::uint8_t>> NodeAo(const MaskTree& tree, AoSums last, AoSums* root) {
+  const std::size_t levels = tree.masks.size() + 1;
+  std::vector<std::vector<std::uint8_t>> ao(levels);
+  auto mean = [](std::uint64_t sum, std::uint64_t count) {
+    return static_cast<std::uint8_t>((2 * sum + count) / (2 * count));
+  };
+  AoSums sums = std::move(last);
+  for (std::size_t k = levels; k-- > 0;) {
+    if (k + 1 < levels) {
+      // Each node's sums from its children's, in node order.
+      const std::vector<std::uint8_t>& masks = tree.masks[k];
+      AoSums up{std::vector<std::uint64_t>(masks.size()), std::vector<std::uint64_t>(masks.size())};
+      std::uint64_t child = 0;
+      for (std::size_t i = 0; i < masks.size(); ++i) {
+        for (int c = std::popcount(masks[i]); c-- > 0; ++child) {
+          up.sum[i] += sums.sum[child];
+          up.count[i] += sums.count[child];
+        }
       }
-      level.ao[i] = static_cast<std::uint8_t>((2 * up_sum[i] + up_count[i]) / (2 * up_count[i]));
+      sums = std::move(up);
     }
-    sum = std::move(up_sum);
-    count = std::move(up_count);
+    ao[k].resize(sums.sum.size());
+    for (std::size_t i = 0; i < sums.sum.size(); ++i) ao[k][i] = mean(sums.sum[i], sums.count[i]);
   }
-  svo.has_ao = true;
+  if (root != nullptr) *root = std::move(sums);
+  return ao;
 }
 
 std::vector<AoPoint> VertexPoints(const Mesh& mesh) {
@@ -329,8 +337,9 @@ Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<c
   return WriteFileAtomic(path, w.bytes());
 }
 
-Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name) {
-  const Provenance recorded = ParseProvenance(svo.metadata);
+Status CheckMeshMatchesOctree(const Mesh& mesh, const GridTransform& grid,
+                              const std::string& metadata, const std::string& mesh_name) {
+  const Provenance recorded = ParseProvenance(metadata);
   if (recorded.triangles > 0 && recorded.triangles != mesh.triangle_count()) {
     return Status::BadInput(
         "{}: the mesh has {} triangles, the octree's {}: not the mesh it was voxelized from",
@@ -339,11 +348,11 @@ Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::strin
   const Box3d bounds = mesh.Bounds();
   if (!recorded.grid) {
     // No recorded grid fit: the mesh must at least lie inside the grid.
-    if (svo.grid.Encloses(bounds)) return Status::Ok();
+    if (grid.Encloses(bounds)) return Status::Ok();
     return Status::BadInput("{}: the mesh lies outside the octree's grid: not its mesh", mesh_name);
   }
   const StatusOr<GridTransform> fitted = recorded.grid->Fit(bounds);
-  const GridTransform& g = svo.grid;
+  const GridTransform& g = grid;
   const double tolerance = 1e-6 * g.voxel_size();
   if (!fitted.ok() || fitted->dims() != g.dims() ||
       std::abs(fitted->voxel_size() - g.voxel_size()) > 1e-9 * g.voxel_size() ||

@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "svokit/bake/cone_tracer.hpp"
+#include "svokit/core/grid_transform.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
-#include "svokit/svo/svo.hpp"
+#include "svokit/svo/mask_tree.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 
 namespace svokit {
 
@@ -27,12 +29,20 @@ AoErrors CompareAo(std::span<const float> a, std::span<const float> b);
 /// The mean of per-point AO (0 for none).
 double MeanAo(std::span<const float> ao);
 
-/// The voxels of `svo` as bake points: centre and the voxel brick's normal (zero where a voxel has
-/// none). Bad input: an octree without normals.
-StatusOr<std::vector<AoPoint>> VoxelPoints(const Svo& svo);
-/// Sets every level's `ao` from the voxels' AO (VoxelPoints' order): a node's is the mean of the
-/// encoded AO of the voxels below it, rounded to nearest.
-void SetNodeAo(std::span<const float> voxel_ao, Svo& svo);
+/// The voxels of `page` (a page of a file of `shape`, decoded whole) as bake points: centre and
+/// the voxel brick's normal (zero where a voxel has none). Bad input: an octree without normals.
+StatusOr<std::vector<AoPoint>> VoxelPoints(const SvoChunk& page, const SvoShape& shape,
+                                           const GridTransform& grid);
+
+/// Per node of a level: the sum of the encoded AO of the voxels below it, and their count.
+struct AoSums {
+  std::vector<std::uint64_t> sum, count;
+};
+/// Every level's AO of `tree`, first_level .. last_level(), from its last level's sums (a voxel's:
+/// its encoded AO, count 1): a node's is the mean of the encoded AO of the voxels below it,
+/// rounded to nearest. `root`, when given, receives the root's sums.
+std::vector<std::vector<std::uint8_t>> NodeAo(const MaskTree& tree, AoSums last,
+                                              AoSums* root = nullptr);
 
 /// Each vertex with its normal: the sum of its triangles' area-weighted normals, normalized (a
 /// vertex of no triangle or of degenerate ones only gets +z).
@@ -64,10 +74,11 @@ std::vector<std::uint8_t> AoTexture(const TexelPoints& texels, std::span<const f
 Status WriteAoPly(const Mesh& mesh, std::span<const AoPoint> points, std::span<const float> ao,
                   const std::filesystem::path& path);
 
-/// Whether `mesh` is the mesh the octree was voxelized from: its triangle count must be the one
-/// the octree's metadata records (when it does), and the grid that the recorded voxelization
-/// options fit around its bounds must be the octree's grid. Bad input names `mesh_name` and what
-/// differs.
-Status CheckMeshMatchesOctree(const Mesh& mesh, const Svo& svo, const std::string& mesh_name);
+/// Whether `mesh` is the mesh the octree of `grid` and `metadata` was voxelized from: its triangle
+/// count must be the one the metadata records (when it does), and the grid that the recorded
+/// voxelization options fit around its bounds must be `grid`. Bad input names `mesh_name` and
+/// what differs.
+Status CheckMeshMatchesOctree(const Mesh& mesh, const GridTransform& grid,
+                              const std::string& metadata, const std::string& mesh_name);
 
 }  // namespace svokit

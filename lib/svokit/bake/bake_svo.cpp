@@ -8,6 +8,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/mesh/image_codec.hpp"
 
 namespace svokit {
@@ -48,7 +49,8 @@ Status CheckOutputs(const AoBakeRequest& r, const std::vector<std::filesystem::p
 
 // The mesh the outputs on it are baked at, checked to be the octree's; its warnings reported
 // and its side files checked against the outputs before anything is written.
-StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const Svo& svo, Progress& progress) {
+StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const SvoReader& octree,
+                               Progress& progress) {
   StatusOr<Mesh> mesh = ImportStage(progress, r.mesh, r.import);
   if (!mesh.ok()) return mesh.status();
   if (r.warn) {
@@ -59,7 +61,8 @@ StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const Svo& svo, Progress&
                             mesh->warnings.size(), mesh->warnings.size() == 1 ? "" : "s");
   }
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, mesh->side_files));
-  SVOKIT_RETURN_IF_ERROR(CheckMeshMatchesOctree(*mesh, svo, r.mesh.string()));
+  SVOKIT_RETURN_IF_ERROR(
+      CheckMeshMatchesOctree(*mesh, octree.grid(), octree.metadata(), r.mesh.string()));
   if (!r.texture_out.empty() && !mesh->has_uvs()) {
     return Status::BadInput("{}: the mesh has no texture coordinates for the texture",
                             r.mesh.string());
@@ -74,9 +77,9 @@ BakeSettings SettingsOf(const ConeOptions& cones) {
 
 class Baker {
  public:
-  Baker(const AoBakeRequest& r, Svo& svo, const ConeTracer& tracer, AoBakeReport& report,
-        Progress& progress)
-      : r_(r), svo_(svo), tracer_(tracer), report_(report), progress_(progress) {}
+  Baker(const AoBakeRequest& r, const TraceOctree& octree, const ConeTracer& tracer,
+        AoBakeReport& report, Progress& progress)
+      : r_(r), octree_(octree), tracer_(tracer), report_(report), progress_(progress) {}
 
   Status Run(const Mesh* mesh) {
     mesh_ = mesh;
@@ -102,21 +105,71 @@ class Baker {
                    : tracer_.Occlusion(points);
   }
 
+  // Page by page in key order: each page's voxels traced, their AO and their nodes' kept (a byte
+  // a node), the top levels' from the pages' sums at the end.
   Status Octree() {
-    StatusOr<std::vector<AoPoint>> points = VoxelPoints(svo_);
-    if (!points.ok()) {
-      return Status::BadInput("{}: {}", r_.input.string(), points.status().message());
+    const SvoReader& reader = octree_.reader();
+    const std::uint32_t page_level = reader.page_level();
+    std::vector<std::vector<std::uint8_t>> ao(reader.depth() + 1);
+    AoSums roots;
+    double ao_sum = 0;
+    std::uint64_t traced = 0;
+    {
+      Progress::Stage stage(progress_, "voxels", reader.page_count());
+      for (std::size_t i = 0; i < reader.page_count(); ++i) {
+        StatusOr<std::vector<float>> voxel_ao = TracePage(i);
+        if (!voxel_ao.ok()) {
+          stage.Cancel();
+          return voxel_ao.status();
+        }
+        AoSums voxels{std::vector<std::uint64_t>(voxel_ao->size()),
+                      std::vector<std::uint64_t>(voxel_ao->size(), 1)};
+        for (std::size_t v = 0; v < voxel_ao->size(); ++v) {
+          voxels.sum[v] = EncodeAo((*voxel_ao)[v]);
+          ao_sum += (*voxel_ao)[v];
+        }
+        traced += voxel_ao->size();
+        AoSums root;
+        const std::vector<std::vector<std::uint8_t>> levels =
+            NodeAo(page_tree_, std::move(voxels), &root);
+        for (std::size_t k = 0; k < levels.size(); ++k) {
+          std::vector<std::uint8_t>& to = ao[page_level + k];
+          to.insert(to.end(), levels[k].begin(), levels[k].end());
+        }
+        roots.sum.push_back(root.sum.at(0));
+        roots.count.push_back(root.count.at(0));
+        stage.Advance(1);
+      }
+      if (Status s = octree_.error(); !s.ok()) {
+        stage.Cancel();
+        return s;
+      }
     }
-    const std::vector<float> voxel_ao =
-        RunStage(progress_, "voxels", [&] { return tracer_.Occlusion(*points); });
-    SetNodeAo(voxel_ao, svo_);
+    if (page_level > 0) {
+      std::vector<std::vector<std::uint8_t>> top = NodeAo(octree_.top().tree, std::move(roots));
+      for (std::uint32_t l = 0; l < page_level; ++l) ao[l] = std::move(top[l]);
+    }
     SVOKIT_RETURN_IF_ERROR(RunStage(progress_, "write", [&] {
-      return WriteBakedSvo(r_.input, svo_, SettingsOf(report_.cones), r_.output);
+      return WriteBakedSvo(r_.input, ao, SettingsOf(report_.cones), r_.output);
     }));
-    report_.octree = AoBakeReport::Points{voxel_ao.size(), MeanAo(voxel_ao)};
+    report_.octree =
+        AoBakeReport::Points{traced, traced > 0 ? ao_sum / static_cast<double>(traced) : 0};
     std::error_code ec;
     report_.output_bytes = std::filesystem::file_size(r_.output, ec);
     return Status::Ok();
+  }
+
+  // The AO of page i's voxels, in their order; the page's tree kept in page_tree_.
+  StatusOr<std::vector<float>> TracePage(std::size_t i) {
+    const SvoReader& reader = octree_.reader();
+    StatusOr<SvoChunk> page = reader.Page(i);
+    if (!page.ok()) return page.status();
+    StatusOr<std::vector<AoPoint>> points = VoxelPoints(*page, reader.shape(), reader.grid());
+    if (!points.ok()) {
+      return Status::BadInput("{}: {}", r_.input.string(), points.status().message());
+    }
+    page_tree_ = std::move(page->tree);
+    return tracer_.Occlusion(*points);
   }
 
   Status Vertices() {
@@ -153,12 +206,13 @@ class Baker {
   }
 
   const AoBakeRequest& r_;
-  Svo& svo_;
+  const TraceOctree& octree_;
   const ConeTracer& tracer_;
   AoBakeReport& report_;
   Progress& progress_;
   const Mesh* mesh_ = nullptr;
   std::optional<RayAoReference> rays_;
+  MaskTree page_tree_;
 };
 
 }  // namespace
@@ -170,30 +224,41 @@ StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
     }
   }
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, {}));
-  // Cones read opacity alone; the octree's own bake starts at each voxel's normal.
-  StatusOr<Svo> svo = ReadSvoStage(progress, r.input, std::nullopt,
-                                   {.colors = false, .normals = !r.output.empty()});
-  if (!svo.ok()) return svo.status();
+  StatusOr<SvoReader> reader = SvoReader::Open(r.input);
+  if (!reader.ok()) return reader.status();
   AoBakeReport report;
-  report.depth = svo->depth;
-  report.voxels = svo->voxel_count();
+  report.depth = reader->depth();
+  report.voxels = reader->NodeCount(reader->depth());
   report.cones = r.cones;
   if (!(report.cones.distance > 0)) {
-    const Box3d grid = svo->grid.GridBounds();
+    const Box3d grid = reader->grid().GridBounds();
     report.cones.distance = kDefaultAoDistance * Length(grid.hi - grid.lo);
   }
-  StatusOr<ConeTracer> tracer = ConeTracer::Make(*svo, report.cones);
+  if (!r.output.empty() && !reader->shape().has_normal) {
+    return Status::BadInput(
+        "{}: the octree's voxels have no normals to bake along (voxelize it with normals)",
+        r.input.string());
+  }
+  StatusOr<std::unique_ptr<TraceOctree>> octree = RunStage(progress, "read", [&] {
+    return TraceOctree::Open(*reader, r.memory_limit > 0 ? r.memory_limit : kDefaultBakeMemory);
+  });
+  if (!octree.ok()) return octree.status();
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(**octree, report.cones);
   if (!tracer.ok()) {
     return Status::BadInput("{}: {}", r.input.string(), tracer.status().message());
   }
   std::optional<Mesh> mesh;
   if (!r.vertex_out.empty() || !r.texture_out.empty() || r.reference) {
-    StatusOr<Mesh> imported = ImportBakedMesh(r, *svo, progress);
+    StatusOr<Mesh> imported = ImportBakedMesh(r, *reader, progress);
     if (!imported.ok()) return imported.status();
     mesh = std::move(*imported);
   }
-  Baker baker(r, *svo, *tracer, report, progress);
+  Baker baker(r, **octree, *tracer, report, progress);
   SVOKIT_RETURN_IF_ERROR(baker.Run(mesh ? &*mesh : nullptr));
+  SVOKIT_RETURN_IF_ERROR((*octree)->error());
+  report.cache_capacity = (*octree)->cache_capacity();
+  report.cache_peak = (*octree)->cache_peak();
+  report.pages_decoded = (*octree)->cache_misses();
   return report;
 }
 

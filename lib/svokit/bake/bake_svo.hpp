@@ -25,6 +25,8 @@ struct AoBakeRequest {
   std::filesystem::path texture_out;  ///< an AO map over the mesh's UVs; may be empty
   int texture_size = 2048;
   ConeOptions cones;  ///< distance 0: kDefaultAoDistance of the grid's diagonal
+  /// Bytes of decoded pages the cones read through (TraceOctree; 0: kDefaultBakeMemory).
+  std::uint64_t memory_limit = 0;
   /// What the mesh's outputs hold: cones through the octree, or this many rays per point
   /// (Embree on the mesh: the reference).
   std::optional<std::uint32_t> rays;
@@ -38,6 +40,9 @@ struct AoBakeRequest {
 /// The most rays per point of `rays` and `reference`: Monte Carlo noise 1/256 of one ray's, while
 /// a billion would trace for days.
 inline constexpr std::uint32_t kMaxAoRays = 65536;
+
+/// The pages cone tracing holds when no memory limit is given.
+inline constexpr std::uint64_t kDefaultBakeMemory = std::uint64_t{256} << 20;
 
 /// How far occluders count by default: this fraction of the diagonal of the octree's grid.
 inline constexpr double kDefaultAoDistance = 0.25;
@@ -54,14 +59,17 @@ struct AoBakeReport {
   std::uint64_t output_bytes = 0;  ///< the output octree's size
   std::optional<Points> vertices;  ///< traced for the vertex output or the reference
   std::optional<double> reference_mean_ao;
-  AoErrors reference_errors;     ///< the vertices' against the reference
-  std::optional<Points> texels;  ///< covered texels of the texture
+  AoErrors reference_errors;                         ///< the vertices' against the reference
+  std::optional<Points> texels;                      ///< covered texels of the texture
+  std::uint64_t cache_capacity = 0, cache_peak = 0;  ///< the pages' cache, in bytes
+  std::uint64_t pages_decoded = 0;                   ///< by the cones (again after eviction)
 };
 
-/// Reads the octree, imports the mesh (checked to be the one the octree was made from), bakes
-/// and writes every output asked for. Outputs and ray counts (1 to kMaxAoRays) are checked before
-/// any work; an output is refused when it is an input: the octree, the mesh, a side file its
-/// import read, or another output.
+/// Opens the octree (a paged file: pages are read as cones reach them, and for the octree's own
+/// bake one at a time, within `memory_limit`), imports the mesh (checked to be the one the octree
+/// was made from), bakes and writes every output asked for. Outputs and ray counts (1 to
+/// kMaxAoRays) are checked before any work; an output is refused when it is an input: the octree,
+/// the mesh, a side file its import read, or another output.
 StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& request,
                                  Progress& progress = Progress::Silent());
 

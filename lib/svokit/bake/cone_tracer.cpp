@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "svokit/core/hash.hpp"
+#include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/svo/sample_codec.hpp"
 
@@ -92,11 +93,7 @@ void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b) {
   b = {c, sign + n.y * n.y * a, -n.y};
 }
 
-StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options) {
-  if (svo.brick_side == 0) {
-    return Status::BadInput(
-        "the octree has no bricks to trace cones through (build it with bricks of 3 or 2)");
-  }
+StatusOr<ConeTracer> ConeTracer::Make(const TraceOctree& octree, const ConeOptions& options) {
   if (Rings(options.cones).empty()) {
     return Status::BadInput("{} cones: constellations have 3, 5, 8 or 16 cones", options.cones);
   }
@@ -112,23 +109,24 @@ StatusOr<ConeTracer> ConeTracer::Make(const Svo& svo, const ConeOptions& options
   if (!std::isfinite(options.offset) || options.offset < 0) {
     return Status::BadInput("cone offset {}: must be ≥ 0", options.offset);
   }
-  if (svo.levels.size() != svo.depth + 1) {
-    return Status::BadInput("the octree's levels are not all loaded");
-  }
-  return ConeTracer(svo, options);
+  return ConeTracer(octree, options);
 }
 
-ConeTracer::ConeTracer(const Svo& svo, const ConeOptions& options)
-    : svo_(&svo), options_(options), cones_(ConeConstellation(options.cones, options.aperture)) {
+ConeTracer::ConeTracer(const TraceOctree& octree, const ConeOptions& options)
+    : octree_(&octree),
+      grid_(octree.reader().grid()),
+      options_(options),
+      cones_(ConeConstellation(options.cones, options.aperture)) {
   for (const Cone& cone : cones_) tan_half_.push_back(std::tan(cone.half_angle));
-  const double shell = svo.mode == VoxelMode::kThin ? kThinShell : kConservativeShell;
-  for (std::uint32_t l = 0; l <= svo.depth; ++l) {
-    node_size_.push_back(std::ldexp(1.0, static_cast<int>(svo.depth - l)));
+  const std::uint32_t depth = octree.depth();
+  const double shell = octree.reader().mode() == VoxelMode::kThin ? kThinShell : kConservativeShell;
+  for (std::uint32_t l = 0; l <= depth; ++l) {
+    node_size_.push_back(std::ldexp(1.0, static_cast<int>(depth - l)));
     level_gain_.push_back(static_cast<float>(kCoverageGain * node_size_.back() / shell));
   }
-  distance_voxels_ = options.distance / svo.grid.voxel_size();
+  distance_voxels_ = options.distance / grid_.voxel_size();
   offset_voxels_ = options.offset * std::sqrt(3.0);
-  root_side_ = std::ldexp(1.0, static_cast<int>(svo.depth));
+  root_side_ = std::ldexp(1.0, static_cast<int>(depth));
 }
 
 int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
@@ -136,7 +134,7 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
         v.z < root_side_)) {
     return -1;
   }
-  const std::uint32_t depth = svo_->depth;
+  const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
   const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
              z = static_cast<std::uint32_t>(v.z);
   // The levels whose node holds both this point and the last one keep their indices.
@@ -146,23 +144,38 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
   cursor.x = x;
   cursor.y = y;
   cursor.z = z;
+  // The page a cursor enters at the page level (the only one, when that is level 0).
+  auto enter = [&](std::uint64_t page) {
+    if (cursor.page_index == page) return;
+    cursor.page = octree_->Page(page);
+    cursor.page_index = page;
+  };
+  if (page_level == 0) enter(0);
   for (; l < level; ++l) {
     const std::uint32_t bit = depth - 1 - l;
     const unsigned c = ((x >> bit) & 1u) | (((y >> bit) & 1u) << 1) | (((z >> bit) & 1u) << 2);
-    const SvoNode& node = svo_->levels[l].nodes[cursor.index[l]];
-    if (((node.child_mask >> c) & 1u) == 0) {
+    const MaskTree& tree = l < page_level ? octree_->top().tree : cursor.page->levels.tree;
+    const std::uint32_t k = l - tree.first_level;
+    const std::uint64_t i = cursor.index[l];
+    const std::uint8_t mask = tree.masks[k][i];
+    if (((mask >> c) & 1u) == 0) {
       cursor.valid = l;
       return static_cast<int>(l);
     }
-    cursor.index[l + 1] = node.Child(c);
+    cursor.index[l + 1] = tree.first_child[k][i] + RankInByte(mask, c);
+    if (l + 1 == page_level) {
+      // The page's nodes are numbered within it: its root is node 0 of its page level.
+      enter(cursor.index[l + 1]);
+      cursor.index[l + 1] = 0;
+    }
   }
   cursor.valid = level;
   return static_cast<int>(level);
 }
 
-float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const {
+float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
   // Trilinear over the brick's lattice (side 3: spacing half the node; side 2: the corners).
-  const std::uint32_t side = svo_->brick_side;
+  const std::uint32_t side = octree_->brick_side();
   const double scale = 1 / node_size_[level];
   const double cells = side - 1;
   const double nx = v.x * scale, ny = v.y * scale, nz = v.z * scale;
@@ -173,14 +186,37 @@ float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t in
   const int iz = std::min(static_cast<int>(gz), static_cast<int>(side) - 2);
   const float fx = static_cast<float>(gx - ix), fy = static_cast<float>(gy - iy),
               fz = static_cast<float>(gz - iz);
-  const std::uint8_t* brick = svo_->levels[level].opacity.data() + index * svo_->brick_samples();
-  auto at = [&](int dx, int dy, int dz) {
-    return static_cast<float>(brick[(ix + dx) + side * ((iy + dy) + side * (iz + dz))]);
-  };
-  const float x00 = at(0, 0, 0) + fx * (at(1, 0, 0) - at(0, 0, 0));
-  const float x10 = at(0, 1, 0) + fx * (at(1, 1, 0) - at(0, 1, 0));
-  const float x01 = at(0, 0, 1) + fx * (at(1, 0, 1) - at(0, 0, 1));
-  const float x11 = at(0, 1, 1) + fx * (at(1, 1, 1) - at(0, 1, 1));
+  const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
+  std::array<float, 8> tap;  // (dx, dy, dz) at dx + 2dy + 4dz
+  if (level < depth) {
+    const TraceLevels& levels = level < page_level ? octree_->top() : cursor.page->levels;
+    const std::uint8_t* brick = levels.opacity[level - levels.tree.first_level].data() +
+                                cursor.index[level] * side * side * side;
+    for (int d = 0; d < 8; ++d) {
+      tap[static_cast<std::size_t>(d)] = static_cast<float>(
+          brick[(ix + (d & 1)) + side * ((iy + (d >> 1 & 1)) + side * (iz + (d >> 2)))]);
+    }
+  } else {
+    // A voxel's brick follows from the voxels around it.
+    const std::int64_t x = static_cast<std::int64_t>(nx), y = static_cast<std::int64_t>(ny),
+                       z = static_cast<std::int64_t>(nz);
+    if (x != cursor.voxel[0] || y != cursor.voxel[1] || z != cursor.voxel[2]) {
+      cursor.around = cursor.page->voxels.Around(x, y, z);
+      cursor.voxel[0] = x;
+      cursor.voxel[1] = y;
+      cursor.voxel[2] = z;
+    }
+    for (int d = 0; d < 8; ++d) {
+      const std::size_t s = static_cast<std::size_t>(
+          (ix + (d & 1)) + side * ((iy + (d >> 1 & 1)) + side * (iz + (d >> 2))));
+      tap[static_cast<std::size_t>(d)] =
+          static_cast<float>(octree_->VoxelSample(cursor.around, static_cast<std::uint32_t>(s)));
+    }
+  }
+  const float x00 = tap[0] + fx * (tap[1] - tap[0]);
+  const float x10 = tap[2] + fx * (tap[3] - tap[2]);
+  const float x01 = tap[4] + fx * (tap[5] - tap[4]);
+  const float x11 = tap[6] + fx * (tap[7] - tap[6]);
   const float y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
   const float opacity = (y0 + fz * (y1 - y0)) * (1.f / 255.f);
   return std::min(1.f, opacity * level_gain_[level]);
@@ -188,7 +224,7 @@ float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t in
 
 double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const {
   // The distance along the axis from p to where it leaves p's node of `level`, a hair beyond.
-  const std::uint32_t shift = svo_->depth - static_cast<std::uint32_t>(level);
+  const std::uint32_t shift = octree_->depth() - static_cast<std::uint32_t>(level);
   const double size = node_size_[static_cast<std::size_t>(level)];
   double exit = INFINITY;
   const double ps[3] = {p.x, p.y, p.z}, inv[3] = {inverse_axis.x, inverse_axis.y, inverse_axis.z};
@@ -201,14 +237,14 @@ double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int l
 }
 
 float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta,
-                            double tan_half) const {
-  const std::uint32_t depth = svo_->depth;
+                            double tan_half, Cursor& cursor) const {
+  const std::uint32_t depth = octree_->depth();
   const double lambda = options_.falloff / distance_voxels_;
   const double o = offset_voxels_;
   // Occlusion as the rays define it: the mean falloff at the first hit, E[f(r)]. Each sample
   // occludes its share of what the samples before it let through (the transmittance).
   float occlusion = 0, transmittance = 1;
-  Cursor cursor;
+  cursor.valid = 0;
   const Vec3d inverse_axis{1 / axis.x, 1 / axis.y, 1 / axis.z};
   for (double t = 1;;) {
     // Distance from the surface point (the origin sits `o` above it along the normal).
@@ -239,11 +275,10 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
                             node_size_[static_cast<std::size_t>(empty)] / (2 * tan_half)));
       continue;
     }
-    float coverage = Coverage(p, coarse, cursor.index[coarse]);
+    float coverage = Coverage(p, coarse, cursor);
     if (fine) {
       // An absent finer node covers nothing.
-      const float finer =
-          reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor.index[deepest]) : 0;
+      const float finer = reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor) : 0;
       coverage += fine_weight * (finer - coverage);
     }
     if (coverage > 0) {
@@ -271,20 +306,37 @@ float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
     b = Cross(n, t2);
     t = t2;
   }
-  const Vec3d origin = svo_->grid.WorldToVoxel(point.position) + n * offset_voxels_;
+  const Vec3d origin = grid_.WorldToVoxel(point.position) + n * offset_voxels_;
+  Cursor cursor;
   float sum = 0;
   for (std::size_t i = 0; i < cones_.size(); ++i) {
     const Vec3d& local = cones_[i].axis;
     const Vec3d axis = t * local.x + b * local.y + n * local.z;
-    sum += TraceCone(origin, axis, local.z, tan_half_[i]);
+    sum += TraceCone(origin, axis, local.z, tan_half_[i], cursor);
   }
   return sum / static_cast<float>(cones_.size());
 }
 
 std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points) const {
+  // By the Morton key of each point's voxel (clamped into the grid's cube), ties by index.
+  const double most = root_side_ - 1;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(points.size());
+  ParallelChunks(points.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3d v = grid_.WorldToVoxel(points[i].position);
+      auto at = [&](double c) {
+        return static_cast<std::uint32_t>(std::isfinite(c) ? std::clamp(c, 0.0, most) : 0.0);
+      };
+      order[i] = {MortonEncode(at(v.x), at(v.y), at(v.z)), static_cast<std::uint32_t>(i)};
+    }
+  });
+  std::sort(order.begin(), order.end());
   std::vector<float> ao(points.size());
   ParallelChunks(points.size(), 256, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) ao[i] = Occlusion(points[i], i);
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t i = order[k].second;
+      ao[i] = Occlusion(points[i], i);
+    }
   });
   return ao;
 }

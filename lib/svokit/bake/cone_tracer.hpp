@@ -17,9 +17,10 @@
 #include <span>
 #include <vector>
 
+#include "svokit/bake/trace_octree.hpp"
+#include "svokit/core/grid_transform.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
-#include "svokit/svo/svo.hpp"
 
 namespace svokit {
 
@@ -54,36 +55,45 @@ struct AoPoint {
 
 class ConeTracer {
  public:
-  /// Bad input: an octree without bricks, options out of range (cones not 3/5/8/16, aperture
-  /// or distance ≤ 0, falloff or offset < 0, non-finite values).
-  static StatusOr<ConeTracer> Make(const Svo& svo, const ConeOptions& options);
+  /// Bad input: options out of range (cones not 3/5/8/16, aperture or distance ≤ 0, falloff or
+  /// offset < 0, non-finite values).
+  static StatusOr<ConeTracer> Make(const TraceOctree& octree, const ConeOptions& options);
 
   /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal);
   /// `index` numbers the point for the jitter. Thread-safe.
   float Occlusion(const AoPoint& point, std::uint64_t index) const;
-  /// Occlusion of every point, in parallel; the result does not depend on the thread count.
+  /// Occlusion of every point, in parallel, traced in the order of their voxels' keys (cones from
+  /// nearby points read the same pages); the result depends on neither order nor thread count.
   std::vector<float> Occlusion(std::span<const AoPoint> points) const;
 
   const ConeOptions& options() const { return options_; }
 
  private:
-  ConeTracer(const Svo& svo, const ConeOptions& options);
+  ConeTracer(const TraceOctree& octree, const ConeOptions& options);
   // The path of the last lookup: node indices at levels 0 .. valid of the nodes holding the voxel
-  // (x, y, z). A cone's samples move little, so most of the path is reused.
+  // (x, y, z), and the page they lie in. A cone's samples move little, so most of the path is
+  // reused; a point's cones start in one page.
   struct Cursor {
     std::uint32_t x = 0, y = 0, z = 0;
     std::uint32_t valid = 0;
     std::array<std::uint64_t, 32> index{};
+    std::shared_ptr<const TracePage> page;
+    std::uint64_t page_index = ~std::uint64_t{0};
+    // The occupancy around the last voxel read at the voxel level.
+    std::int64_t voxel[3] = {-1, -1, -1};
+    std::uint32_t around = 0;
   };
   // Walks `cursor` towards the node of `level` holding voxel-space point `v`: the deepest level
   // reached (`level` when that node exists), or −1 outside the octree's cube.
   int Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
-  // Coverage at `v` in node `index` of `level` (trilinear in its brick).
-  float Coverage(const Vec3d& v, std::uint32_t level, std::uint64_t index) const;
+  // Coverage at `v` in the node of `level` the cursor holds (trilinear in its brick).
+  float Coverage(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   double ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const;
-  float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half) const;
+  float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half,
+                  Cursor& cursor) const;
 
-  const Svo* svo_;
+  const TraceOctree* octree_;
+  GridTransform grid_;
   ConeOptions options_;
   std::vector<Cone> cones_;
   std::vector<double> tan_half_;   // per cone: tan of its half-angle

@@ -570,6 +570,19 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
               ResizeBricks(out, kept, side, !source.colors.empty(), !source.normals.empty()), keep);
 }
 
+std::uint8_t VoxelSampleOpacity(int cells, int filled) {
+  // As the voxel lattice's Compute: one voxel exactly, several summed then scaled.
+  if (filled == 0) return Encode(false, false, PremultipliedSample{}).opacity;
+  if (filled == 1) return EncodeUnorm8(1.f / static_cast<float>(cells));
+  BrickSample one;
+  one.opacity = 1;
+  const PremultipliedSample cell = Premultiply(one);
+  PremultipliedSample sum, mean;
+  for (int i = 0; i < filled; ++i) Accumulate(sum, cell, 1.f);
+  Accumulate(mean, sum, 1.f / static_cast<float>(cells));
+  return Encode(false, false, mean).opacity;
+}
+
 namespace brick_math {
 
 EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p) {

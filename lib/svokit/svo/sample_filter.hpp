@@ -73,4 +73,9 @@ void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSou
 void VoxelBricks(const MaskTree& tree, std::uint32_t side, const VoxelSamplesSource& source,
                  SvoLevel& out, std::span<const std::uint8_t> keep = {});
 
+/// The opacity byte VoxelBricks gives a voxel brick's sample whose closed neighbourhood holds
+/// `cells` voxel cells (1, 2, 4 or 8), `filled` of them voxels: a voxel brick's opacity follows
+/// from the occupancy around it alone.
+std::uint8_t VoxelSampleOpacity(int cells, int filled);
+
 }  // namespace svokit

@@ -4,6 +4,7 @@
 #include <zstd.h>
 
 #include "svokit/core/bytes.hpp"
+#include "svokit/core/release_pages.hpp"
 #include "svokit/formats/svo/svo_detail.hpp"
 
 namespace svokit {
@@ -35,22 +36,42 @@ bool DecompressPrefix(std::span<const std::uint8_t> frame, std::span<std::uint8_
 
 }  // namespace
 
-std::vector<std::uint8_t> EncodeAoSection(const Svo& svo) {
-  std::vector<std::uint8_t> raw;
-  for (const SvoLevel& level : svo.levels) raw.insert(raw.end(), level.ao.begin(), level.ao.end());
-  std::vector<std::uint8_t> stored(ZSTD_compressBound(raw.size()));
-  const std::size_t n = ZSTD_compress(stored.data(), stored.size(), raw.data(), raw.size(), 9);
-  const bool zstd = !ZSTD_isError(n) && n < raw.size();
-  stored.resize(zstd ? n : 0);
+std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8_t>> ao) {
+  std::uint64_t raw = 0;
+  for (const std::vector<std::uint8_t>& level : ao) raw += level.size();
+  // The levels compressed as one frame, fed level by level (no copy of them all).
+  std::vector<std::uint8_t> stored(ZSTD_compressBound(raw));
+  ZSTD_CCtx* ctx = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(ctx, ZSTD_c_compressionLevel, 9);
+  ZSTD_CCtx_setPledgedSrcSize(ctx, raw);
+  ZSTD_outBuffer out{stored.data(), stored.size(), 0};
+  bool zstd = true;
+  for (std::size_t l = 0; zstd && l <= ao.size(); ++l) {
+    const bool last = l == ao.size();
+    ZSTD_inBuffer in{last ? nullptr : ao[l].data(), last ? 0 : ao[l].size(), 0};
+    std::size_t left = 0;
+    do {
+      left = ZSTD_compressStream2(ctx, &out, &in, last ? ZSTD_e_end : ZSTD_e_continue);
+      zstd = !ZSTD_isError(left);
+    } while (zstd && (last ? left != 0 : in.pos < in.size));
+  }
+  ZSTD_freeCCtx(ctx);
+  zstd = zstd && out.pos < raw;
+  stored.resize(zstd ? out.pos : 0);
   // The header as two arrays: GCC 12 misreads four scalar appends as an overflow.
-  const std::uint32_t head[2] = {static_cast<std::uint32_t>(svo.levels.size()),
-                                 zstd ? kZstd : kStored};
-  const std::uint64_t sizes[2] = {raw.size(), zstd ? n : raw.size()};
-  ByteWriter out;
-  out.PutArray(std::span<const std::uint32_t>(head));
-  out.PutArray(std::span<const std::uint64_t>(sizes));
-  out.PutArray(std::span<const std::uint8_t>(zstd ? stored : raw));
-  return std::move(out.bytes());
+  const std::uint32_t head[2] = {static_cast<std::uint32_t>(ao.size()), zstd ? kZstd : kStored};
+  const std::uint64_t sizes[2] = {raw, zstd ? out.pos : raw};
+  ByteWriter bytes;
+  bytes.PutArray(std::span<const std::uint32_t>(head));
+  bytes.PutArray(std::span<const std::uint64_t>(sizes));
+  if (zstd) {
+    bytes.PutArray(std::span<const std::uint8_t>(stored));
+  } else {
+    for (const std::vector<std::uint8_t>& level : ao) {
+      bytes.PutArray(std::span<const std::uint8_t>(level));
+    }
+  }
+  return std::move(bytes.bytes());
 }
 
 bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo) {
@@ -99,10 +120,14 @@ bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink,
 
 }  // namespace svo_detail
 
-Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const BakeSettings& bake,
+Status WriteBakedSvo(const std::filesystem::path& input,
+                     std::span<const std::vector<std::uint8_t>> ao, const BakeSettings& bake,
                      const std::filesystem::path& output) {
   using namespace svo_detail;
-  StatusOr<container::Frame> frame = container::Frame::Open(input, kSvoFormat);
+  // The pages are not read here: each is checked where it is decoded (by the bake that traced it).
+  static constexpr std::uint32_t kAllLevels = ~0u;
+  StatusOr<container::Frame> frame =
+      container::Frame::Open(input, kSvoFormat, &SectionsToLoad, &kAllLevels);
   if (!frame.ok()) return frame.status();
   if (!frame->issues().empty()) return Status::BadInput("{}", frame->issues().front().message);
   if (frame->version() < 2) {
@@ -123,10 +148,19 @@ Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const
   container::Writer writer(format, frame->flags());
   for (const container::Frame::Section& s : frame->sections()) {
     if (s.tag == kAo || s.tag == kMetadata) continue;
-    writer.AddSectionView(s.tag, s.bytes);
+    writer.AddSectionProduced(s.tag, [bytes = s.bytes](const container::Writer::Emit& emit) {
+      constexpr std::size_t kPiece = std::size_t{8} << 20;
+      for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+        const std::span<const std::uint8_t> piece =
+            bytes.subspan(at, std::min(kPiece, bytes.size() - at));
+        SVOKIT_RETURN_IF_ERROR(emit(piece));
+        ReleaseMappedFilePages(piece.data(), piece.data() + piece.size());
+      }
+      return Status::Ok();
+    });
   }
   writer.AddSection(kMetadata, std::vector<std::uint8_t>(meta_text.begin(), meta_text.end()));
-  writer.AddSection(kAo, EncodeAoSection(baked));
+  writer.AddSection(kAo, EncodeAoSection(ao));
   return writer.WriteFile(output);
 }
 

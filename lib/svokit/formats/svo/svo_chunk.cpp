@@ -602,6 +602,10 @@ Status DecodeFullMasks(const StreamSet& set, const SvoShape& shape, const ChunkF
 Status DecodeContours(const StreamSet& set, const SvoShape& shape, const ChunkFrame& frame,
                       std::span<const std::uint64_t> counts, const std::string& name,
                       SvoChunk& chunk) {
+  if (frame.parts == ChunkParts::kOpacity) {
+    chunk.contours.resize(frame.levels);
+    return Status::Ok();
+  }
   std::uint64_t contour_count = 0, bit_bytes = 0;
   for (std::uint32_t k = 0; k < frame.levels; ++k) bit_bytes += (counts[k] + 7) / 8;
   if (shape.has_contours) SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kContourBits, bit_bytes, name));
@@ -651,7 +655,9 @@ Status DecodeSamples(const StreamSet& set, const SvoShape& shape, const ChunkFra
   const std::uint32_t sample_levels =
       shape.brick_side == 0 ? 0 : std::min(frame.levels, shape.depth - frame.root_level);
   std::uint64_t samples = 0;
-  const bool lay_out = frame.parts == ChunkParts::kAll;
+  const bool lay_out = frame.parts != ChunkParts::kCounts;
+  const bool with_color = shape.has_color && frame.parts != ChunkParts::kOpacity,
+             with_normal = shape.has_normal && frame.parts != ChunkParts::kOpacity;
   for (std::uint32_t k = 0; lay_out && k < sample_levels; ++k) {
     chunk.layouts.push_back(LayOutSamples(chunk.tree, frame.root_level + k, shape.brick_side));
     samples += chunk.layouts.back().size();
@@ -663,8 +669,8 @@ Status DecodeSamples(const StreamSet& set, const SvoShape& shape, const ChunkFra
   }
   std::uint64_t filled = 0;
   for (const std::uint8_t o : set[kOpacity]) filled += o != 0;
-  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kColors, shape.has_color ? 4 * filled : 0, name));
-  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kNormals, shape.has_normal ? 2 * filled : 0, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kColors, with_color ? 4 * filled : 0, name));
+  SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kNormals, with_normal ? 2 * filled : 0, name));
   std::uint64_t sample = 0, nonempty = 0;
   std::uint8_t color[4] = {}, normal[2] = {};  // the previous non-empty sample's bytes
   for (std::uint32_t k = 0; k < (lay_out ? sample_levels : std::min(sample_levels, 1u)); ++k) {
@@ -672,17 +678,17 @@ Status DecodeSamples(const StreamSet& set, const SvoShape& shape, const ChunkFra
     const std::uint64_t n = lay_out ? chunk.layouts[k].size() : samples;
     s.opacity.assign(set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample),
                      set[kOpacity].begin() + static_cast<std::ptrdiff_t>(sample + n));
-    s.color.assign(shape.has_color ? n : 0, 0);
-    s.normal.assign(shape.has_normal ? n : 0, 0);
-    for (std::uint64_t i = 0; i < n; ++i) {
+    s.color.assign(with_color ? n : 0, 0);
+    s.normal.assign(with_normal ? n : 0, 0);
+    for (std::uint64_t i = 0; (with_color || with_normal) && i < n; ++i) {
       if (s.opacity[i] == 0) continue;
-      if (shape.has_color) {
+      if (with_color) {
         for (int c = 0; c < 4; ++c) {
           color[c] = static_cast<std::uint8_t>(color[c] + set[kColors][c * filled + nonempty]);
         }
         std::memcpy(&s.color[i], color, 4);
       }
-      if (shape.has_normal) {
+      if (with_normal) {
         for (int c = 0; c < 2; ++c) {
           normal[c] = static_cast<std::uint8_t>(normal[c] + set[kNormals][c * filled + nonempty]);
         }
@@ -747,6 +753,7 @@ Status DecodeHalo(const StreamSet& set, const SvoShape& shape, const ChunkFrame&
       }
     }
   }
+  if (frame.parts == ChunkParts::kOpacity) return Status::Ok();
   const std::uint64_t halo_count = chunk.halo_keys.size();
   SVOKIT_RETURN_IF_ERROR(ExpectSize(set, kHaloColors, per_voxel_colors ? 8 * halo_count : 0, name));
   SVOKIT_RETURN_IF_ERROR(
@@ -770,7 +777,14 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   constexpr std::uint32_t kAttributeStreams = 1u << kVoxelColors | 1u << kVoxelNormals |
                                               1u << kHaloKeys | 1u << kHaloColors |
                                               1u << kHaloNormals;
-  StatusOr<StreamSet> read = StreamSet::Read(bytes, name, counts_only ? kAttributeStreams : 0);
+  constexpr std::uint32_t kNotOpacity =
+      1u << kContourBits | 1u << kContourThickness | 1u << kContourPosition |
+      1u << kContourNormals | 1u << kColors | 1u << kNormals | 1u << kVoxelColors |
+      1u << kVoxelNormals | 1u << kHaloColors | 1u << kHaloNormals;
+  const std::uint32_t skip = counts_only                           ? kAttributeStreams
+                             : frame.parts == ChunkParts::kOpacity ? kNotOpacity
+                                                                   : 0;
+  StatusOr<StreamSet> read = StreamSet::Read(bytes, name, skip);
   if (!read.ok()) return read.status();
   const StreamSet& set = *read;
   SvoChunk chunk;
@@ -783,7 +797,8 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   SVOKIT_RETURN_IF_ERROR(DecodeContours(set, shape, frame, *counts, name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeSamples(set, shape, frame, name, chunk));
   if (counts_only) return chunk;
-  SVOKIT_RETURN_IF_ERROR(DecodeVoxels(set, shape, frame, counts->back(), name, chunk));
+  if (frame.parts != ChunkParts::kOpacity)
+    SVOKIT_RETURN_IF_ERROR(DecodeVoxels(set, shape, frame, counts->back(), name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeHalo(set, shape, frame, name, chunk));
   return chunk;
 }

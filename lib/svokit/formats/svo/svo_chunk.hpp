@@ -53,10 +53,12 @@ inline constexpr std::uint64_t kChunkLimit = std::uint64_t{4} << 30;
 /// What a decoder knows of a chunk before reading it: where its root is and which levels it holds
 /// (top chunk: root 0, levels 0 .. P − 1, masks down to P − 1; page: root at P, levels P ..
 /// depth, masks down to depth − 1).
-/// What a decode makes of a chunk: all of it, or what counting needs (statistics): no voxel
+/// What a decode makes of a chunk: all of it; what counting needs (statistics): no voxel
 /// attributes or halo, and the samples not laid out over the nodes, every level's in one
-/// LevelSamples (SvoChunk::layouts empty), their count unchecked against the tree.
-enum class ChunkParts { kAll, kCounts };
+/// LevelSamples (SvoChunk::layouts empty), their count unchecked against the tree; or what cone
+/// tracing needs: masks, opacity samples laid out, halo keys (no contours, whose levels are held
+/// empty, and no colour or normal).
+enum class ChunkParts { kAll, kCounts, kOpacity };
 
 struct ChunkFrame {
   std::uint32_t root_level = 0;

@@ -73,8 +73,9 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
                     IssueSink& sink, Svo& svo, Progress::Stage* stage = nullptr,
                     VoxelAttributeArrays* voxels = nullptr, SvoReadArrays arrays = {});
 
-/// The `AOCC` section of `svo`'s levels' ambient occlusion (svo_ao.cpp).
-std::vector<std::uint8_t> EncodeAoSection(const Svo& svo);
+/// The `AOCC` section of every level's ambient occlusion, `ao[level]` a byte per node
+/// (svo_ao.cpp).
+std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8_t>> ao);
 /// Reads the file's `AOCC` section, if any, into the decoded levels (0 .. `last`) of `svo`.
 bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo);
 

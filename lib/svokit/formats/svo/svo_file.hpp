@@ -115,10 +115,11 @@ StatusOr<SvoFileStats> WriteSvo(const CompactSvo& svo, const std::filesystem::pa
 StatusOr<SvoFileStats> WriteSvoStage(Progress& progress, const CompactSvo& svo,
                                      const std::filesystem::path& path,
                                      const SvoCompression& compression);
-/// Writes `input` (a version 2 or 3 .svo) again as `output` with `baked`'s per-node ambient
-/// occlusion (every level's `ao`) as its `AOCC` section and `bake` in its META; every other section
-/// is copied as it is.
-Status WriteBakedSvo(const std::filesystem::path& input, const Svo& baked, const BakeSettings& bake,
+/// Writes `input` (a version 2 or 3 .svo) again as `output` with `ao` (per level, a byte of
+/// ambient occlusion per node) as its `AOCC` section and `bake` in its META; every other section
+/// is copied as it is, a piece at a time (its mapped bytes let go once written).
+Status WriteBakedSvo(const std::filesystem::path& input,
+                     std::span<const std::vector<std::uint8_t>> ao, const BakeSettings& bake,
                      const std::filesystem::path& output);
 
 /// Verifies and decodes a whole file; `max_level` stops after that level (LOD streaming).
