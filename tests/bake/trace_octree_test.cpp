@@ -55,15 +55,16 @@ TEST(TraceOctree, VoxelBricksFollowFromTheOccupancy) {
   ExpectVoxelOpacityOfTheFile(*BakeScene(sphere, 160, 0, {.contours = false}, /*solid=*/true));
 }
 
-// The least memory limit an octree accepts, read from the refusal of a smaller one.
-std::uint64_t LeastLimit(const SvoReader& reader) {
-  const StatusOr<std::unique_ptr<TraceOctree>> refused = TraceOctree::Open(reader, 1);
+// The least memory limit that works, read from the refusal of a smaller one.
+std::uint64_t LeastLimit(const Status& refused) {
   EXPECT_FALSE(refused.ok());
-  if (refused.ok()) return 0;
   std::smatch m;
-  const std::string message = refused.status().message();
+  const std::string message = refused.message();
   EXPECT_TRUE(std::regex_search(message, m, std::regex("give ([0-9]+)M or more"))) << message;
   return m.empty() ? 0 : std::stoull(m[1]) << 20;
+}
+std::uint64_t LeastLimit(const SvoReader& reader) {
+  return LeastLimit(TraceOctree::Open(reader, 1).status());
 }
 
 TEST(TraceOctree, ConesGiveTheSameAoAtEveryMemoryLimit) {
@@ -121,7 +122,10 @@ TEST(BakeSvoAo, TheSameBakedFileAtEveryMemoryLimit) {
   request.input = plain;
   request.cones.distance = 1;
   std::optional<std::vector<std::uint8_t>> first;
-  const std::uint64_t least = LeastLimit(*scene->reader);
+  request.output = dir / "refused.svo";
+  request.memory_limit = 1;
+  const std::uint64_t least = LeastLimit(BakeSvoAo(request).status());
+  EXPECT_FALSE(std::filesystem::exists(request.output));
   for (const std::uint64_t limit : {std::uint64_t{0}, least, 3 * least}) {
     request.output = dir / ("baked-" + std::to_string(limit) + ".svo");
     request.memory_limit = limit;

@@ -70,6 +70,36 @@ StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const SvoReader& octree,
   return mesh;
 }
 
+template <class T>
+std::uint64_t Bytes(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
+
+// What a bake holds besides the octree it traces: the mesh and its points with their AO; for the
+// octree's own bake a page decoded whole with its voxels' points and bricks, and every node's AO.
+std::uint64_t HeldBesides(const AoBakeRequest& r, const SvoReader& reader, const Mesh* mesh) {
+  constexpr std::uint64_t kPerPoint = sizeof(AoPoint) + 2 * sizeof(float) + 16;
+  constexpr std::uint64_t kPerPageVoxel = 200;  // keys, points, sums, voxel bricks, the chunk
+  std::uint64_t held = 0;
+  if (mesh != nullptr) {
+    held += Bytes(mesh->positions) + Bytes(mesh->triangles) + Bytes(mesh->normals) +
+            Bytes(mesh->uvs) + Bytes(mesh->colors) + Bytes(mesh->material_ids);
+    if (!r.vertex_out.empty() || r.reference) held += mesh->positions.size() * kPerPoint;
+    if (!r.texture_out.empty()) {
+      held += static_cast<std::uint64_t>(r.texture_size) * r.texture_size * (kPerPoint + 5);
+    }
+  }
+  if (!r.output.empty()) {
+    std::uint64_t largest = 0;
+    for (std::size_t i = 0; i < reader.page_count(); ++i) {
+      largest = std::max(largest, reader.page(i).voxels);
+    }
+    held += largest * kPerPageVoxel;
+    for (std::uint32_t l = 0; l <= reader.depth(); ++l) held += reader.NodeCount(l);
+  }
+  return held;
+}
+
 BakeSettings SettingsOf(const ConeOptions& cones) {
   return {cones.cones,   cones.aperture, cones.distance,
           cones.falloff, cones.offset,   cones.jitter_seed};
@@ -239,19 +269,23 @@ StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
         "{}: the octree's voxels have no normals to bake along (voxelize it with normals)",
         r.input.string());
   }
-  StatusOr<std::unique_ptr<TraceOctree>> octree = RunStage(progress, "read", [&] {
-    return TraceOctree::Open(*reader, r.memory_limit > 0 ? r.memory_limit : kDefaultBakeMemory);
-  });
-  if (!octree.ok()) return octree.status();
-  StatusOr<ConeTracer> tracer = ConeTracer::Make(**octree, report.cones);
-  if (!tracer.ok()) {
-    return Status::BadInput("{}: {}", r.input.string(), tracer.status().message());
+  if (Status s = CheckConeOptions(report.cones); !s.ok()) {
+    return Status::BadInput("{}: {}", r.input.string(), s.message());
   }
   std::optional<Mesh> mesh;
   if (!r.vertex_out.empty() || !r.texture_out.empty() || r.reference) {
     StatusOr<Mesh> imported = ImportBakedMesh(r, *reader, progress);
     if (!imported.ok()) return imported.status();
     mesh = std::move(*imported);
+  }
+  StatusOr<std::unique_ptr<TraceOctree>> octree = RunStage(progress, "read", [&] {
+    return TraceOctree::Open(*reader, r.memory_limit > 0 ? r.memory_limit : kDefaultBakeMemory,
+                             HeldBesides(r, *reader, mesh ? &*mesh : nullptr));
+  });
+  if (!octree.ok()) return octree.status();
+  StatusOr<ConeTracer> tracer = ConeTracer::Make(**octree, report.cones);
+  if (!tracer.ok()) {
+    return Status::BadInput("{}: {}", r.input.string(), tracer.status().message());
   }
   Baker baker(r, **octree, *tracer, report, progress);
   SVOKIT_RETURN_IF_ERROR(baker.Run(mesh ? &*mesh : nullptr));

@@ -93,7 +93,7 @@ void TangentFrame(const Vec3d& n, Vec3d& t, Vec3d& b) {
   b = {c, sign + n.y * n.y * a, -n.y};
 }
 
-StatusOr<ConeTracer> ConeTracer::Make(const TraceOctree& octree, const ConeOptions& options) {
+Status CheckConeOptions(const ConeOptions& options) {
   if (Rings(options.cones).empty()) {
     return Status::BadInput("{} cones: constellations have 3, 5, 8 or 16 cones", options.cones);
   }
@@ -109,6 +109,11 @@ StatusOr<ConeTracer> ConeTracer::Make(const TraceOctree& octree, const ConeOptio
   if (!std::isfinite(options.offset) || options.offset < 0) {
     return Status::BadInput("cone offset {}: must be ≥ 0", options.offset);
   }
+  return Status::Ok();
+}
+
+StatusOr<ConeTracer> ConeTracer::Make(const TraceOctree& octree, const ConeOptions& options) {
+  SVOKIT_RETURN_IF_ERROR(CheckConeOptions(options));
   return ConeTracer(octree, options);
 }
 

@@ -53,10 +53,13 @@ struct AoPoint {
   Vec3d normal;
 };
 
+/// Bad input: options out of range (cones not 3/5/8/16, aperture or distance ≤ 0, falloff or
+/// offset < 0, non-finite values).
+Status CheckConeOptions(const ConeOptions& options);
+
 class ConeTracer {
  public:
-  /// Bad input: options out of range (cones not 3/5/8/16, aperture or distance ≤ 0, falloff or
-  /// offset < 0, non-finite values).
+  /// Bad input: options out of range (CheckConeOptions).
   static StatusOr<ConeTracer> Make(const TraceOctree& octree, const ConeOptions& options);
 
   /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal);

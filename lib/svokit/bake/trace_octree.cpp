@@ -102,7 +102,8 @@ std::uint32_t VoxelOccupancy::Around(std::int64_t x, std::int64_t y, std::int64_
 }
 
 StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader,
-                                                         std::uint64_t memory_limit) {
+                                                         std::uint64_t memory_limit,
+                                                         std::uint64_t held_besides) {
   const SvoShape& shape = reader.shape();
   if (shape.brick_side == 0) {
     return Status::BadInput(
@@ -155,12 +156,16 @@ StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader
       if (!bound.ok()) return bound.status();
       largest = std::max(largest, *bound);
     }
-    const std::uint64_t in_use = Concurrency() * largest;
+    const TraceLevels& top = octree->top_;
+    const std::uint64_t fixed = held_besides + NestedBytes(top.tree.masks) +
+                                NestedBytes(top.tree.full) + NestedBytes(top.tree.first_child) +
+                                NestedBytes(top.opacity) + Concurrency() * largest;
     StatusOr<std::size_t> fits =
-        InFlightWithin(memory_limit, in_use, largest, largest, "this file",
-                       "cone tracing's pages (one a thread, and one more kept)");
+        InFlightWithin(memory_limit, fixed, largest, largest, "this file",
+                       "the top levels, cone tracing's pages (one a thread, and one more kept) "
+                       "and what is baked");
     if (!fits.ok()) return fits.status().WithContext(reader.name());
-    octree->capacity_ = memory_limit - in_use;
+    octree->capacity_ = memory_limit - fixed;
   }
   return octree;
 }

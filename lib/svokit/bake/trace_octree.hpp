@@ -61,12 +61,14 @@ struct TracePage {
 
 class TraceOctree {
  public:
-  /// The top levels of `reader`'s file read, pages to come through a cache: pages in use by the
-  /// threads (one each) and those kept for later within `memory_limit` bytes (0: every page may be
-  /// kept). A limit that cannot hold one page a thread and one more is bad input naming the least
-  /// that can. Bad input as well: an octree without bricks.
+  /// The top levels of `reader`'s file read, pages to come through a cache: the top levels,
+  /// `held_besides` (what the caller holds meanwhile), the pages in use by the threads (one each)
+  /// and those kept for later within `memory_limit` bytes (0: every page may be kept). A limit
+  /// that cannot hold one page a thread and one more is bad input naming the least that can. Bad
+  /// input as well: an octree without bricks.
   static StatusOr<std::unique_ptr<TraceOctree>> Open(const SvoReader& reader,
-                                                     std::uint64_t memory_limit);
+                                                     std::uint64_t memory_limit,
+                                                     std::uint64_t held_besides = 0);
 
   const SvoReader& reader() const { return reader_; }
   std::uint32_t depth() const { return depth_; }

@@ -182,8 +182,15 @@ StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts) const {
 
 StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
   const svo_detail::Version2::Page& p = state_->v.pages.at(i);
-  return ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),
-                          fmt::format("{}: page {}", name(), i));
+  StatusOr<ChunkBytes> bytes = ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),
+                                                fmt::format("{}: page {}", name(), i));
+  // Reading the directory maps the pages around it too (the kernel's fault-around): a pass over
+  // every directory of a large file would otherwise hold much of the file.
+  if (state_->mapped) {
+    const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
+    ReleaseMappedFilePages(begin, begin + p.size);
+  }
+  return bytes;
 }
 
 SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,
