@@ -165,7 +165,8 @@ StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader
                        "the top levels, cone tracing's pages (one a thread, and one more kept) "
                        "and what is baked");
     if (!fits.ok()) return fits.status().WithContext(reader.name());
-    octree->capacity_ = memory_limit - fixed;
+    // An eighth stays free for what the allocator holds of pages already let go.
+    octree->capacity_ = std::max(largest, (memory_limit - fixed) / 8 * 7);
   }
   return octree;
 }

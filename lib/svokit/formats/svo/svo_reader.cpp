@@ -171,12 +171,7 @@ StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts) const {
     return Status::BadInput("{}: page {} of {} does not exist", name(), i, page_count());
   }
   StatusOr<SvoChunk> page = svo_detail::DecodePage(state_->v, i, name(), nullptr, parts);
-  // Bytes given to FromBytes are the caller's, not a mapping of the reader's own.
-  if (state_->mapped) {
-    const svo_detail::Version2::Page& p = state_->v.pages[i];
-    const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
-    ReleaseMappedFilePages(begin, begin + p.size);
-  }
+  ReleasePage(i);
   return page;
 }
 
@@ -184,13 +179,21 @@ StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
   const svo_detail::Version2::Page& p = state_->v.pages.at(i);
   StatusOr<ChunkBytes> bytes = ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),
                                                 fmt::format("{}: page {}", name(), i));
-  // Reading the directory maps the pages around it too (the kernel's fault-around): a pass over
-  // every directory of a large file would otherwise hold much of the file.
-  if (state_->mapped) {
-    const std::uint8_t* begin = state_->v.page_bytes.data() + p.offset;
-    ReleaseMappedFilePages(begin, begin + p.size);
-  }
+  ReleasePage(i);
   return bytes;
+}
+
+void SvoReader::ReleasePage(std::size_t i) const {
+  // Bytes given to FromBytes are the caller's, not a mapping of the reader's own.
+  if (!state_->mapped) return;
+  // A read maps the file pages around it too (the kernel's fault-around, 64 KiB): they go as well,
+  // or reads of pages in any order would keep much of the file.
+  constexpr std::uint64_t kFaultAround = 64 << 10;
+  const svo_detail::Version2::Page& p = state_->v.pages[i];
+  const std::span<const std::uint8_t> all = state_->v.page_bytes;
+  const std::uint64_t lo = p.offset > kFaultAround ? p.offset - kFaultAround : 0;
+  const std::uint64_t hi = std::min<std::uint64_t>(all.size(), p.offset + p.size + kFaultAround);
+  ReleaseMappedFilePages(all.data() + lo, all.data() + hi);
 }
 
 SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,

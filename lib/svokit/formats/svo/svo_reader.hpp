@@ -76,6 +76,8 @@ class SvoReader {
  private:
   struct State;
   explicit SvoReader(std::unique_ptr<State> state);
+  // Gives page i's mapped file bytes back to the kernel, and the ones mapped around them.
+  void ReleasePage(std::size_t i) const;
   std::unique_ptr<State> state_;
 };
 
