@@ -3,6 +3,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/stats.hpp"
 #include "svokit/inspect/stats_report.hpp"
@@ -32,16 +33,26 @@ StatusOr<RenderedPicture> Render(const InspectRequest& r, const Svo& svo, Progre
                          .hit_pixels = rendered->hits};
 }
 
-StatusOr<SlicePicture> Slice(const InspectRequest& r, const Svo& svo, Progress& progress) {
+// The slice of `svo` (read whole), else of the paged file `reader` streamed page by page.
+StatusOr<SlicePicture> Slice(const InspectRequest& r, const Svo* svo, const SvoReader* reader,
+                             Progress& progress) {
   SliceOptions options;
   options.level = r.level;
-  const StatusOr<RgbaImage> image = RunStage(progress, "slice", [&]() -> StatusOr<RgbaImage> {
-    StatusOr<RgbaImage> made = RenderSlice(svo, r.slice, options);
-    if (!made.ok()) return made;
-    SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(*made, r.slice_path));
-    return made;
-  });
-  if (!image.ok()) return image.status().WithContext(r.input.string());
+  Progress::Stage stage(progress, "slice", 1);
+  StatusOr<RgbaImage> image = svo != nullptr
+                                  ? RenderSlice(*svo, r.slice, options)
+                                  : RenderSlice(*reader, r.slice, options, r.memory_limit, &stage);
+  // The paged route's errors name the file already.
+  if (!image.ok() && svo != nullptr) image = image.status().WithContext(r.input.string());
+  if (image.ok()) {
+    if (Status s = WriteRgbaImage(*image, r.slice_path); !s.ok()) {
+      image = s.WithContext(r.input.string());
+    }
+  }
+  if (!image.ok()) {
+    stage.Cancel();
+    return image.status();
+  }
   return SlicePicture{.path = r.slice_path.string(),
                       .axis = r.slice.axis,
                       .index = r.slice.index,
@@ -61,20 +72,20 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   report.histograms = r.histograms;
   report.version = 1;
   std::optional<SvoStats> stats;
-  // A paged file (version 2 or 3) is counted page by page; version 1 is read whole.
+  // A paged file (version 2 or 3) is counted, and its slices drawn, page by page; version 1 is
+  // read whole.
+  std::optional<SvoReader> paged;
   if (StatusOr<SvoReader> reader = SvoReader::Open(r.input); reader.ok()) {
-    if (r.level && *r.level > reader->depth()) {
-      return Status::BadInput("{}: level {} exceeds the octree's depth {}", r.input.string(),
-                              *r.level, reader->depth());
-    }
-    report.version = reader->version();
+    paged = std::move(*reader);
+    if (r.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(*paged, *r.level));
+    report.version = paged->version();
     report.file_bytes = std::filesystem::file_size(r.input);
-    StatusOr<SvoFileStats> file_stats = reader->FileStats(r.levels);
+    StatusOr<SvoFileStats> file_stats = paged->FileStats(r.levels);
     if (!file_stats.ok()) return file_stats.status();
     report.file_stats = std::move(*file_stats);
     Progress::Stage stage(progress, "statistics", 0);
     StatusOr<SvoStats> counted =
-        ComputeSvoStats(*reader, r.level, SvoStreamOptions{.memory_limit = r.memory_limit}, &stage);
+        ComputeSvoStats(*paged, r.level, SvoStreamOptions{.memory_limit = r.memory_limit}, &stage);
     if (!counted.ok()) {
       stage.Cancel();
       return counted.status();
@@ -82,7 +93,8 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
     stats = std::move(*counted);
   }
   std::optional<Svo> svo;
-  if (!stats || !r.render_path.empty() || !r.slice_path.empty()) {
+  const bool slice_whole = !r.slice_path.empty() && !paged;
+  if (!stats || !r.render_path.empty() || slice_whole) {
     StatusOr<Svo> read = ReadSvoStage(progress, r.input, r.level);
     if (!read.ok()) return read.status();
     svo = std::move(*read);
@@ -94,7 +106,8 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
     report.render = *picture;
   }
   if (!r.slice_path.empty()) {
-    StatusOr<SlicePicture> picture = Slice(r, *svo, progress);
+    StatusOr<SlicePicture> picture =
+        Slice(r, slice_whole ? &*svo : nullptr, paged ? &*paged : nullptr, progress);
     if (!picture.ok()) return picture.status();
     report.slice = *picture;
   }
