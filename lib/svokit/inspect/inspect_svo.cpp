@@ -1,5 +1,7 @@
 #include "svokit/inspect/inspect_svo.hpp"
 
+#include <fmt/format.h>
+
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
@@ -12,23 +14,41 @@ namespace svokit {
 
 namespace {
 
-StatusOr<RenderedPicture> Render(const InspectRequest& r, const Svo& svo, Progress& progress) {
-  const RenderOptions& options = r.render;
-  const StatusOr<RenderResult> rendered =
-      RunStage(progress, "render", [&]() -> StatusOr<RenderResult> {
-        StatusOr<RenderResult> made = RenderSvo(svo, options);
-        if (!made.ok()) return made;
+// The render of `svo` (read whole), else of the paged file `reader` through a page cache.
+StatusOr<RenderedPicture> Render(const InspectRequest& r, const Svo* svo, const SvoReader* reader,
+                                 Progress& progress) {
+  // --level reads levels 0..L; the finest read is drawn unless the render asks for another.
+  RenderOptions options = r.render;
+  if (!options.level) options.level = r.level;
+  // The paged route's errors name the file already.
+  PagedRenderStats paging;
+  const StatusOr<RenderResult> rendered = RunStage(
+      progress, "render",
+      [&]() -> StatusOr<RenderResult> {
+        StatusOr<RenderResult> made = svo != nullptr
+                                          ? RenderSvo(*svo, options)
+                                          : RenderSvo(*reader, options, r.memory_limit, &paging);
+        if (!made.ok()) {
+          return svo != nullptr ? made.status().WithContext(r.input.string()) : made.status();
+        }
         SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(made->image, r.render_path));
         return made;
+      },
+      [&](const StatusOr<RenderResult>&) -> std::string {
+        if (svo != nullptr || paging.threads == 0) return "";
+        return fmt::format("{} page reads, {} from the cache ({} MiB, {} threads)",
+                           paging.page_reads, paging.page_hits, paging.cache_capacity >> 20,
+                           paging.threads);
       });
-  if (!rendered.ok()) return rendered.status().WithContext(r.input.string());
+  if (!rendered.ok()) return rendered.status();
+  const bool has_contours = svo != nullptr ? svo->has_contours : reader->shape().has_contours;
   return RenderedPicture{.path = r.render_path.string(),
                          .width = options.width,
                          .height = options.height,
                          .view = options.view,
                          .shade = options.shade,
                          .level = rendered->level,
-                         .contours = options.contours && svo.has_contours,
+                         .contours = options.contours && has_contours,
                          .pixel_size = rendered->camera.pixel_size,
                          .hit_pixels = rendered->hits};
 }
@@ -94,14 +114,17 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   }
   std::optional<Svo> svo;
   const bool slice_whole = !r.slice_path.empty() && !paged;
-  if (!stats || !r.render_path.empty() || slice_whole) {
+  // Ambient occlusion is indexed by the whole octree's nodes: such renders read it whole.
+  const bool render_whole = !r.render_path.empty() && (!paged || r.render.shade == Shade::kAo);
+  if (!stats || render_whole || slice_whole) {
     StatusOr<Svo> read = ReadSvoStage(progress, r.input, r.level);
     if (!read.ok()) return read.status();
     svo = std::move(*read);
     report.file_bytes = std::filesystem::file_size(r.input);
   }
   if (!r.render_path.empty()) {
-    StatusOr<RenderedPicture> picture = Render(r, *svo, progress);
+    StatusOr<RenderedPicture> picture =
+        Render(r, render_whole ? &*svo : nullptr, paged ? &*paged : nullptr, progress);
     if (!picture.ok()) return picture.status();
     report.render = *picture;
   }

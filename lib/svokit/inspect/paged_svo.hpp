@@ -12,9 +12,9 @@
 
 namespace svokit {
 
-/// Levels 0 .. min(max_level, page level − 1) of the octree, from the top chunk (none when the
-/// page level is 0). The page level's parents have no contour masks: their children's words are
-/// the pages' roots'.
+/// Levels 0 .. min(max_level, page level − 1) of the octree, from the top chunk (none, the grid
+/// and flags alone, when the page level is 0). The page level's parents have no contour masks:
+/// their children's words are the pages' roots'.
 StatusOr<Svo> ReadTopSvo(const SvoReader& reader, std::uint32_t max_level);
 
 /// Page `chunk` of `reader` as an Svo of levels 0 .. max_level (page level ≤ max_level ≤ depth).
@@ -23,8 +23,10 @@ Svo PageSvo(const SvoReader& reader, const SvoChunk& chunk, std::uint32_t max_le
 /// Bytes `svo` holds (its arrays' capacities): what a cached page costs.
 std::uint64_t SvoHeldBytes(const Svo& svo);
 
-/// A bound on the bytes PageSvo holds at its peak (the decoded page, the voxel bricks' working set
-/// and the Svo) for a page of `decoded` bytes (PageDecodedBytes) and `voxels` voxels.
-std::uint64_t PageSvoPeakBytes(const SvoShape& shape, std::uint64_t decoded, std::uint64_t voxels);
+/// A bound on the bytes assembling page i into PageSvo(…, max_level) holds at its peak (the
+/// decoded page, the voxel bricks' working set and the Svo), from its stream directory (nothing is
+/// decompressed).
+StatusOr<std::uint64_t> PageSvoPeakBytes(const SvoReader& reader, std::size_t i,
+                                         std::uint32_t max_level);
 
 }  // namespace svokit

@@ -237,13 +237,19 @@ StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
   Box3d plane{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
   plane.lo[slice.axis] = plane.hi[slice.axis] =
       reader.grid().origin()[slice.axis] + (slice.index + 0.5) * cell;
-  const SvoShape& shape = reader.shape();
-  StatusOr<SvoStreamPlan> plan =
-      PlanStream(reader, SvoStreamOptions{.memory_limit = memory_limit, .box = plane},
-                 [&](std::uint64_t decoded, std::uint64_t voxels) {
-                   return PageSvoPeakBytes(shape, decoded, voxels);
-                 });
+  StatusOr<SvoStreamPlan> plan = PlanStream(reader, SvoStreamOptions{.box = plane});
   if (!plan.ok()) return plan.status();
+  // What a page in flight holds is its assembly's peak, which the stream directory bounds.
+  std::uint64_t largest = 1;
+  for (const std::size_t i : plan->pages) {
+    StatusOr<std::uint64_t> bytes = PageSvoPeakBytes(reader, i, level);
+    if (!bytes.ok()) return bytes.status();
+    largest = std::max(largest, *bytes);
+  }
+  StatusOr<std::size_t> in_flight = InFlightWithin(memory_limit, 0, largest, largest, "this file",
+                                                   "the pages in flight (one at least)");
+  if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
+  plan->in_flight = *in_flight;
   SVOKIT_RETURN_IF_ERROR(StreamPages<Svo>(
       reader, *plan,
       [&](std::size_t, SvoChunk chunk) -> StatusOr<Svo> { return PageSvo(reader, chunk, level); },
