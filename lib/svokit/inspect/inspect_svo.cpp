@@ -92,8 +92,7 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   report.histograms = r.histograms;
   report.version = 1;
   std::optional<SvoStats> stats;
-  // A paged file (version 2 or 3) is counted, and its slices drawn, page by page; version 1 is
-  // read whole.
+  // A paged file (version 2 or 3) is counted and drawn page by page; version 1 is read whole.
   std::optional<SvoReader> paged;
   if (StatusOr<SvoReader> reader = SvoReader::Open(r.input); reader.ok()) {
     paged = std::move(*reader);
