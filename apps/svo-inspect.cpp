@@ -46,8 +46,8 @@ struct InspectCli {
                    "L's nodes as leaves")
         ->option_text("L");
     memory_limit.Add(cli,
-                     "Bytes of pages the statistics of a paged file hold at once (default: a few "
-                     "per thread); renders and slices read the levels they show whole");
+                     "Bytes of pages a paged file's statistics, renders and slices hold at once "
+                     "(default: a few per thread); --shade ao reads the octree whole");
   }
 
   // Every option is parsed before the file is read, so a typo costs nothing.

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -171,7 +172,9 @@ void ExpectPartsOfTheBuild(const Case& c) {
       }
       EXPECT_EQ(page.offset, page_bytes);
       EXPECT_GT(page.size, 0u);
-      EXPECT_EQ(part->PageBytes(page).size(), page.size);
+      StatusOr<std::vector<std::uint8_t>> bytes = part->PageBytes(page);
+      ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+      EXPECT_EQ(bytes->size(), page.size);
       page_bytes += page.size;
       // Without bricks a page is stored as the .svo stores it.
       if (c.bricks == 0) {
@@ -181,8 +184,8 @@ void ExpectPartsOfTheBuild(const Case& c) {
       EXPECT_EQ(page.shell_size > 0, c.bricks != 0);
       shell_bytes += page.shell_size;
     }
-    EXPECT_EQ(page_bytes, part->page_bytes.size());
-    EXPECT_EQ(shell_bytes, part->shell_bytes.size());
+    EXPECT_EQ(page_bytes, part->page_bytes.size);
+    EXPECT_EQ(shell_bytes, part->shell_bytes.size);
 
     // The top levels' contour words: part 0's, with contours; every node of the whole tree's top
     // levels among them, with its word.
@@ -224,12 +227,13 @@ SvoPartPages PagesOf(const SvoPart& part) {
     for (const SvoPartPage& page : part.pages) {
       PagedSvoWriter::EncodedPage encoded;
       encoded.key = page.key;
-      const std::span<const std::uint8_t> bytes = part.PageBytes(page);
-      encoded.bytes.assign(bytes.begin(), bytes.end());
+      StatusOr<std::vector<std::uint8_t>> bytes = part.PageBytes(page);
+      if (!bytes.ok()) return bytes.status();
+      encoded.bytes = std::move(*bytes);
       encoded.levels = page.levels;
-      const std::span<const std::uint8_t> shell = part.ShellBytes(page);
-      SVOKIT_RETURN_IF_ERROR(
-          take(std::move(encoded), std::vector<std::uint8_t>(shell.begin(), shell.end())));
+      StatusOr<std::vector<std::uint8_t>> shell = part.ShellBytes(page);
+      if (!shell.ok()) return shell.status();
+      SVOKIT_RETURN_IF_ERROR(take(std::move(encoded), std::move(*shell)));
     }
     return Status::Ok();
   };
@@ -402,6 +406,26 @@ TEST(SvoPart, DamagedPartsAreRefusedWithOneLineNamingTheFile) {
     expect_refused(
         middle, section, [](std::vector<std::uint8_t>&) { return false; },
         std::string("required section '") + section + "' is missing");
+  }
+  // A byte of PAGE or SHEL changed behind its checksum: they are read with pread, not mapped,
+  // and their checksums still hold them.
+  for (const char* section : {"PAGE", "SHEL"}) {
+    SCOPED_TRACE(section);
+    const StatusOr<container::Frame> frame = container::Frame::Open(middle, kSvoPartFormat);
+    ASSERT_TRUE(frame.ok());
+    const container::Frame::Section* s = frame->Find(TagOf(section));
+    ASSERT_NE(s, nullptr);
+    ASSERT_GT(s->size, 0u);
+    std::vector<std::uint8_t> bytes = test::ReadBytes(middle);
+    bytes[s->offset + s->size / 2] ^= 0x40;
+    const fs::path damaged = dir / "flipped.svopart";
+    std::ofstream(damaged, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()),
+               static_cast<std::streamsize>(bytes.size()));
+    const StatusOr<SvoPart> part = ReadSvoPart(damaged);
+    ASSERT_FALSE(part.ok());
+    EXPECT_EQ(part.status().message(),
+              damaged.string() + ": section '" + section + "' checksum mismatch (file is corrupt)");
   }
 }
 

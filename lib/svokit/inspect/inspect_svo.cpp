@@ -1,8 +1,11 @@
 #include "svokit/inspect/inspect_svo.hpp"
 
+#include <fmt/format.h>
+
 #include "svokit/core/file_io.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/inspect/ray_cast.hpp"
 #include "svokit/inspect/stats.hpp"
 #include "svokit/inspect/stats_report.hpp"
@@ -11,37 +14,65 @@ namespace svokit {
 
 namespace {
 
-StatusOr<RenderedPicture> Render(const InspectRequest& r, const Svo& svo, Progress& progress) {
-  const RenderOptions& options = r.render;
-  const StatusOr<RenderResult> rendered =
-      RunStage(progress, "render", [&]() -> StatusOr<RenderResult> {
-        StatusOr<RenderResult> made = RenderSvo(svo, options);
-        if (!made.ok()) return made;
+// The render of `svo` (read whole), else of the paged file `reader` through a page cache.
+StatusOr<RenderedPicture> Render(const InspectRequest& r, const Svo* svo, const SvoReader* reader,
+                                 Progress& progress) {
+  // --level reads levels 0..L; the finest read is drawn unless the render asks for another.
+  RenderOptions options = r.render;
+  if (!options.level) options.level = r.level;
+  // The paged route's errors name the file already.
+  PagedRenderStats paging;
+  const StatusOr<RenderResult> rendered = RunStage(
+      progress, "render",
+      [&]() -> StatusOr<RenderResult> {
+        StatusOr<RenderResult> made = svo != nullptr
+                                          ? RenderSvo(*svo, options)
+                                          : RenderSvo(*reader, options, r.memory_limit, &paging);
+        if (!made.ok()) {
+          return svo != nullptr ? made.status().WithContext(r.input.string()) : made.status();
+        }
         SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(made->image, r.render_path));
         return made;
+      },
+      [&](const StatusOr<RenderResult>&) -> std::string {
+        if (svo != nullptr || paging.threads == 0) return "";
+        return fmt::format("{} page reads, {} from the cache ({} MiB, {} threads)",
+                           paging.page_reads, paging.page_hits, paging.cache_capacity >> 20,
+                           paging.threads);
       });
-  if (!rendered.ok()) return rendered.status().WithContext(r.input.string());
+  if (!rendered.ok()) return rendered.status();
+  const bool has_contours = svo != nullptr ? svo->has_contours : reader->shape().has_contours;
   return RenderedPicture{.path = r.render_path.string(),
                          .width = options.width,
                          .height = options.height,
                          .view = options.view,
                          .shade = options.shade,
                          .level = rendered->level,
-                         .contours = options.contours && svo.has_contours,
+                         .contours = options.contours && has_contours,
                          .pixel_size = rendered->camera.pixel_size,
                          .hit_pixels = rendered->hits};
 }
 
-StatusOr<SlicePicture> Slice(const InspectRequest& r, const Svo& svo, Progress& progress) {
+// The slice of `svo` (read whole), else of the paged file `reader` streamed page by page.
+StatusOr<SlicePicture> Slice(const InspectRequest& r, const Svo* svo, const SvoReader* reader,
+                             Progress& progress) {
   SliceOptions options;
   options.level = r.level;
-  const StatusOr<RgbaImage> image = RunStage(progress, "slice", [&]() -> StatusOr<RgbaImage> {
-    StatusOr<RgbaImage> made = RenderSlice(svo, r.slice, options);
-    if (!made.ok()) return made;
-    SVOKIT_RETURN_IF_ERROR(WriteRgbaImage(*made, r.slice_path));
-    return made;
-  });
-  if (!image.ok()) return image.status().WithContext(r.input.string());
+  Progress::Stage stage(progress, "slice", 1);
+  StatusOr<RgbaImage> image = svo != nullptr
+                                  ? RenderSlice(*svo, r.slice, options)
+                                  : RenderSlice(*reader, r.slice, options, r.memory_limit, &stage);
+  // The paged route's errors name the file already.
+  if (!image.ok() && svo != nullptr) image = image.status().WithContext(r.input.string());
+  if (image.ok()) {
+    if (Status s = WriteRgbaImage(*image, r.slice_path); !s.ok()) {
+      image = s.WithContext(r.input.string());
+    }
+  }
+  if (!image.ok()) {
+    stage.Cancel();
+    return image.status();
+  }
   return SlicePicture{.path = r.slice_path.string(),
                       .axis = r.slice.axis,
                       .index = r.slice.index,
@@ -61,20 +92,19 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
   report.histograms = r.histograms;
   report.version = 1;
   std::optional<SvoStats> stats;
-  // A paged file (version 2 or 3) is counted page by page; version 1 is read whole.
+  // A paged file (version 2 or 3) is counted and drawn page by page; version 1 is read whole.
+  std::optional<SvoReader> paged;
   if (StatusOr<SvoReader> reader = SvoReader::Open(r.input); reader.ok()) {
-    if (r.level && *r.level > reader->depth()) {
-      return Status::BadInput("{}: level {} exceeds the octree's depth {}", r.input.string(),
-                              *r.level, reader->depth());
-    }
-    report.version = reader->version();
+    paged = std::move(*reader);
+    if (r.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(*paged, *r.level));
+    report.version = paged->version();
     report.file_bytes = std::filesystem::file_size(r.input);
-    StatusOr<SvoFileStats> file_stats = reader->FileStats(r.levels);
+    StatusOr<SvoFileStats> file_stats = paged->FileStats(r.levels);
     if (!file_stats.ok()) return file_stats.status();
     report.file_stats = std::move(*file_stats);
     Progress::Stage stage(progress, "statistics", 0);
     StatusOr<SvoStats> counted =
-        ComputeSvoStats(*reader, r.level, SvoStreamOptions{.memory_limit = r.memory_limit}, &stage);
+        ComputeSvoStats(*paged, r.level, SvoStreamOptions{.memory_limit = r.memory_limit}, &stage);
     if (!counted.ok()) {
       stage.Cancel();
       return counted.status();
@@ -82,19 +112,24 @@ StatusOr<std::string> InspectSvo(const InspectRequest& r, Progress& progress) {
     stats = std::move(*counted);
   }
   std::optional<Svo> svo;
-  if (!stats || !r.render_path.empty() || !r.slice_path.empty()) {
+  const bool slice_whole = !r.slice_path.empty() && !paged;
+  // Ambient occlusion is indexed by the whole octree's nodes: such renders read it whole.
+  const bool render_whole = !r.render_path.empty() && (!paged || r.render.shade == Shade::kAo);
+  if (!stats || render_whole || slice_whole) {
     StatusOr<Svo> read = ReadSvoStage(progress, r.input, r.level);
     if (!read.ok()) return read.status();
     svo = std::move(*read);
     report.file_bytes = std::filesystem::file_size(r.input);
   }
   if (!r.render_path.empty()) {
-    StatusOr<RenderedPicture> picture = Render(r, *svo, progress);
+    StatusOr<RenderedPicture> picture =
+        Render(r, render_whole ? &*svo : nullptr, paged ? &*paged : nullptr, progress);
     if (!picture.ok()) return picture.status();
     report.render = *picture;
   }
   if (!r.slice_path.empty()) {
-    StatusOr<SlicePicture> picture = Slice(r, *svo, progress);
+    StatusOr<SlicePicture> picture =
+        Slice(r, slice_whole ? &*svo : nullptr, paged ? &*paged : nullptr, progress);
     if (!picture.ok()) return picture.status();
     report.slice = *picture;
   }

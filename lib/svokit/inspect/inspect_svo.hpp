@@ -1,6 +1,6 @@
 #pragma once
-// svo-inspect's run: an octree's statistics computed (a paged file's page by page, within a memory
-// bound), and the pictures asked for rendered from it read whole (down to a level), in one report.
+// svo-inspect's run: an octree's statistics computed and the pictures asked for drawn (a paged
+// file's page by page, within a memory bound; version 1 read whole), in one report.
 
 #include <cstdint>
 #include <filesystem>
@@ -17,7 +17,7 @@ namespace svokit {
 struct InspectRequest {
   std::filesystem::path input;
   std::optional<std::uint32_t> level;  ///< read levels 0..level only
-  /// Bytes of pages a paged file's statistics hold at once (0: a few pages per thread).
+  /// Bytes of pages a paged file's statistics and pictures hold at once (0: a few per thread).
   std::uint64_t memory_limit = 0;
   bool levels = false;  ///< the per-level table
   bool histograms = false;

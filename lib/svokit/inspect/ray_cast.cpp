@@ -3,11 +3,17 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include "svokit/core/parallel.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
+#include "svokit/inspect/paged_svo.hpp"
 #include "svokit/mesh/image_codec.hpp"
 
 namespace svokit {
@@ -16,6 +22,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMargin = 0.02;  // of the image per side, around the fitted bounds
+// Without a limit, the pages a paged render caches per thread: a band of tiles' worth.
+constexpr std::uint64_t kDefaultPagesPerThread = 4;
 
 Vec3d Normalized(const Vec3d& v) {
   return v / Length(v);
@@ -109,11 +117,38 @@ BrickValue SampleBrick(const Svo& svo, std::uint32_t level, std::uint64_t index,
 
 // The traversal runs in the octree's unit cube, mirrored so every direction component is positive
 // (child c of the mirrored cube is child c ^ mirror of the real one); t stays the world distance.
+// Where a ray enters a page (a node of the page level) of a paged render: the page's cube in the
+// mirrored unit cube, the ray's span there, and the nodes the ray had visited before it.
+struct PageEntry {
+  std::size_t page = 0;
+  Vec3d lo;
+  double size = 0;
+  Span span;
+  std::uint32_t visits_before = 0;
+  std::uint32_t ray = 0;  ///< the ray's index in its tile
+};
+
+constexpr std::uint32_t kNoPages = ~std::uint32_t{0};
+
+// The pages of a paged render: page i (a node of `page_level`) as an Svo of its own (PageSvo).
+struct SvoPageSource {
+  std::uint32_t page_level = 0;
+  std::function<StatusOr<std::shared_ptr<const Svo>>(std::size_t)> page;
+};
+
+// A paged render casts in two steps: Cast() runs over the levels above the pages (`svo`),
+// recording each page the ray reaches as if it missed there; then ResolvePage() follows the ray
+// into those pages in its order (the page at hand) until one is hit. What each visit computes is
+// what the one-step traversal of the whole octree computes, so the pictures are the same.
 class Caster {
  public:
-  Caster(const Svo& svo, const Vec3d& origin, const Vec3d& direction, std::uint32_t leaf_level,
+  Caster(const Svo& svo, std::uint32_t page_level, std::vector<PageEntry>* record,
+         std::uint32_t ray, const Vec3d& origin, const Vec3d& direction, std::uint32_t leaf_level,
          bool use_contours)
       : svo_(svo),
+        page_level_(page_level),
+        record_(record),
+        ray_(ray),
         leaf_level_(leaf_level),
         contours_(use_contours),
         world_origin_(origin),
@@ -151,12 +186,29 @@ class Caster {
     span.entry_normal = FaceNormal(entry_axis);
     span.t0 = std::max(span.t0, 0.0);
     if (span.t0 <= span.t1) {
-      const SvoLevel& root = svo_.levels[0];
-      Visit(0, 0, root.contours.empty() ? 0 : root.contours[0], {0, 0, 0}, 1.0, span);
+      if (page_level_ == 0) {
+        RecordPage(0, {0, 0, 0}, 1.0, span);
+      } else {
+        const SvoLevel& root = svo_.levels[0];
+        Visit(svo_, 0, 0, root.contours.empty() ? 0 : root.contours[0], {0, 0, 0}, 1.0, span);
+      }
     }
-    hit_.visits = visits_;
+    hit_.visits = top_visits_ = visits_;
     return hit_;
   }
+
+  // Follows the ray into the page it recorded at `entry`, `page` its nodes: true when it is hit
+  // there (the ray is then done). hit() counts the visits the one-step traversal would.
+  bool ResolvePage(const Svo& page, const PageEntry& entry) {
+    const std::uint32_t before = visits_;
+    const SvoLevel& root = page.levels[page_level_];
+    const bool hit = Visit(page, page_level_, 0, root.contours.empty() ? 0 : root.contours[0],
+                           entry.lo, entry.size, entry.span);
+    page_visits_ += visits_ - before;
+    hit_.visits = (hit ? entry.visits_before : top_visits_) + page_visits_;
+    return hit;
+  }
+  const RayHit& hit() const { return hit_; }
 
  private:
   // The world normal of the mirrored cube face the ray enters through along `axis`.
@@ -188,16 +240,24 @@ class Caster {
     return span.t0 <= span.t1;
   }
 
-  // `contour`: the node's contour word, 0 for none (0 never encodes one: its normal is zero).
-  bool Visit(std::uint32_t level, std::uint64_t index, std::uint32_t contour, const Vec3d& lo,
-             double size, Span span) {
+  // A page the ray reaches, followed later (ResolvePage): the traversal goes on as if it missed.
+  bool RecordPage(std::size_t page, const Vec3d& lo, double size, const Span& span) {
+    record_->push_back({page, lo, size, span, visits_, ray_});
+    return false;
+  }
+
+  // Node `index` of `level` of `svo`; `contour`: its contour word, 0 for none (0 never encodes
+  // one: its normal is zero).
+  bool Visit(const Svo& svo, std::uint32_t level, std::uint64_t index, std::uint32_t contour,
+             const Vec3d& lo, double size, Span span) {
     ++visits_;
     if (contours_ && contour != 0 && !ClipToContour(contour, lo, size, span)) return false;
     if (level == leaf_level_) {
-      Hit(level, index, contour, lo, size, span);
+      Hit(svo, level, index, contour, lo, size, span);
       return true;
     }
-    const SvoNode& node = svo_.levels[level].nodes[index];
+    const bool pages_below = level + 1 == page_level_;
+    const SvoNode& node = svo.levels[level].nodes[index];
     const double half = size * 0.5;
     Vec3d tm, t1;
     std::array<double, 3> t0{};
@@ -233,13 +293,17 @@ class Caster {
         }
         child.t1 = std::min(child.t1, cmax);
         if (child.t0 <= child.t1) {
-          std::uint32_t word = 0;
-          if (node.contour_mask >> real & 1) {
-            word = svo_.levels[level + 1].contours[node.ChildContour(real)];
-          }
           const Vec3d child_lo{lo.x + ((c & 1) ? half : 0), lo.y + ((c & 2) ? half : 0),
                                lo.z + ((c & 4) ? half : 0)};
-          if (Visit(level + 1, node.Child(real), word, child_lo, half, child)) return true;
+          if (pages_below) {
+            if (RecordPage(node.Child(real), child_lo, half, child)) return true;
+          } else {
+            std::uint32_t word = 0;
+            if (node.contour_mask >> real & 1) {
+              word = svo.levels[level + 1].contours[node.ChildContour(real)];
+            }
+            if (Visit(svo, level + 1, node.Child(real), word, child_lo, half, child)) return true;
+          }
         }
       }
       // Leave through the nearest mid-plane not yet crossed, unless the ray leaves the node (or
@@ -263,8 +327,8 @@ class Caster {
     return false;
   }
 
-  void Hit(std::uint32_t level, std::uint64_t index, std::uint32_t contour, const Vec3d& lo,
-           double size, const Span& span) {
+  void Hit(const Svo& svo, std::uint32_t level, std::uint64_t index, std::uint32_t contour,
+           const Vec3d& lo, double size, const Span& span) {
     hit_.hit = true;
     hit_.t = span.t0;
     hit_.level = level;
@@ -276,7 +340,7 @@ class Caster {
       const double local = (o_[a] + d_[a] * span.t0 - lo[a]) / size;
       f[a] = (mirror_ >> a & 1) ? 1 - local : local;
     }
-    const BrickValue brick = SampleBrick(svo_, level, index, f);
+    const BrickValue brick = SampleBrick(svo, level, index, f);
     hit_.color = brick.color;
     // The leaf's own contour normal, else the filtered brick normal, else the face or slab the
     // span was entered through.
@@ -292,12 +356,16 @@ class Caster {
   }
 
   const Svo& svo_;
+  std::uint32_t page_level_;
+  std::vector<PageEntry>* record_;
+  std::uint32_t ray_;
   std::uint32_t leaf_level_;
   bool contours_;
   Vec3d world_origin_, world_dir_;
   Vec3d o_, d_, inv_;
   unsigned mirror_ = 0;
   std::uint32_t visits_ = 0;
+  std::uint32_t top_visits_ = 0, page_visits_ = 0;  // a paged cast's, apart
   RayHit hit_;
 };
 
@@ -341,27 +409,48 @@ OrthoCamera FitCamera(const Svo& svo, View view, int width, int height) {
 
 RayHit CastRay(const Svo& svo, const Vec3d& origin, const Vec3d& direction,
                std::uint32_t leaf_level, bool use_contours) {
-  return Caster(svo, origin, direction, leaf_level, use_contours).Cast();
+  return Caster(svo, kNoPages, nullptr, 0, origin, direction, leaf_level, use_contours).Cast();
 }
 
-StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
+namespace {
+
+Status CheckImageSize(const RenderOptions& options) {
   if (options.width < 1 || options.height < 1 || options.width > kMaxImageSide ||
       options.height > kMaxImageSide) {
     return Status::BadInput("an image of {}x{}: each side must be 1 to {}", options.width,
                             options.height, kMaxImageSide);
   }
-  if (svo.levels.empty() || svo.levels[0].node_count != 1) {
-    return Status::Internal("render of an octree without a root");
+  return Status::Ok();
+}
+
+// Pixels go by tiles of this side, the tiles in Morton order: a paged render reads each page a
+// tile's rays meet once for the tile, and neighbouring tiles find it still in the cache.
+constexpr int kTile = 32;
+
+// The tiles of a tiles_x × tiles_y grid, as (x, y), in Morton order.
+std::vector<std::array<int, 2>> TileOrder(int tiles_x, int tiles_y) {
+  std::vector<std::pair<std::uint64_t, std::array<int, 2>>> keyed;
+  for (int y = 0; y < tiles_y; ++y) {
+    for (int x = 0; x < tiles_x; ++x) {
+      std::uint64_t key = 0;
+      for (int b = 0; b < 16; ++b) {
+        key |= std::uint64_t{static_cast<std::uint32_t>(x) >> b & 1u} << (2 * b);
+        key |= std::uint64_t{static_cast<std::uint32_t>(y) >> b & 1u} << (2 * b + 1);
+      }
+      keyed.push_back({key, {x, y}});
+    }
   }
-  const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
-  const std::uint32_t level = options.level.value_or(loaded);
-  if (level > loaded) {
-    return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
-  }
-  if (options.shade == Shade::kAo && !svo.has_ao) {
-    return Status::BadInput(
-        "shading by ambient occlusion: the octree has no baked ambient occlusion (svo-bake)");
-  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::array<int, 2>> order;
+  for (const auto& k : keyed) order.push_back(k.second);
+  return order;
+}
+
+// The picture of `svo` (with `pages`, the levels above the pages) at leaf level `level`, tiles
+// in parallel on the current arena; each pixel is its own ray's, so the image does not depend on
+// the order. A page that cannot be read fails the render (the first tile's error).
+StatusOr<RenderResult> Draw(const Svo& svo, const SvoPageSource* pages,
+                            const RenderOptions& options, std::uint32_t level) {
   RenderResult result;
   result.level = level;
   result.camera = FitCamera(svo, options.view, options.width, options.height);
@@ -376,50 +465,160 @@ StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
   // A key light from the viewer's upper left: faces turned away darken, and the three faces of a
   // cube seen from iso differ (a pure headlight would shade them alike).
   const Vec3d light_dir = Normalized(cam.forward * -1.0 + cam.up * 0.6 - cam.right * 0.4);
-  std::vector<std::uint64_t> row_hits(static_cast<std::size_t>(options.height)),
-      row_visits(static_cast<std::size_t>(options.height));
-  tbb::parallel_for(0, options.height, [&](int y) {
-    for (int x = 0; x < options.width; ++x) {
-      const Vec3d origin = cam.top_left + cam.right * ((x + 0.5) * cam.pixel_size) -
-                           cam.up * ((y + 0.5) * cam.pixel_size);
-      const RayHit hit = CastRay(svo, origin, cam.forward, level, options.contours);
-      row_visits[static_cast<std::size_t>(y)] += hit.visits;
-      if (!hit.hit) continue;
-      ++row_hits[static_cast<std::size_t>(y)];
-      std::uint8_t* px = result.image.at(x, y);
-      px[3] = 255;
-      switch (options.shade) {
-        case Shade::kColor: {
-          const double light = 0.2 + 0.8 * std::max(0.0, Dot(hit.normal, light_dir));
-          px[0] = Byte(LinearToSrgb(static_cast<float>(hit.color.r * light)));
-          px[1] = Byte(LinearToSrgb(static_cast<float>(hit.color.g * light)));
-          px[2] = Byte(LinearToSrgb(static_cast<float>(hit.color.b * light)));
-          break;
+  const std::vector<std::array<int, 2>> order =
+      TileOrder((options.width + kTile - 1) / kTile, (options.height + kTile - 1) / kTile);
+  std::vector<std::uint64_t> tile_hits(order.size()), tile_visits(order.size());
+  std::vector<Status> tile_status(order.size(), Status::Ok());
+  const std::uint32_t page_level = pages != nullptr ? pages->page_level : kNoPages;
+  tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t t) {
+    const int x0 = order[t][0] * kTile, y0 = order[t][1] * kTile;
+    const int x1 = std::min(x0 + kTile, options.width), y1 = std::min(y0 + kTile, options.height);
+    std::vector<Caster> rays;
+    std::vector<PageEntry> entries;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const Vec3d origin = cam.top_left + cam.right * ((x + 0.5) * cam.pixel_size) -
+                             cam.up * ((y + 0.5) * cam.pixel_size);
+        rays.emplace_back(svo, page_level, &entries, static_cast<std::uint32_t>(rays.size()),
+                          origin, cam.forward, level, options.contours);
+        rays.back().Cast();
+      }
+    }
+    if (pages != nullptr) {
+      // The tile's pages one at a time, each read once, in an order every ray meets them in: a
+      // ray's coordinates (mirrored) only grow, so the pages it crosses by their sum.
+      std::sort(entries.begin(), entries.end(), [](const PageEntry& a, const PageEntry& b) {
+        const double sa = (a.lo.x + a.lo.y + a.lo.z) / a.size;
+        const double sb = (b.lo.x + b.lo.y + b.lo.z) / b.size;
+        return sa != sb ? sa < sb : a.page != b.page ? a.page < b.page : a.ray < b.ray;
+      });
+      std::vector<std::uint8_t> done(rays.size(), 0);
+      std::shared_ptr<const Svo> page;
+      std::size_t held = 0;
+      for (const PageEntry& entry : entries) {
+        if (done[entry.ray]) continue;
+        if (page == nullptr || entry.page != held) {
+          StatusOr<std::shared_ptr<const Svo>> read = pages->page(entry.page);
+          if (!read.ok()) {
+            tile_status[t] = read.status();
+            return;
+          }
+          page = std::move(*read);
+          held = entry.page;
         }
-        case Shade::kNormal:
-          px[0] = Byte(hit.normal.x * 0.5 + 0.5);
-          px[1] = Byte(hit.normal.y * 0.5 + 0.5);
-          px[2] = Byte(hit.normal.z * 0.5 + 0.5);
-          break;
-        case Shade::kDepth: {
-          const double v = 1 - 0.85 * (hit.t - near) / std::max(far - near, 1e-300);
-          px[0] = px[1] = px[2] = Byte(v);
-          break;
-        }
-        case Shade::kAo: {
-          // The hit node's baked AO as grey, white where open (not lit: the term alone).
-          const std::uint8_t ao = svo.levels[hit.level].ao[hit.node];
-          px[0] = px[1] = px[2] = static_cast<std::uint8_t>(255 - ao);
-          break;
+        done[entry.ray] = rays[entry.ray].ResolvePage(*page, entry);
+      }
+    }
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const RayHit& hit = rays[static_cast<std::size_t>((y - y0) * (x1 - x0) + (x - x0))].hit();
+        tile_visits[t] += hit.visits;
+        if (!hit.hit) continue;
+        ++tile_hits[t];
+        std::uint8_t* px = result.image.at(x, y);
+        px[3] = 255;
+        switch (options.shade) {
+          case Shade::kColor: {
+            const double light = 0.2 + 0.8 * std::max(0.0, Dot(hit.normal, light_dir));
+            px[0] = Byte(LinearToSrgb(static_cast<float>(hit.color.r * light)));
+            px[1] = Byte(LinearToSrgb(static_cast<float>(hit.color.g * light)));
+            px[2] = Byte(LinearToSrgb(static_cast<float>(hit.color.b * light)));
+            break;
+          }
+          case Shade::kNormal:
+            px[0] = Byte(hit.normal.x * 0.5 + 0.5);
+            px[1] = Byte(hit.normal.y * 0.5 + 0.5);
+            px[2] = Byte(hit.normal.z * 0.5 + 0.5);
+            break;
+          case Shade::kDepth: {
+            const double v = 1 - 0.85 * (hit.t - near) / std::max(far - near, 1e-300);
+            px[0] = px[1] = px[2] = Byte(v);
+            break;
+          }
+          case Shade::kAo: {
+            // The hit node's baked AO as grey, white where open (not lit: the term alone).
+            const std::uint8_t ao = svo.levels[hit.level].ao[hit.node];
+            px[0] = px[1] = px[2] = static_cast<std::uint8_t>(255 - ao);
+            break;
+          }
         }
       }
     }
   });
-  for (std::size_t y = 0; y < row_hits.size(); ++y) {
-    result.hits += row_hits[y];
-    result.node_visits += row_visits[y];
+  for (std::size_t t = 0; t < tile_hits.size(); ++t) {
+    SVOKIT_RETURN_IF_ERROR(tile_status[t]);
+    result.hits += tile_hits[t];
+    result.node_visits += tile_visits[t];
   }
   return result;
+}
+
+}  // namespace
+
+StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options) {
+  SVOKIT_RETURN_IF_ERROR(CheckImageSize(options));
+  if (svo.levels.empty() || svo.levels[0].node_count != 1) {
+    return Status::Internal("render of an octree without a root");
+  }
+  const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
+  const std::uint32_t level = options.level.value_or(loaded);
+  if (level > loaded) {
+    return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
+  }
+  if (options.shade == Shade::kAo && !svo.has_ao) {
+    return Status::BadInput(
+        "shading by ambient occlusion: the octree has no baked ambient occlusion (svo-bake)");
+  }
+  return Draw(svo, nullptr, options, level);
+}
+
+StatusOr<RenderResult> RenderSvo(const SvoReader& reader, const RenderOptions& options,
+                                 std::uint64_t memory_limit, PagedRenderStats* stats) {
+  SVOKIT_RETURN_IF_ERROR(CheckImageSize(options).WithContext(reader.name()));
+  const std::uint32_t level = options.level.value_or(reader.depth());
+  SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, level));
+  if (options.shade == Shade::kAo) {
+    // AOCC is indexed by the whole octree's nodes, which a page does not know.
+    return Status::BadInput("{}: shading by ambient occlusion reads the octree whole",
+                            reader.name());
+  }
+  const std::uint32_t page_level = reader.page_level();
+  StatusOr<Svo> top = ReadTopSvo(reader, level);
+  if (!top.ok()) return top.status();
+  if (level < page_level) return Draw(*top, nullptr, options, level);
+  // Each thread holds at most one page outside the cache (one it assembles, or one the cache has
+  // given up while its tile's rays are in it): the cache gets what the threads leave.
+  std::uint64_t largest = 1;
+  for (std::size_t i = 0; i < reader.page_count(); ++i) {
+    StatusOr<std::uint64_t> bytes = PageSvoPeakBytes(reader, i, level);
+    if (!bytes.ok()) return bytes.status();
+    largest = std::max(largest, *bytes);
+  }
+  StatusOr<std::size_t> in_flight = InFlightWithin(memory_limit, largest, largest, largest,
+                                                   "this file", "a page cached and one assembled");
+  if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
+  const std::size_t threads = std::min(*in_flight, Concurrency());
+  const std::uint64_t capacity = memory_limit == 0 ? kDefaultPagesPerThread * threads * largest
+                                                   : memory_limit - threads * largest;
+  PageCache<Svo> cache(
+      capacity,
+      [&](std::size_t i) -> StatusOr<Svo> {
+        StatusOr<SvoChunk> chunk = reader.Page(i);
+        if (!chunk.ok()) return chunk.status();
+        return PageSvo(reader, *chunk, level);
+      },
+      &SvoHeldBytes);
+  const SvoPageSource pages{page_level, [&](std::size_t i) { return cache.Page(i); }};
+  tbb::task_arena arena(static_cast<int>(threads));
+  StatusOr<RenderResult> drawn = arena.execute([&] { return Draw(*top, &pages, options, level); });
+  if (stats != nullptr) {
+    stats->threads = threads;
+    stats->cache_capacity = capacity;
+    stats->largest_page = largest;
+    stats->page_reads = cache.misses();
+    stats->page_hits = cache.hits();
+  }
+  return drawn;
 }
 
 }  // namespace svokit

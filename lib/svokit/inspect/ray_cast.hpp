@@ -10,6 +10,7 @@
 
 #include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/image.hpp"
 #include "svokit/inspect/render_options.hpp"
 #include "svokit/svo/svo.hpp"
@@ -56,8 +57,25 @@ struct RenderResult {
   std::uint64_t hits = 0, node_visits = 0;
 };
 
-/// Renders `svo` (rows in parallel; the image does not depend on the thread count). Bad input:
+/// Renders `svo` (tiles in parallel; the image does not depend on the thread count). Bad input:
 /// a size outside 1..16384 per axis, a level beyond the loaded ones.
 StatusOr<RenderResult> RenderSvo(const Svo& svo, const RenderOptions& options);
+
+/// How a paged render went.
+struct PagedRenderStats {
+  std::size_t threads = 0;
+  std::uint64_t cache_capacity = 0, largest_page = 0;  ///< bytes (PageSvoPeakBytes)
+  std::uint64_t page_reads = 0, page_hits = 0;
+};
+
+/// The same picture of a paged file (RenderSvo of it read whole, byte for byte), never read whole:
+/// the top levels are held; each tile's rays cross them noting the pages they reach, then the tile
+/// reads those pages one at a time front to back through a cache of assembled pages (least
+/// recently used out) and follows each ray into them until it hits. The cache and a page per
+/// thread stay within `memory_limit` bytes (0: a few pages per thread; below two of the largest
+/// page is bad input naming the smallest that works), threads fewer if it has no room for them.
+/// Shading by ambient occlusion is refused (the AOCC section is indexed by the whole octree).
+StatusOr<RenderResult> RenderSvo(const SvoReader& reader, const RenderOptions& options,
+                                 std::uint64_t memory_limit, PagedRenderStats* stats = nullptr);
 
 }  // namespace svokit

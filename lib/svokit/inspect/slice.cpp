@@ -4,6 +4,13 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "svokit/core/morton.hpp"
+#include "svokit/formats/svo/svo_stream.hpp"
+#include "svokit/inspect/paged_svo.hpp"
 
 namespace svokit {
 
@@ -68,100 +75,191 @@ StatusOr<SliceSpec> ParseSlice(std::string_view text) {
   return s;
 }
 
-StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
-                                const SliceOptions& options) {
-  if (svo.levels.empty()) return Status::Internal("slice of an octree without levels");
-  const auto loaded = static_cast<std::uint32_t>(svo.levels.size() - 1);
-  const std::uint32_t level = options.level.value_or(loaded);
-  if (level > loaded) {
-    return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
+namespace {
+
+// The picture of one slice at one level, painted node by node from whichever octree holds them
+// (the whole tree, the top levels, a page): each cell is one node or part of one full leaf, so
+// the order nodes are painted in does not matter.
+class SliceCanvas {
+ public:
+  // `dims`: the voxel grid's; `depth`: the octree's; `loaded`: its deepest level at hand.
+  static StatusOr<SliceCanvas> Make(const std::array<std::uint32_t, 3>& voxel_dims,
+                                    std::uint32_t depth, std::uint32_t loaded,
+                                    const SliceSpec& slice, const SliceOptions& options) {
+    const std::uint32_t level = options.level.value_or(loaded);
+    if (level > loaded) {
+      return Status::BadInput("level {} is beyond the octree's levels 0..{}", level, loaded);
+    }
+    // The grid at the slice level: voxel dims rounded up to whole nodes.
+    const std::uint32_t shift = depth - level;
+    std::array<std::uint32_t, 3> dims{};
+    for (int a = 0; a < 3; ++a) {
+      dims[a] = static_cast<std::uint32_t>(((std::uint64_t{voxel_dims[a]} - 1) >> shift) + 1);
+    }
+    static constexpr char kAxes[] = "xyz";
+    if (slice.index >= dims[slice.axis]) {
+      return Status::BadInput("slice {}={}: the grid has {} cells along {} at level {} (0..{})",
+                              kAxes[slice.axis], slice.index, dims[slice.axis], kAxes[slice.axis],
+                              level, dims[slice.axis] - 1);
+    }
+    SliceCanvas c;
+    c.slice_ = slice;
+    c.level_ = level;
+    // Image axes per slice axis: (column axis, row axis, rows run against the row axis).
+    c.col_axis_ = slice.axis == 0 ? 2 : 0;
+    c.row_axis_ = slice.axis == 1 ? 2 : 1;
+    c.flip_rows_ = slice.axis != 1;
+    c.cols_ = dims[c.col_axis_];
+    c.rows_ = dims[c.row_axis_];
+    c.scale_ = options.scale;
+    if (c.scale_ <= 0) c.scale_ = std::max(1, 512 / static_cast<int>(std::max(c.cols_, c.rows_)));
+    if (std::uint64_t{c.cols_} * c.scale_ > 16384 || std::uint64_t{c.rows_} * c.scale_ > 16384) {
+      return Status::BadInput("slice of {}x{} cells at {} pixels per cell is too large", c.cols_,
+                              c.rows_, c.scale_);
+    }
+    c.image_ =
+        RgbaImage(static_cast<int>(c.cols_) * c.scale_, static_cast<int>(c.rows_) * c.scale_);
+    return c;
   }
-  // The grid at the slice level: voxel dims rounded up to whole nodes.
-  const std::uint32_t shift = svo.depth - level;
-  std::array<std::uint32_t, 3> dims{};
-  for (int a = 0; a < 3; ++a) {
-    dims[a] = static_cast<std::uint32_t>(((std::uint64_t{svo.grid.dims()[a]} - 1) >> shift) + 1);
+
+  std::uint32_t level() const { return level_; }
+  RgbaImage& image() { return image_; }
+
+  // Paints the nodes of `svo` below node `node` of `level` (at grid position `ijk` of that level)
+  // that cross the slice, down to the slice level; children of level `cut` are left to the octrees
+  // that hold them (the pages below the top levels).
+  void Paint(const Svo& svo, std::uint32_t level, std::uint64_t node,
+             const std::array<std::uint32_t, 3>& ijk, std::uint32_t cut) {
+    std::vector<Frame> stack{{level, node, ijk}};
+    while (!stack.empty()) {
+      const Frame f = stack.back();
+      stack.pop_back();
+      if (f.level == level_) {
+        const std::array<std::uint8_t, 3> rgb = NodeColor(svo, level_, f.node);
+        PaintCell(f.ijk, rgb.data());
+        continue;
+      }
+      const SvoNode& n = svo.levels[f.level].nodes[f.node];
+      const unsigned bit = slice_.index >> (level_ - f.level - 1) & 1;
+      for (unsigned c = 0; c < 8; ++c) {
+        if ((c >> slice_.axis & 1) != bit) continue;
+        const std::array<std::uint32_t, 3> child{
+            f.ijk[0] * 2 + (c & 1), f.ijk[1] * 2 + (c >> 1 & 1), f.ijk[2] * 2 + (c >> 2 & 1)};
+        if (n.full_mask >> c & 1) PaintFull(f.level + 1, child);
+        if (!(n.child_mask >> c & 1) || f.level + 1 == cut) continue;
+        stack.push_back({f.level + 1, n.Child(c), child});
+      }
+    }
   }
-  static constexpr char kAxes[] = "xyz";
-  if (slice.index >= dims[slice.axis]) {
-    return Status::BadInput("slice {}={}: the grid has {} cells along {} at level {} (0..{})",
-                            kAxes[slice.axis], slice.index, dims[slice.axis], kAxes[slice.axis],
-                            level, dims[slice.axis] - 1);
-  }
-  // Image axes per slice axis: (column axis, row axis, rows run against the row axis).
-  const int col_axis = slice.axis == 0 ? 2 : 0, row_axis = slice.axis == 1 ? 2 : 1;
-  const bool flip_rows = slice.axis != 1;
-  const std::uint32_t cols = dims[col_axis], rows = dims[row_axis];
-  int scale = options.scale;
-  if (scale <= 0) scale = std::max(1, 512 / static_cast<int>(std::max(cols, rows)));
-  if (std::uint64_t{cols} * scale > 16384 || std::uint64_t{rows} * scale > 16384) {
-    return Status::BadInput("slice of {}x{} cells at {} pixels per cell is too large", cols, rows,
-                            scale);
-  }
-  RgbaImage image(static_cast<int>(cols) * scale, static_cast<int>(rows) * scale);
-  const auto paint = [&](const std::array<std::uint32_t, 3>& ijk, const std::uint8_t* rgb) {
-    if (ijk[col_axis] >= cols || ijk[row_axis] >= rows) return;
-    const std::uint32_t col = ijk[col_axis];
-    const std::uint32_t row = flip_rows ? rows - 1 - ijk[row_axis] : ijk[row_axis];
-    for (int dy = 0; dy < scale; ++dy) {
-      for (int dx = 0; dx < scale; ++dx) {
+
+ private:
+  struct Frame {
+    std::uint32_t level;
+    std::uint64_t node;
+    std::array<std::uint32_t, 3> ijk;
+  };
+
+  void PaintCell(const std::array<std::uint32_t, 3>& ijk, const std::uint8_t* rgb) {
+    if (ijk[col_axis_] >= cols_ || ijk[row_axis_] >= rows_) return;
+    const std::uint32_t col = ijk[col_axis_];
+    const std::uint32_t row = flip_rows_ ? rows_ - 1 - ijk[row_axis_] : ijk[row_axis_];
+    for (int dy = 0; dy < scale_; ++dy) {
+      for (int dx = 0; dx < scale_; ++dx) {
         std::uint8_t* px =
-            image.at(static_cast<int>(col) * scale + dx, static_cast<int>(row) * scale + dy);
+            image_.at(static_cast<int>(col) * scale_ + dx, static_cast<int>(row) * scale_ + dy);
         px[0] = rgb[0];
         px[1] = rgb[1];
         px[2] = rgb[2];
         px[3] = 255;
       }
     }
-  };
-  const auto put = [&](const std::array<std::uint32_t, 3>& ijk, std::uint64_t node) {
-    const std::array<std::uint8_t, 3> rgb = NodeColor(svo, level, node);
-    paint(ijk, rgb.data());
-  };
+  }
+
   // A full leaf of level l crossing the slice: its square of cells at the slice level.
-  const auto put_full = [&](std::uint32_t l, const std::array<std::uint32_t, 3>& ijk) {
-    const std::uint32_t side = 1u << (level - l);
+  void PaintFull(std::uint32_t l, const std::array<std::uint32_t, 3>& ijk) {
+    const std::uint32_t side = 1u << (level_ - l);
     std::array<std::uint32_t, 3> cell{ijk[0] * side, ijk[1] * side, ijk[2] * side};
-    cell[slice.axis] = slice.index;
-    const std::uint32_t col0 = cell[col_axis], row0 = cell[row_axis];
-    for (std::uint32_t r = 0; r < side && row0 + r < rows; ++r) {
-      for (std::uint32_t c = 0; c < side && col0 + c < cols; ++c) {
-        cell[col_axis] = col0 + c;
-        cell[row_axis] = row0 + r;
-        paint(cell, kSliceInterior);
+    cell[slice_.axis] = slice_.index;
+    const std::uint32_t col0 = cell[col_axis_], row0 = cell[row_axis_];
+    for (std::uint32_t r = 0; r < side && row0 + r < rows_; ++r) {
+      for (std::uint32_t c = 0; c < side && col0 + c < cols_; ++c) {
+        cell[col_axis_] = col0 + c;
+        cell[row_axis_] = row0 + r;
+        PaintCell(cell, kSliceInterior);
       }
-    }
-  };
-  // Depth-first over the nodes whose extent along the axis holds the slice.
-  struct Frame {
-    std::uint32_t level;
-    std::uint64_t node;
-    std::array<std::uint32_t, 3> ijk;
-  };
-  std::vector<Frame> stack{{0, 0, {0, 0, 0}}};
-  while (!stack.empty()) {
-    const Frame f = stack.back();
-    stack.pop_back();
-    if (f.level == level) {
-      put(f.ijk, f.node);
-      continue;
-    }
-    const SvoNode& n = svo.levels[f.level].nodes[f.node];
-    const unsigned bit = slice.index >> (level - f.level - 1) & 1;
-    for (unsigned c = 0; c < 8; ++c) {
-      if ((c >> slice.axis & 1) != bit) continue;
-      if (n.full_mask >> c & 1) {
-        put_full(f.level + 1, {f.ijk[0] * 2 + (c & 1), f.ijk[1] * 2 + (c >> 1 & 1),
-                               f.ijk[2] * 2 + (c >> 2 & 1)});
-      }
-      if (!(n.child_mask >> c & 1)) continue;
-      stack.push_back(
-          {f.level + 1,
-           n.Child(c),
-           {f.ijk[0] * 2 + (c & 1), f.ijk[1] * 2 + (c >> 1 & 1), f.ijk[2] * 2 + (c >> 2 & 1)}});
     }
   }
-  return image;
+
+  SliceSpec slice_;
+  std::uint32_t level_ = 0;
+  int col_axis_ = 0, row_axis_ = 1;
+  bool flip_rows_ = true;
+  std::uint32_t cols_ = 0, rows_ = 0;
+  int scale_ = 1;
+  RgbaImage image_;
+};
+
+constexpr std::uint32_t kNoCut = ~std::uint32_t{0};
+
+}  // namespace
+
+StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
+                                const SliceOptions& options) {
+  if (svo.levels.empty()) return Status::Internal("slice of an octree without levels");
+  StatusOr<SliceCanvas> canvas =
+      SliceCanvas::Make(svo.grid.dims(), svo.depth,
+                        static_cast<std::uint32_t>(svo.levels.size() - 1), slice, options);
+  if (!canvas.ok()) return canvas.status();
+  canvas->Paint(svo, 0, 0, {0, 0, 0}, kNoCut);
+  return std::move(canvas->image());
+}
+
+StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
+                                const SliceOptions& options, std::uint64_t memory_limit,
+                                Progress::Stage* stage) {
+  if (options.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, *options.level));
+  StatusOr<SliceCanvas> canvas =
+      SliceCanvas::Make(reader.grid().dims(), reader.depth(), reader.depth(), slice, options);
+  if (!canvas.ok()) return canvas.status().WithContext(reader.name());
+  const std::uint32_t level = canvas->level(), page_level = reader.page_level();
+  // The top levels are held whole (as the statistics hold them); their nodes of the page level
+  // are pages, painted as they stream past.
+  if (page_level > 0) {
+    StatusOr<Svo> top = ReadTopSvo(reader, level);
+    if (!top.ok()) return top.status();
+    canvas->Paint(*top, 0, 0, {0, 0, 0}, page_level);
+  }
+  if (level < page_level) return std::move(canvas->image());
+  // Only the pages the plane through the slice's cell centres crosses.
+  const double cell =
+      reader.grid().voxel_size() * std::ldexp(1.0, static_cast<int>(reader.depth() - level));
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Box3d plane{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
+  plane.lo[slice.axis] = plane.hi[slice.axis] =
+      reader.grid().origin()[slice.axis] + (slice.index + 0.5) * cell;
+  StatusOr<SvoStreamPlan> plan = PlanStream(reader, SvoStreamOptions{.box = plane});
+  if (!plan.ok()) return plan.status();
+  // What a page in flight holds is its assembly's peak, which the stream directory bounds.
+  std::uint64_t largest = 1;
+  for (const std::size_t i : plan->pages) {
+    StatusOr<std::uint64_t> bytes = PageSvoPeakBytes(reader, i, level);
+    if (!bytes.ok()) return bytes.status();
+    largest = std::max(largest, *bytes);
+  }
+  StatusOr<std::size_t> in_flight = InFlightWithin(memory_limit, 0, largest, largest, "this file",
+                                                   "the pages in flight (one at least)");
+  if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
+  plan->in_flight = *in_flight;
+  SVOKIT_RETURN_IF_ERROR(StreamPages<Svo>(
+      reader, *plan,
+      [&](std::size_t, SvoChunk chunk) -> StatusOr<Svo> { return PageSvo(reader, chunk, level); },
+      [&](std::size_t page, Svo svo) {
+        const MortonCoord c = MortonDecode(reader.page(page).key);
+        canvas->Paint(svo, page_level, 0, {c.x, c.y, c.z}, kNoCut);
+        return Status::Ok();
+      },
+      stage));
+  return std::move(canvas->image());
 }
 
 }  // namespace svokit

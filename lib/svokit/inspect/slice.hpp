@@ -11,7 +11,9 @@
 #include <optional>
 #include <string_view>
 
+#include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/inspect/image.hpp"
 #include "svokit/svo/svo.hpp"
 
@@ -40,5 +42,13 @@ inline constexpr std::uint8_t kSliceInterior[3] = {70, 110, 170};
 /// Bad input: an index outside the grid at that level, a level beyond the loaded ones.
 StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
                                 const SliceOptions& options = {});
+
+/// The same picture of a paged file, read page by page: the top levels whole, then only the pages
+/// the slice crosses, within `memory_limit` bytes of pages in flight (0: a few per thread; a limit
+/// below the largest page's is bad input naming the smallest that works). `stage` advances per
+/// page.
+StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
+                                const SliceOptions& options, std::uint64_t memory_limit,
+                                Progress::Stage* stage = nullptr);
 
 }  // namespace svokit

@@ -237,13 +237,9 @@ StatusOr<SvoFileStats> MergeBuiltAlone(const std::vector<SvoPart>& parts,
   const SvoPartHead& head = parts[0].head;
   BuiltPages built;
   for (const PartPage& p : where) built.keys.push_back(p.page->key);
-  const auto copy = [](std::span<const std::uint8_t> bytes) {
-    return StatusOr<std::vector<std::uint8_t>>(
-        std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
-  };
   built.name = path.string();
-  built.page = [&](std::size_t i) { return copy(where[i].part->PageBytes(*where[i].page)); };
-  built.shell = [&](std::size_t i) { return copy(where[i].part->ShellBytes(*where[i].page)); };
+  built.page = [&](std::size_t i) { return where[i].part->PageBytes(*where[i].page); };
+  built.shell = [&](std::size_t i) { return where[i].part->ShellBytes(*where[i].page); };
   const TopContours* top_words = head.frame.shape.has_contours ? &parts[0].top : nullptr;
   PagedSvoWriter writer(head.frame, head.compression);
   LevelSamples roots;
@@ -272,10 +268,11 @@ StatusOr<SvoFileStats> MergeFinished(const std::vector<SvoPart>& parts,
           for (const SvoPartPage& page : part.pages) {
             PagedSvoWriter::EncodedPage encoded;
             encoded.key = page.key;
-            const std::span<const std::uint8_t> bytes = part.PageBytes(page);
-            encoded.bytes.assign(bytes.begin(), bytes.end());
+            StatusOr<std::vector<std::uint8_t>> bytes = part.PageBytes(page);
+            if (!bytes.ok()) return bytes.status();
+            encoded.bytes = std::move(*bytes);
             StatusOr<ChunkBytes> sizes =
-                ChunkStreamBytes(bytes, fmt::format("{}: page {:#x}", part.name, page.key));
+                ChunkStreamBytes(encoded.bytes, fmt::format("{}: page {:#x}", part.name, page.key));
             if (!sizes.ok()) return sizes.status();
             encoded.stats = std::move(*sizes);
             encoded.levels = page.levels;

@@ -182,7 +182,8 @@ Svo SvoAssembler::Finish(const GridTransform& grid, VoxelMode mode, std::string 
       n.first_contour = contour;
       for (unsigned c = 0; c < 8; ++c) {
         if (!(masks[i] >> c & 1u)) continue;
-        if (below[child] != 0) {
+        // A last level whose children's chunks were not appended has no contour masks.
+        if (child < below.size() && below[child] != 0) {
           n.contour_mask |= static_cast<std::uint8_t>(1u << c);
           ++contour;
         }

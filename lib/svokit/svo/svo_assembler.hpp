@@ -31,6 +31,8 @@ class SvoAssembler {
     const SvoChunk* one = &chunk;
     Append(std::span(&one, 1));
   }
+  /// The octree of what was appended; when max_level's children were not (the top chunk alone,
+  /// down to the level above its pages), that level's nodes have no contour masks.
   Svo Finish(const GridTransform& grid, VoxelMode mode, std::string metadata);
 
  private:

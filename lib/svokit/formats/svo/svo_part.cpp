@@ -1,13 +1,16 @@
 #include "svokit/formats/svo/svo_part.hpp"
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <optional>
 #include <utility>
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include "svokit/core/bytes.hpp"
+#include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/container/grid_section.hpp"
@@ -140,8 +143,8 @@ Status DecodeTable(std::span<const std::uint8_t> bytes, SvoPart& part) {
       for (auto& v : l) SVOKIT_RETURN_IF_ERROR(t.Get(v));
     }
     // Sizes inside their sections (checked before adding, so no sum wraps around).
-    if (page.size > part.page_bytes.size() - offset ||
-        page.shell_size > part.shell_bytes.size() - shell_offset) {
+    if (page.size > part.page_bytes.size - offset ||
+        page.shell_size > part.shell_bytes.size - shell_offset) {
       return Status::BadInput("{}: the page table does not fill the pages", part.name);
     }
     page.offset = offset;
@@ -157,7 +160,7 @@ Status DecodeTable(std::span<const std::uint8_t> bytes, SvoPart& part) {
                               page.key);
     }
   }
-  if (offset != part.page_bytes.size() || shell_offset != part.shell_bytes.size()) {
+  if (offset != part.page_bytes.size || shell_offset != part.shell_bytes.size) {
     return Status::BadInput("{}: the page table does not fill the pages", part.name);
   }
   return Status::Ok();
@@ -235,7 +238,23 @@ Status WriteSvoPart(const std::filesystem::path& path, const SvoPartHead& head,
 }
 
 StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path) {
-  StatusOr<container::Reader> file = container::Reader::Open(path, kSvoPartFormat);
+  // The pages and shells are not mapped: their checksums are read through with pread below.
+  constexpr container::SectionFilter kSmallSections = [](container::Tag tag, const void*) {
+    return tag != kPartPages && tag != kPartShells;
+  };
+  StatusOr<container::Frame> frame = container::Frame::Open(path, kSvoPartFormat, kSmallSections);
+  if (!frame.ok()) return frame.status();
+  std::array<SvoPart::Extent, 2> big;
+  std::array<std::uint32_t, 2> big_crc{};
+  std::array<bool, 2> found{};
+  for (int k = 0; k < 2; ++k) {
+    if (const container::Frame::Section* s = frame->Find(k == 0 ? kPartPages : kPartShells)) {
+      big[k] = {s->offset, s->size};
+      big_crc[k] = s->crc;
+      found[k] = true;
+    }
+  }
+  StatusOr<container::Reader> file = container::Reader::FromFrame(std::move(*frame));
   if (!file.ok()) return file.status();
   if (file->version() != kSvoPartFormat.version) {
     return Status::BadInput("{}: a version-{} part; parts are merged by the svokit that built them",
@@ -245,31 +264,82 @@ StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path) {
   StatusOr<std::span<const std::uint8_t>> grid = part.file.Require(kGrid);
   StatusOr<std::span<const std::uint8_t>> head = part.file.Require(kPartHead);
   StatusOr<std::span<const std::uint8_t>> table = part.file.Require(kPartTable);
-  StatusOr<std::span<const std::uint8_t>> pages = part.file.Require(kPartPages);
-  StatusOr<std::span<const std::uint8_t>> shells = part.file.Require(kPartShells);
   StatusOr<std::span<const std::uint8_t>> top = part.file.Require(kPartTop);
   StatusOr<std::span<const std::uint8_t>> meta = part.file.Require(kMetadata);
-  for (const auto* s : {&grid, &head, &table, &pages, &shells, &top, &meta}) {
+  for (const auto* s : {&grid, &head, &table, &top, &meta}) {
     if (!s->ok()) return s->status();
   }
-  SvoFrame& frame = part.head.frame;
-  SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, part.name, frame.grid, frame.mode));
+  for (int k = 0; k < 2; ++k) {
+    if (!found[k]) {
+      return Status::BadInput("{}: required section '{}' is missing", part.name,
+                              k == 0 ? "PAGE" : "SHEL");
+    }
+  }
+  std::uint64_t size = 0;
+  StatusOr<int> fd = OpenRegularFile(path, size, {~std::uint64_t{0}, "a part"});
+  if (!fd.ok()) return fd.status();
+  part.fd = std::shared_ptr<const int>(new int(*fd), [](const int* p) {
+    ::close(*p);
+    delete p;
+  });
+  part.page_bytes = big[0];
+  part.shell_bytes = big[1];
+  // Checksummed a few MB at a time: the file's pages go through the page cache, not the process.
+  constexpr std::uint64_t kPiece = std::uint64_t{4} << 20;
+  std::vector<std::uint8_t> piece;
+  for (int k = 0; k < 2; ++k) {
+    std::uint32_t crc = 0;
+    for (std::uint64_t at = 0; at < big[k].size; at += kPiece) {
+      piece.resize(static_cast<std::size_t>(std::min(kPiece, big[k].size - at)));
+      if (const std::string why = ReadFullyAt(*part.fd, big[k].offset + at, piece); !why.empty()) {
+        return Status::BadInput("{}: cannot read ({})", part.name, why);
+      }
+      crc = Crc32c(piece.data(), piece.size(), crc);
+    }
+    if (crc != big_crc[k]) {
+      return Status::BadInput("{}: section '{}' checksum mismatch (file is corrupt)", part.name,
+                              k == 0 ? "PAGE" : "SHEL");
+    }
+  }
+  SvoFrame& frame_out = part.head.frame;
+  SVOKIT_RETURN_IF_ERROR(DecodeGridSection(*grid, part.name, frame_out.grid, frame_out.mode));
   SVOKIT_RETURN_IF_ERROR(DecodeHead(*head, part.name, part.head));
-  frame.metadata.assign(meta->begin(), meta->end());
-  part.page_bytes = *pages;
-  part.shell_bytes = *shells;
+  frame_out.metadata.assign(meta->begin(), meta->end());
   SVOKIT_RETURN_IF_ERROR(DecodeTable(*table, part));
   SVOKIT_RETURN_IF_ERROR(DecodeTop(*top, part));
   return part;
+}
+
+namespace {
+
+// `size` bytes at `offset` of `section` of the part.
+StatusOr<std::vector<std::uint8_t>> ReadPartBytes(const SvoPart& part, SvoPart::Extent section,
+                                                  std::uint64_t offset, std::uint64_t size) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  if (const std::string why = ReadFullyAt(*part.fd, section.offset + offset, bytes); !why.empty()) {
+    return Status::BadInput("{}: cannot read ({})", part.name, why);
+  }
+  return bytes;
+}
+
+}  // namespace
+
+StatusOr<std::vector<std::uint8_t>> SvoPart::PageBytes(const SvoPartPage& page) const {
+  return ReadPartBytes(*this, page_bytes, page.offset, page.size);
+}
+
+StatusOr<std::vector<std::uint8_t>> SvoPart::ShellBytes(const SvoPartPage& page) const {
+  return ReadPartBytes(*this, shell_bytes, page.shell_offset, page.shell_size);
 }
 
 StatusOr<SvoChunk> DecodeSvoPartPage(const SvoPart& part, const SvoPartPage& page) {
   const SvoFrame& frame = part.head.frame;
   const std::uint32_t page_level = PageLevel(frame.depth());
   const std::string name = fmt::format("{}: page {:#x}", part.name, page.key);
-  StatusOr<SvoChunk> chunk =
-      DecodeChunk(part.PageBytes(page), frame.shape,
-                  {page_level, page.key, frame.depth() - page_level + 1, true}, name);
+  StatusOr<std::vector<std::uint8_t>> bytes = part.PageBytes(page);
+  if (!bytes.ok()) return bytes.status();
+  StatusOr<SvoChunk> chunk = DecodeChunk(
+      *bytes, frame.shape, {page_level, page.key, frame.depth() - page_level + 1, true}, name);
   if (!chunk.ok()) return chunk.status();
   // The counts the writer took from this chunk (PagedSvoWriter::Encode): the merged file's
   // header and page table are their sums.
@@ -299,8 +369,9 @@ StatusOr<SvoChunk> DecodeSvoPartPage(const SvoPart& part, const SvoPartPage& pag
   }
   if (frame.shape.brick_side != 0) {
     const std::vector<std::uint8_t> shell = EncodePageShell(*chunk, frame.shape);
-    const std::span<const std::uint8_t> stored = part.ShellBytes(page);
-    if (!std::equal(shell.begin(), shell.end(), stored.begin(), stored.end())) {
+    StatusOr<std::vector<std::uint8_t>> stored = part.ShellBytes(page);
+    if (!stored.ok()) return stored.status();
+    if (shell != *stored) {
       return Status::BadInput("{}: its shell is not the one its samples make", name);
     }
   }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -62,27 +63,30 @@ struct SvoPartPage {
   std::vector<std::array<std::uint64_t, 3>> levels;
 };
 
-/// A part file, read and checked on its own (header, tables against sections); its pages' bytes
-/// stay in the mapped file.
+/// A part file, read and checked on its own (header, tables against sections). Its pages and
+/// shells stay in the file and are read with pread when asked for, so a merge holds the pages it
+/// works on, not the parts' sizes (a mapping would keep every page touched).
 struct SvoPart {
+  /// Where a section lies in the file.
+  struct Extent {
+    std::uint64_t offset = 0, size = 0;
+  };
   std::string name;
-  container::Reader file;
+  container::Reader file;  ///< the small sections (GRID, PART, PTAB, TOPC, META)
   SvoPartHead head;
   std::vector<SvoPartPage> pages;
-  std::span<const std::uint8_t> page_bytes, shell_bytes;
+  std::shared_ptr<const int> fd;   ///< the part opened for reading, closed with the last copy
+  Extent page_bytes, shell_bytes;  ///< the PAGE and SHEL sections
   TopContours top;
 
-  std::span<const std::uint8_t> PageBytes(const SvoPartPage& page) const {
-    return page_bytes.subspan(page.offset, page.size);
-  }
-  std::span<const std::uint8_t> ShellBytes(const SvoPartPage& page) const {
-    return shell_bytes.subspan(page.shell_offset, page.shell_size);
-  }
+  StatusOr<std::vector<std::uint8_t>> PageBytes(const SvoPartPage& page) const;
+  StatusOr<std::vector<std::uint8_t>> ShellBytes(const SvoPartPage& page) const;
 };
 /// Reads and checks a part on its own: its header's fields in range (part index, cell share,
 /// depth ≤ 20, brick side, flags, codec, zstd level 1 .. 22), its page table's keys ascending in
 /// the page level, sizes inside their sections and counts possible, its top contours' keys
-/// ascending and words well formed. Pages are checked by DecodeSvoPartPage.
+/// ascending and words well formed, every section's checksum. Pages are checked by
+/// DecodeSvoPartPage.
 StatusOr<SvoPart> ReadSvoPart(const std::filesystem::path& path);
 
 /// Decodes `page` of `part` and checks it against the part: the chunk's own checks (DecodeChunk:

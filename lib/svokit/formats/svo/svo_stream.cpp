@@ -84,57 +84,16 @@ StatusOr<SvoStreamPlan> PlanStream(
 }
 
 SvoPageCache::SvoPageCache(const SvoReader& reader, std::uint64_t capacity)
-    : reader_(reader), capacity_(capacity) {}
+    : PageCache<SvoChunk>(
+          capacity, [&reader](std::size_t i) { return reader.Page(i); }, &ChunkHeldBytes) {}
 
-StatusOr<std::shared_ptr<const SvoChunk>> SvoPageCache::Page(std::size_t i) {
-  {
-    std::lock_guard lock(mutex_);
-    if (const auto it = entries_.find(i); it != entries_.end()) {
-      ++hits_;
-      uses_.splice(uses_.begin(), uses_, it->second.use);
-      return it->second.chunk;
-    }
-    ++misses_;
-  }
-  StatusOr<SvoChunk> decoded = reader_.Page(i);
-  if (!decoded.ok()) return decoded.status();
-  auto chunk = std::make_shared<const SvoChunk>(std::move(*decoded));
-  const std::uint64_t bytes = ChunkHeldBytes(*chunk);
-  std::lock_guard lock(mutex_);
-  if (const auto it = entries_.find(i); it != entries_.end()) return it->second.chunk;  // a race
-  uses_.push_front(i);
-  entries_.emplace(i, Entry{chunk, bytes, uses_.begin()});
-  held_ += bytes;
-  while (held_ > capacity_ && uses_.size() > 1) {
-    const auto last = entries_.find(uses_.back());
-    held_ -= last->second.bytes;
-    entries_.erase(last);
-    uses_.pop_back();
-  }
-  return chunk;
-}
-
-std::uint64_t SvoPageCache::held_bytes() const {
-  std::lock_guard lock(mutex_);
-  return held_;
-}
-std::uint64_t SvoPageCache::hits() const {
-  std::lock_guard lock(mutex_);
-  return hits_;
-}
-std::uint64_t SvoPageCache::misses() const {
-  std::lock_guard lock(mutex_);
-  return misses_;
-}
-
-namespace {
-
-// A level deeper than the octree is refused, as ReadSvoStage words it.
-Status CheckLevel(const SvoReader& reader, std::uint32_t level) {
+Status CheckSvoLevel(const SvoReader& reader, std::uint32_t level) {
   if (level <= reader.depth()) return Status::Ok();
   return Status::BadInput("{}: level {} exceeds the octree's depth {}", reader.name(), level,
                           reader.depth());
 }
+
+namespace {
 
 // The keys of `level` in `chunk` (root_level ≤ level ≤ its last level).
 std::vector<std::uint64_t> ChunkLevelKeys(const SvoChunk& chunk, std::uint32_t level) {
@@ -160,7 +119,7 @@ SvoVoxelPage VoxelPageOf(std::size_t page, SvoChunk& chunk, std::uint32_t level,
 Status ForEachVoxelPage(const SvoReader& reader, std::uint32_t level,
                         const SvoStreamOptions& options,
                         const std::function<Status(SvoVoxelPage&)>& visit, Progress::Stage* stage) {
-  SVOKIT_RETURN_IF_ERROR(CheckLevel(reader, level));
+  SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, level));
   if (level < reader.page_level()) {
     StatusOr<SvoChunk> top = reader.Top();
     if (!top.ok()) return top.status();
@@ -184,7 +143,7 @@ Status ForEachLevelPage(const SvoReader& reader, std::uint32_t level, bool brick
                         const SvoStreamOptions& options,
                         const std::function<Status(std::size_t page, SvoChunkLevel&)>& visit,
                         Progress::Stage* stage) {
-  SVOKIT_RETURN_IF_ERROR(CheckLevel(reader, level));
+  SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, level));
   SvoShape shape = reader.shape();
   if (!bricks) shape.brick_side = 0;
   if (level < reader.page_level()) {

@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "svokit/core/box.hpp"
@@ -87,33 +88,84 @@ Status StreamPages(const SvoReader& reader, const SvoStreamPlan& plan, const Mak
       });
 }
 
-/// Decoded pages of one file, kept while they fit `capacity` bytes (ChunkHeldBytes), the least
-/// recently used given up first; the page asked for is always kept, even alone over capacity.
-/// Thread-safe: pages are decoded outside the lock, shared with whoever holds them.
-class SvoPageCache {
+/// Pages of one file made into T (decoded, or assembled from the decode), kept while they fit
+/// `capacity` bytes (`bytes` of each), the least recently used given up first; the page asked for
+/// is always kept, even alone over capacity. Thread-safe: pages are made outside the lock, shared
+/// with whoever holds them.
+template <class T>
+class PageCache {
  public:
-  SvoPageCache(const SvoReader& reader, std::uint64_t capacity);
+  using Make = std::function<StatusOr<T>(std::size_t)>;
+  using Bytes = std::function<std::uint64_t(const T&)>;
+  PageCache(std::uint64_t capacity, Make make, Bytes bytes)
+      : capacity_(capacity), make_(std::move(make)), bytes_(std::move(bytes)) {}
 
-  StatusOr<std::shared_ptr<const SvoChunk>> Page(std::size_t i);
+  StatusOr<std::shared_ptr<const T>> Page(std::size_t i) {
+    {
+      std::lock_guard lock(mutex_);
+      if (const auto it = entries_.find(i); it != entries_.end()) {
+        ++hits_;
+        uses_.splice(uses_.begin(), uses_, it->second.use);
+        return it->second.page;
+      }
+      ++misses_;
+    }
+    StatusOr<T> made = make_(i);
+    if (!made.ok()) return made.status();
+    auto page = std::make_shared<const T>(std::move(*made));
+    const std::uint64_t bytes = bytes_(*page);
+    std::lock_guard lock(mutex_);
+    if (const auto it = entries_.find(i); it != entries_.end()) return it->second.page;  // a race
+    uses_.push_front(i);
+    entries_.emplace(i, Entry{page, bytes, uses_.begin()});
+    held_ += bytes;
+    while (held_ > capacity_ && uses_.size() > 1) {
+      const auto last = entries_.find(uses_.back());
+      held_ -= last->second.bytes;
+      entries_.erase(last);
+      uses_.pop_back();
+    }
+    return page;
+  }
 
   std::uint64_t capacity() const { return capacity_; }
-  std::uint64_t held_bytes() const;
-  std::uint64_t hits() const;
-  std::uint64_t misses() const;
+  std::uint64_t held_bytes() const {
+    std::lock_guard lock(mutex_);
+    return held_;
+  }
+  std::uint64_t hits() const {
+    std::lock_guard lock(mutex_);
+    return hits_;
+  }
+  std::uint64_t misses() const {
+    std::lock_guard lock(mutex_);
+    return misses_;
+  }
 
  private:
   struct Entry {
-    std::shared_ptr<const SvoChunk> chunk;
+    std::shared_ptr<const T> page;
     std::uint64_t bytes = 0;
     std::list<std::size_t>::iterator use;
   };
-  const SvoReader& reader_;
   std::uint64_t capacity_;
+  Make make_;
+  Bytes bytes_;
   mutable std::mutex mutex_;
   std::unordered_map<std::size_t, Entry> entries_;
   std::list<std::size_t> uses_;  ///< most recent first
   std::uint64_t held_ = 0, hits_ = 0, misses_ = 0;
 };
+
+/// Decoded pages of `reader` (ChunkHeldBytes each), for reads in any order (a renderer's pages near
+/// the camera).
+class SvoPageCache : public PageCache<SvoChunk> {
+ public:
+  SvoPageCache(const SvoReader& reader, std::uint64_t capacity);
+};
+
+/// A level deeper than the octree is bad input, worded as ReadSvoStage words it.
+Status CheckSvoLevel(const SvoReader& reader, std::uint32_t level);
 
 /// One page's voxels (of the whole tree, or of level `level` read as leaves): Morton keys at that
 /// level, ascending, and with the voxel level the voxels' colours (empty when the file has none;
