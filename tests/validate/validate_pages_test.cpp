@@ -117,10 +117,7 @@ TEST(ValidatePages, FlippedPageBitSameReport) {
 TEST(ValidatePages, ChangedVoxelsSameFindings) {
   const test::PagedFile& torus = test::PagedTorus();
   VoxelSet voxels = torus.voxels;
-  // Every 997th voxel's normal reversed, and a stray voxel in the hole of the torus.
-  for (std::size_t i = 0; i < voxels.normals.size(); i += 997) {
-    voxels.normals[i] = Vec3f{-voxels.normals[i].x, -voxels.normals[i].y, -voxels.normals[i].z};
-  }
+  // A stray voxel in the hole of the torus.
   const auto& d = voxels.grid.dims();
   const std::uint64_t key = MortonEncode(d[0] / 2, d[1] / 2, d[2] / 2);
   const auto at =
@@ -133,8 +130,13 @@ TEST(ValidatePages, ChangedVoxelsSameFindings) {
   bo.brick_side = 3;
   auto svo = BuildCompactSvo(voxels, &TorusMesh(), bo, R"({"source":"test"})");
   ASSERT_TRUE(svo.ok());
-  // A contour word pushed off its cube, in a page's voxel level.
+  // Every 997th voxel's normal reversed after its bricks were filtered, and contour words pushed
+  // off their cubes.
   SvoChunk& whole = svo->whole;
+  for (std::size_t i = 0; i < whole.normals.size(); i += 997) {
+    const Vec3f n = whole.normals[i];
+    whole.normals[i] = Vec3f{-n.x, -n.y, -n.z};
+  }
   std::vector<std::uint32_t>& words = whole.contours.back();
   for (std::size_t i = 0; i < words.size(); i += 5003) {
     if (words[i] == 0) continue;
