@@ -2,7 +2,10 @@
 
 #include <algorithm>
 
+#include "svokit/core/morton.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/svo/mask_tree.hpp"
+#include "svokit/svo/sample_filter.hpp"
 #include "svokit/validate/paged_detail.hpp"
 
 namespace svokit::validate::paged_detail {
@@ -86,6 +89,96 @@ PageLevels LevelsOf(const SvoChunk& chunk, const SvoShape& shape) {
   }
   if (shape.has_color && shape.shared_color.empty()) out.colors = chunk.colors;
   if (shape.has_normal) out.normals = chunk.normals;
+  out.CountBytes();
+  return out;
+}
+
+bool NearFaces(std::uint64_t key, std::uint32_t level, std::uint32_t page_level,
+               std::uint64_t reach) {
+  const MortonCoord c = MortonDecode(key);
+  const std::uint32_t shift = level - page_level;
+  const std::uint64_t last = (std::uint64_t{1} << shift) - 1;
+  for (const std::uint64_t v : {std::uint64_t{c.x}, std::uint64_t{c.y}, std::uint64_t{c.z}}) {
+    const std::uint64_t in = v & last;
+    if (in < reach || last - in < reach) return true;
+  }
+  return false;
+}
+
+PageLevels ShellOf(const SvoChunk& chunk, const SvoShape& shape) {
+  const std::uint32_t first = chunk.root_level, depth = shape.depth;
+  const std::uint32_t samples = shape.brick_side * shape.brick_side * shape.brick_side;
+  PageLevels out;
+  out.first_level = first;
+  out.key = chunk.root_key;
+  SvoShape no_voxel_bricks = shape;
+  for (std::uint32_t level = first; level <= depth; ++level) {
+    // The voxel level's bricks below, for the near voxels alone.
+    if (level == depth) no_voxel_bricks.brick_side = 0;
+    SvoChunkLevel lv = AssembleChunkLevel(chunk, no_voxel_bricks, level);
+    std::vector<std::uint64_t> keys;
+    std::vector<std::uint32_t> words;
+    SvoLevel bricks;
+    for (std::size_t i = 0; i < lv.keys.size(); ++i) {
+      if (!NearFaces(lv.keys[i], level, first)) continue;
+      keys.push_back(lv.keys[i]);
+      if (shape.has_contours) words.push_back(lv.contours[i]);
+      if (samples == 0 || level == depth) continue;
+      const SvoLevel& b = lv.bricks;
+      const std::size_t s = i * samples;
+      bricks.opacity.insert(bricks.opacity.end(), b.opacity.begin() + s,
+                            b.opacity.begin() + s + samples);
+      if (!b.color.empty()) {
+        bricks.color.insert(bricks.color.end(), b.color.begin() + s, b.color.begin() + s + samples);
+      }
+      if (!b.normal.empty()) {
+        bricks.normal.insert(bricks.normal.end(), b.normal.begin() + s,
+                             b.normal.begin() + s + samples);
+      }
+    }
+    bricks.node_count = keys.size();
+    out.keys.push_back(std::move(keys));
+    out.words.push_back(std::move(words));
+    out.bricks.push_back(std::move(bricks));
+  }
+  // The near voxels' attributes, and their bricks from them, the voxels a few further in (a
+  // brick reads the voxels touching it) and the halo: the same samples the whole page gives.
+  const std::vector<std::uint64_t> own = ChunkVoxelKeys(chunk);
+  const bool per_voxel_colors = shape.has_color && shape.shared_color.empty();
+  std::vector<std::uint64_t> keys;
+  std::vector<std::uint8_t> keep;
+  DefaultInitVector<HalfRgba> colors;
+  DefaultInitVector<OctNormal> normals;
+  std::size_t a = 0, b = 0;
+  while (a < own.size() || b < chunk.halo_keys.size()) {
+    const bool mine =
+        b == chunk.halo_keys.size() || (a < own.size() && own[a] < chunk.halo_keys[b]);
+    if (mine && !NearFaces(own[a], depth, first, 6)) {
+      ++a;
+      continue;
+    }
+    const bool kept = mine && NearFaces(own[a], depth, first);
+    keys.push_back(mine ? own[a] : chunk.halo_keys[b]);
+    keep.push_back(kept ? 1 : 0);
+    if (per_voxel_colors) colors.push_back(mine ? chunk.colors[a] : chunk.halo_colors[b]);
+    if (shape.has_normal) normals.push_back(mine ? chunk.normals[a] : chunk.halo_normals[b]);
+    if (kept) {
+      if (per_voxel_colors) out.colors.push_back(chunk.colors[a]);
+      if (shape.has_normal) out.normals.push_back(chunk.normals[a]);
+    }
+    (mine ? a : b)++;
+  }
+  if (samples != 0 && !keys.empty()) {
+    VoxelSamplesSource source;
+    if (shape.has_color) {
+      source.colors = per_voxel_colors ? std::span<const HalfRgba>(colors)
+                                       : std::span<const HalfRgba>(shape.shared_color);
+    }
+    if (shape.has_normal) source.normals = normals;
+    const MaskTree tree = MaskTreeFromKeys(LevelKeysFromVoxels(std::move(keys), depth));
+    VoxelBricks(tree, shape.brick_side, source, out.bricks.back(), keep);
+  }
+  out.bricks.back().node_count = out.keys.back().size();
   out.CountBytes();
   return out;
 }

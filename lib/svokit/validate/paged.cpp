@@ -23,6 +23,7 @@
 
 namespace svokit::validate {
 
+using paged_detail::NearFaces;
 using paged_detail::PageLevels;
 
 namespace {
@@ -42,18 +43,6 @@ std::uint64_t DistanceToCube(std::uint64_t key, std::uint32_t level, std::uint64
     d = std::max(d, at[a] < lo[a] ? lo[a] - at[a] : at[a] > hi ? at[a] - hi : 0);
   }
   return d;
-}
-
-// Whether node `key` of `level` lies within two nodes of its page's cube's faces.
-bool NearFaces(std::uint64_t key, std::uint32_t level, std::uint32_t page_level) {
-  const MortonCoord c = MortonDecode(key);
-  const std::uint32_t shift = level - page_level;
-  const std::uint64_t mask = (std::uint64_t{1} << shift) - 1, last = mask;
-  for (const std::uint64_t v : {std::uint64_t{c.x}, std::uint64_t{c.y}, std::uint64_t{c.z}}) {
-    const std::uint64_t in = v & mask;
-    if (in < 2 || last - in < 2) return true;
-  }
-  return false;
 }
 
 // The nodes of `from` that `keep(level, key)` selects, with their bricks, words and attributes.
@@ -221,11 +210,7 @@ std::shared_ptr<const PageLevels> PagedValidator::Shell(std::size_t page) {
   if (auto hit = shells_->Find(page)) return hit;
   StatusOr<SvoChunk> chunk = reader_.Page(page);
   if (!chunk.ok()) return nullptr;
-  const PageLevels whole = paged_detail::LevelsOf(*chunk, shape_);
-  auto shell = std::make_shared<const PageLevels>(Select(
-      whole,
-      [&](std::uint32_t level, std::uint64_t key) { return NearFaces(key, level, page_level_); },
-      samples_));
+  auto shell = std::make_shared<const PageLevels>(paged_detail::ShellOf(*chunk, shape_));
   shells_->Put(page, shell);
   return shell;
 }

@@ -38,6 +38,13 @@ struct PageLevels {
 
 /// Every level of page `chunk`, its bricks assembled as a reader does.
 PageLevels LevelsOf(const SvoChunk& chunk, const SvoShape& shape);
+/// The nodes of page `chunk` within two of its cube's faces, as LevelsOf gives them: the voxel
+/// bricks computed for those voxels only.
+PageLevels ShellOf(const SvoChunk& chunk, const SvoShape& shape);
+/// Whether node `key` of `level` lies within `reach` nodes of its page's (level `page_level`)
+/// faces.
+bool NearFaces(std::uint64_t key, std::uint32_t level, std::uint32_t page_level,
+               std::uint64_t reach = 2);
 
 /// An octree of some nodes of a file: every level's keys and words, node records linked from the
 /// keys (levels above the pages: the ancestors), and where one page's nodes are in each level.
