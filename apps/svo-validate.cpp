@@ -3,6 +3,7 @@
 // everything holds, 1 with the findings, 2 for unusable input.
 
 #include <filesystem>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@
 #include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/validate/validate.hpp"
 
 int main(int argc, char** argv) {
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
       tool};
   std::filesystem::path input, mesh_path;
   bool json = false;
+  app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
   app::ImportCli import;
   app::AddFile(cli, "input", input, "Octree (.svo)")->required();
@@ -33,19 +36,35 @@ int main(int argc, char** argv) {
                "The mesh the octree was built from (.svm or any mesh file): enables the "
                "occupancy and contour-surface checks");
   cli.add_flag("--json", json, "Print the report as one JSON object");
+  memory_limit.Add(cli,
+                   "Bytes a paged file's pages and their checks (a page's distance field, its "
+                   "neighbours' borders) hold at once, besides the mesh (default: a few pages per "
+                   "thread)");
   import.Add(cli);
   app::AddCommonOptions(cli, common, "svo-validate bunny.svo --mesh bunny.svm");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
+    StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
+    if (!limit.ok()) return app::Fail(tool, limit.status());
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
-    StatusOr<LenientSvo> file = RunStage(progress, "read", [&] { return ReadSvoLenient(input); });
-    if (!file.ok()) return app::Fail(tool, file.status());
+    // A paged file is checked page by page; version 1 has no pages and is read whole.
+    StatusOr<LenientSvoReader> paged =
+        RunStage(progress, "open", [&] { return LenientSvoReader::Open(input); });
+    if (!paged.ok()) return app::Fail(tool, paged.status());
+    std::optional<LenientSvo> whole;
+    if (paged->version < 2) {
+      StatusOr<LenientSvo> file = RunStage(progress, "read", [&] { return ReadSvoLenient(input); });
+      if (!file.ok()) return app::Fail(tool, file.status());
+      whole = std::move(*file);
+    }
+    const GridTransform* grid = whole ? (whole->complete ? &whole->svo.grid : nullptr)
+                                      : (paged->reader ? &paged->reader->grid() : nullptr);
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
       // A damaged grid cannot vouch for or against the mesh: the checks will say what they can.
-      StatusOr<Mesh> m = file->complete
-                             ? ImportSourceMesh(progress, mesh_path, file->svo.grid, input,
+      StatusOr<Mesh> m = grid != nullptr
+                             ? ImportSourceMesh(progress, mesh_path, *grid, input,
                                                 "the octree was built from", import.options)
                              : ImportStage(progress, mesh_path, import.options);
       if (!m.ok()) return app::Fail(tool, m.status());
@@ -60,7 +79,13 @@ int main(int argc, char** argv) {
     }
     validate::ValidateOptions options;
     options.mesh = mesh ? &*mesh : nullptr;
-    const validate::Report report = validate::Validate(*file, input.string(), options, progress);
+    options.memory_limit = limit->value_or(0);
+    StatusOr<validate::Report> checked =
+        whole ? StatusOr<validate::Report>(
+                    validate::Validate(*whole, input.string(), options, progress))
+              : validate::ValidatePaged(*paged, input.string(), options, progress);
+    if (!checked.ok()) return app::Fail(tool, checked.status());
+    const validate::Report& report = *checked;
     if (json) {
       // The mesh's import warnings belong to the run, not to the octree's report.
       nlohmann::ordered_json j = nlohmann::ordered_json::parse(report.Json());

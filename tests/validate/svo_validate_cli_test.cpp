@@ -85,6 +85,8 @@ TEST(SvoValidateCli, UnusableInputExitsTwoWithOneLine) {
       {{(in / "t.svo").string(), "--mesh", (in / "far.obj").string()},
        "far.obj: the mesh lies outside"},
       {{(in / "t.svo").string(), "--bogus"}, "--bogus"},
+      {{(in / "t.svo").string(), "--memory-limit", "lots"}, "--memory-limit"},
+      {{(in / "t.svo").string(), "--memory-limit", "1"}, "is too small for this file"},
       {{}, "input"},
   };
   for (const auto& [args, expect] : cases) {

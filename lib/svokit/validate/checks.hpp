@@ -3,12 +3,16 @@
 // kinds are stable keys, listed in docs/tools/svo-validate.md.
 
 #include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/svo/sample_filter.hpp"
 #include "svokit/svo/svo.hpp"
+#include "svokit/validate/contour_surface.hpp"
 #include "svokit/validate/report.hpp"
 
 namespace svokit::validate {
@@ -28,6 +32,45 @@ CheckResult CheckBricks(const Svo& svo, const std::vector<std::vector<std::uint6
                         int filter, const VoxelSamplesSource& voxels,
                         Progress::Stage* stage = nullptr);
 
+/// A finding about one node, its index kept apart: a page knows its nodes' indices within the
+/// level only once the pages before it are counted.
+struct RawFinding {
+  std::string kind;
+  std::uint32_t level = 0;
+  std::uint64_t node = 0;  ///< index within its level (or within its page's run of it)
+  std::uint64_t key = 0;   ///< Morton key at `level`
+  std::string what;        ///< the message after "level L node N x,y,z: "
+};
+/// `raw` as a Finding whose node index is first_index + raw.node.
+Finding NodeFinding(const RawFinding& raw, std::uint64_t first_index);
+
+/// One level's node findings in node order: counts per kind and the first `keep` of each kind.
+struct LevelFindings {
+  std::map<std::string, std::uint64_t> counts;
+  std::vector<RawFinding> examples;
+  void Add(RawFinding f, std::size_t keep);
+  /// Appends the findings of the nodes that follow, whose indices start at `first_index`.
+  void Append(const LevelFindings& part, std::uint64_t first_index, std::size_t keep);
+  void MergeInto(CheckResult& out) const;
+};
+
+struct BrickLevelCounts {
+  std::uint64_t samples = 0, shared = 0;
+};
+/// CheckBricks on nodes first .. last − 1 of `level` (their indices in `out` relative to
+/// `first`): `svo` holds them and every node their filter and shared samples read.
+BrickLevelCounts CheckBrickLevel(const Svo& svo,
+                                 const std::vector<std::vector<std::uint64_t>>& level_keys,
+                                 std::uint32_t level, int filter, const VoxelSamplesSource& voxels,
+                                 std::size_t first, std::size_t last, std::size_t keep,
+                                 LevelFindings& out, Progress::Stage* stage = nullptr);
+/// Whether filter 2's voxel attributes are missing (the bricks check is skipped then).
+bool BrickVoxelsMissing(const Svo& svo, int filter, const VoxelSamplesSource& voxels);
+
+/// The contour_range finding of node `node` (key `key`) of `level` with contour `word`, if any.
+std::optional<RawFinding> ContourRangeFinding(std::uint32_t level, std::size_t node,
+                                              std::uint64_t key, std::uint32_t word);
+
 /// Contour words of a consistent octree: the decoded slab meets its node's cube.
 CheckResult CheckContourRanges(const Svo& svo);
 
@@ -36,6 +79,9 @@ CheckResult CheckContourRanges(const Svo& svo);
 CheckResult CheckContourSurface(const Svo& svo,
                                 const std::vector<std::vector<std::uint64_t>>& level_keys,
                                 const Mesh& mesh);
+
+/// The contour_surface check's result from what the sampling found.
+CheckResult ContourSurfaceResult(const SlabSampleResult& s, VoxelMode mode);
 
 /// Per level and node, the node's contour word (0 = none), from the parents' contour masks.
 std::vector<std::vector<std::uint32_t>> NodeContours(const Svo& svo);

@@ -16,6 +16,7 @@ namespace {
 struct Partial {
   std::uint64_t points = 0, checks = 0, violations = 0, orphans = 0;
   std::vector<SlabViolation> first;
+  std::vector<std::array<std::uint64_t, 3>> order;  // triangle, point, check of each of first
 };
 
 // Per axis, the node coordinates at a level whose closed extent [c·s, (c + 1)·s] holds v (one,
@@ -39,14 +40,30 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                                     std::span<const std::vector<std::uint32_t>> words,
                                     const SlabSampleOptions& options) {
   std::vector<std::unique_ptr<KeyIndex>> index;
-  for (const auto& keys : level_keys) index.push_back(std::make_unique<KeyIndex>(keys));
-  const std::size_t triangles = mesh.triangles.size();
+  std::vector<SlabLevel> levels;
+  for (std::size_t l = 0; l < level_keys.size(); ++l) {
+    index.push_back(std::make_unique<KeyIndex>(level_keys[l]));
+    levels.push_back({index.back().get(), words[l]});
+  }
+  std::vector<std::uint32_t> all(mesh.triangles.size());
+  for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<std::uint32_t>(t);
+  return SampleContourSlabsOf(mesh, grid, depth, levels, all, nullptr, options, nullptr);
+}
+
+SlabSampleResult SampleContourSlabsOf(const Mesh& mesh, const GridTransform& grid,
+                                      std::uint32_t depth, std::span<const SlabLevel> levels,
+                                      std::span<const std::uint32_t> triangles,
+                                      const std::function<bool(const Vec3d&)>& owns,
+                                      const SlabSampleOptions& options,
+                                      std::vector<std::array<std::uint64_t, 3>>* order) {
+  const std::size_t count = triangles.size();
   constexpr std::size_t kChunk = 256;
-  std::vector<Partial> parts((triangles + kChunk - 1) / kChunk);
+  std::vector<Partial> parts((count + kChunk - 1) / kChunk);
   tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t part) {
     Partial& r = parts[part];
     std::vector<Vec3d> pts;
-    for (std::size_t t = part * kChunk; t < std::min(triangles, (part + 1) * kChunk); ++t) {
+    for (std::size_t n = part * kChunk; n < std::min(count, (part + 1) * kChunk); ++n) {
+      const std::size_t t = triangles[n];
       // Sampled in voxel space, the voxelizer's frame: world areas of a 1e-300 mesh underflow.
       const Triangle& tri = mesh.triangles[t];
       const Vec3d a = grid.WorldToVoxel(mesh.positions[tri[0]]),
@@ -71,8 +88,11 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
         if (u + v > 1) u = 1 - u, v = 1 - v;
         pts.push_back(a * (1 - u - v) + b * u + c * v);
       }
-      for (const Vec3d& q : pts) {
+      for (std::size_t p = 0; p < pts.size(); ++p) {
+        const Vec3d& q = pts[p];
+        if (owns && !owns(q)) continue;
         ++r.points;
+        std::uint64_t check = 0;
         for (std::uint32_t level = 0; level <= depth; ++level) {
           const double s = std::ldexp(1.0, static_cast<int>(depth - level));
           const std::int64_t limit = std::int64_t{1} << level;
@@ -83,12 +103,12 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
           for (int iz = 0; iz < nz; ++iz) {
             for (int iy = 0; iy < ny; ++iy) {
               for (int ix = 0; ix < nx; ++ix) {
-                const std::int64_t node = index[level]->Find(MortonEncode(
+                const std::int64_t node = levels[level].index->Find(MortonEncode(
                     static_cast<std::uint32_t>(cx[ix]), static_cast<std::uint32_t>(cy[iy]),
                     static_cast<std::uint32_t>(cz[iz])));
                 if (node < 0) continue;
                 found = true;
-                const std::uint32_t word = words[level][static_cast<std::size_t>(node)];
+                const std::uint32_t word = levels[level].words[static_cast<std::size_t>(node)];
                 if (word == 0) continue;  // no contour: the whole cube
                 const Contour ct = DecodeContour(word);
                 const Vec3d u{(q.x - (static_cast<double>(cx[ix]) + 0.5) * s) / s,
@@ -97,6 +117,7 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                 const double d = ct.nx * u.x + ct.ny * u.y + ct.nz * u.z;
                 const double tol = 1e-9 * (std::abs(ct.nx) + std::abs(ct.ny) + std::abs(ct.nz));
                 ++r.checks;
+                ++check;
                 if (d < ct.Low() - tol || d > ct.High() + tol) {
                   if (r.violations++ < options.max_violations) {
                     r.first.push_back(
@@ -107,6 +128,7 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                          d,
                          ct.Low(),
                          ct.High()});
+                    r.order.push_back({t, p, check});
                   }
                 }
               }
@@ -123,8 +145,11 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
     out.checks += p.checks;
     out.violations += p.violations;
     out.orphans += p.orphans;
-    for (SlabViolation& v : p.first) {
-      if (out.first.size() < options.max_violations) out.first.push_back(v);
+    for (std::size_t i = 0; i < p.first.size(); ++i) {
+      if (out.first.size() < options.max_violations) {
+        out.first.push_back(p.first[i]);
+        if (order != nullptr) order->push_back(p.order[i]);
+      }
     }
   }
   return out;

@@ -3,7 +3,9 @@
 // points) must lie inside the decoded slab of every node whose closed cube holds them. Used by
 // svo-validate on files and by tests/svo/contour_test.cpp on FitContours' output.
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -11,6 +13,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/core/vec.hpp"
 #include "svokit/mesh/mesh.hpp"
+#include "svokit/svo/key_index.hpp"
 
 namespace svokit::validate {
 
@@ -45,5 +48,21 @@ SlabSampleResult SampleContourSlabs(const Mesh& mesh, const GridTransform& grid,
                                     std::span<const std::vector<std::uint64_t>> level_keys,
                                     std::span<const std::vector<std::uint32_t>> words,
                                     const SlabSampleOptions& options = {});
+
+/// One level as SampleContourSlabsOf reads it: its nodes' keys (indexed) and contour words.
+struct SlabLevel {
+  const KeyIndex* index = nullptr;
+  std::span<const std::uint32_t> words;
+};
+
+/// SampleContourSlabs over triangles `triangles` (ascending) only, and of their points only those
+/// `owns(point in voxels)` accepts; `order`, when given, receives for each of `first` its
+/// (triangle, point, check) position, the order the whole run would have found it in.
+SlabSampleResult SampleContourSlabsOf(const Mesh& mesh, const GridTransform& grid,
+                                      std::uint32_t depth, std::span<const SlabLevel> levels,
+                                      std::span<const std::uint32_t> triangles,
+                                      const std::function<bool(const Vec3d&)>& owns,
+                                      const SlabSampleOptions& options,
+                                      std::vector<std::array<std::uint64_t, 3>>* order);
 
 }  // namespace svokit::validate

@@ -14,6 +14,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/svo/key_index.hpp"
 #include "svokit/validate/checks.hpp"
+#include "svokit/validate/paged_detail.hpp"
 #include "svokit/voxelize/triangle_voxelizer.hpp"
 #include "svokit/voxelize/voxel_space.hpp"
 
@@ -225,5 +226,152 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
   r.Stat("triangles", snapped.triangles.size() + snapped.segments.size());
   return r;
 }
+
+namespace paged_detail {
+
+struct CubeOccupancy::Impl {
+  SnappedMesh snapped;
+  bool thin = false;
+  double required = 0, allowed = 0;
+  std::array<std::uint32_t, 3> dims{};
+  std::uint32_t depth = 0;
+};
+
+CubeOccupancy::CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelMode mode)
+    : impl_(std::make_unique<Impl>()) {
+  InitializeOpenVdb();
+  impl_->snapped = Snap(mesh, grid);
+  impl_->thin = mode == VoxelMode::kThin;
+  impl_->required = impl_->thin ? 0.5 / std::sqrt(3.0) : 0.5;
+  impl_->allowed = 0.5 * std::sqrt(3.0);
+  impl_->dims = grid.dims();
+  impl_->depth = OctreeDepth(grid);
+}
+
+CubeOccupancy::~CubeOccupancy() = default;
+
+std::size_t CubeOccupancy::primitives() const {
+  return impl_->snapped.triangles.size() + impl_->snapped.segments.size();
+}
+
+std::pair<Vec3d, Vec3d> CubeOccupancy::Bounds(std::size_t i) const {
+  const SnappedMesh& m = impl_->snapped;
+  openvdb::Vec3d lo, hi;
+  if (i < m.triangles.size()) {
+    lo = hi = m.points[m.triangles[i][0]];
+    for (int v = 1; v < 3; ++v) {
+      lo = openvdb::math::minComponent(lo, m.points[m.triangles[i][v]]);
+      hi = openvdb::math::maxComponent(hi, m.points[m.triangles[i][v]]);
+    }
+  } else {
+    const auto& [p, q] = m.segments[i - m.triangles.size()];
+    lo = openvdb::math::minComponent(p, q);
+    hi = openvdb::math::maxComponent(p, q);
+  }
+  return {Vec3d{lo.x(), lo.y(), lo.z()}, Vec3d{hi.x(), hi.y(), hi.z()}};
+}
+
+std::uint64_t CubeOccupancy::BytesPerCube(std::int64_t side) {
+  // A band two voxels either side of a surface through the cube: OpenVDB's leaves of 8³ floats
+  // and its primitive-index grid, about 16 bytes per voxel over (side + margin)² · 8 voxels.
+  const auto s = static_cast<std::uint64_t>(side + 2 * static_cast<std::int64_t>(kMargin));
+  return 16 * 8 * s * s * 4;
+}
+
+void CubeOccupancy::Check(const std::array<std::int64_t, 3>& lo, std::int64_t side,
+                          std::span<const std::uint32_t> near,
+                          std::span<const std::uint64_t> leaves, MeshPart& out) const {
+  const Impl& m = *impl_;
+  const std::size_t keep = 10;
+  const double tol = kDistanceTolerance;
+  // The cube's primitives alone: the distance at the cube's voxels is the whole mesh's, since
+  // every primitive within the band's reach of them is here.
+  SnappedMesh part;
+  for (const std::uint32_t i : near) {
+    if (i < m.snapped.triangles.size()) {
+      const auto& t = m.snapped.triangles[i];
+      const auto base = static_cast<std::uint32_t>(part.points.size());
+      for (int v = 0; v < 3; ++v) part.points.push_back(m.snapped.points[t[v]]);
+      part.triangles.push_back({base, base + 1, base + 2});
+    } else {
+      part.segments.push_back(m.snapped.segments[i - m.snapped.triangles.size()]);
+    }
+  }
+  out.leaves += leaves.size();
+  openvdb::FloatGrid::Ptr distance;
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
+  constexpr float kBand = 2.0f;
+  if (part.triangles.empty()) {
+    distance = openvdb::FloatGrid::create(kBand);
+    distance->setTransform(transform);
+  } else {
+    distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        part, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
+  }
+  AddSegmentDistances(part, kBand, *distance);
+  const auto report = [&](const char* kind, std::uint64_t key, double d, const char* what) {
+    const MortonCoord c = MortonDecode(key);
+    return Finding{kind,
+                   fmt::format("voxel ({}, {}, {}): centre {:.6f} h from the surface, {}", c.x, c.y,
+                               c.z, d, what),
+                   std::array<std::int64_t, 3>{c.x, c.y, c.z}, m.depth, d};
+  };
+  {
+    auto acc = distance->getConstAccessor();
+    for (const std::uint64_t key : leaves) {
+      const MortonCoord c = MortonDecode(key);
+      const double d = static_cast<double>(acc.getValue(
+          openvdb::Coord(static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z))));
+      if (d > m.allowed + tol && out.extra++ < keep) {
+        out.extra_first.push_back(
+            report("extra_voxel", key, d, "a leaf beyond the voxel's circumscribed sphere"));
+      }
+    }
+  }
+  std::vector<Located> missing;
+  for (auto it = distance->tree().cbeginValueOn(); it; ++it) {
+    const double d = static_cast<double>(*it);
+    if (d > m.required - tol) continue;
+    const openvdb::Coord ijk = it.getCoord();
+    const std::int64_t at[3] = {ijk.x(), ijk.y(), ijk.z()};
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      inside = inside && at[a] >= lo[a] && at[a] < lo[a] + side && at[a] >= 0 &&
+               at[a] < static_cast<std::int64_t>(m.dims[a]);
+    }
+    if (!inside) continue;
+    ++out.required;
+    const std::uint64_t key =
+        MortonEncode(static_cast<std::uint32_t>(ijk.x()), static_cast<std::uint32_t>(ijk.y()),
+                     static_cast<std::uint32_t>(ijk.z()));
+    if (!std::binary_search(leaves.begin(), leaves.end(), key)) missing.push_back({key, d});
+  }
+  std::sort(missing.begin(), missing.end(),
+            [](const Located& a, const Located& b) { return a.key < b.key; });
+  for (const Located& v : missing) {
+    if (out.missing++ < keep)
+      out.missing_first.push_back(report("missing_voxel", v.key, v.distance, "not a leaf"));
+  }
+}
+
+CheckResult CubeOccupancy::Result(const MeshPart& sum, std::uint64_t leaves) const {
+  const Impl& m = *impl_;
+  CheckResult r("occupancy");
+  r.note = fmt::format("{}: leaf required within {:.4f} h, allowed within {:.4f} h (± {} h)",
+                       m.thin ? "thin" : "conservative", m.required, m.allowed, kDistanceTolerance);
+  for (const Finding& f : sum.missing_first) r.Add(f);
+  r.AddCount("missing_voxel", sum.missing - sum.missing_first.size());
+  for (const Finding& f : sum.extra_first) r.Add(f);
+  r.AddCount("extra_voxel", sum.extra - sum.extra_first.size());
+  r.Stat("leaves", leaves);
+  r.Stat("matched", leaves - sum.extra);
+  r.Stat("required", sum.required);
+  r.Stat("missing", sum.missing);
+  r.Stat("extra", sum.extra);
+  r.Stat("triangles", primitives());
+  return r;
+}
+
+}  // namespace paged_detail
 
 }  // namespace svokit::validate

@@ -12,6 +12,7 @@
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/release_pages.hpp"
 #include "svokit/formats/container/container_detail.hpp"
 
 namespace svokit::container {
@@ -202,13 +203,36 @@ StatusOr<Frame> Frame::Open(const std::filesystem::path& path, const FormatId& f
   ::close(fd);
   std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(mapping->data),
                                       mapping->size);
-  StatusOr<Frame> frame = FromBytes(bytes, name, format, load, context);
+  StatusOr<Frame> frame = Parse(bytes, name, format, load, context, /*release=*/true);
   if (frame.ok()) frame->mapping_ = std::move(mapping);
   return frame;
 }
 
 StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std::string& name,
                                  const FormatId& format, SectionFilter load, const void* context) {
+  return Parse(bytes, name, format, load, context, /*release=*/false);
+}
+
+namespace {
+
+// CRC-32C of a section; with `release`, its mapped file pages go back to the kernel as they are
+// summed, so checking a file larger than memory holds none of it.
+std::uint32_t SectionCrc(std::span<const std::uint8_t> bytes, bool release) {
+  constexpr std::size_t kPiece = std::size_t{32} << 20;
+  std::uint32_t crc = 0;
+  for (std::size_t at = 0; at < bytes.size(); at += kPiece) {
+    const std::size_t n = std::min(kPiece, bytes.size() - at);
+    crc = Crc32c(bytes.data() + at, n, crc);
+    if (release) ReleaseMappedFilePages(bytes.data() + at, bytes.data() + at + n);
+  }
+  return crc;
+}
+
+}  // namespace
+
+StatusOr<Frame> Frame::Parse(std::span<const std::uint8_t> bytes, const std::string& name,
+                             const FormatId& format, SectionFilter load, const void* context,
+                             bool release) {
   if (bytes.size() < kHeaderSize ||
       std::memcmp(bytes.data(), format.magic.data(), format.magic.size()) != 0) {
     return Status::BadInput("{}: not a {} file (bad magic)", name, format.name);
@@ -267,7 +291,7 @@ StatusOr<Frame> Frame::FromBytes(std::span<const std::uint8_t> bytes, const std:
       s.bytes = bytes.subspan(s.offset, s.size);
       s.loaded = load == nullptr || load(s.tag, context);
       if (s.loaded) {
-        s.crc_ok = Crc32c(s.bytes.data(), s.bytes.size()) == section_crc;
+        s.crc_ok = SectionCrc(s.bytes, release) == section_crc;
         if (!s.crc_ok) {
           issue(IssueKind::kSectionChecksum,
                 fmt::format("section '{}' checksum mismatch (file is corrupt)", TagString(s.tag)));

@@ -130,6 +130,10 @@ class Frame {
 
  private:
   friend class Reader;
+  // FromBytes; with `release`, mapped bytes go back to the kernel once checksummed.
+  static StatusOr<Frame> Parse(std::span<const std::uint8_t> bytes, const std::string& name,
+                               const FormatId& format, SectionFilter load, const void* context,
+                               bool release);
   std::shared_ptr<const void> mapping_;  // keeps mapped bytes alive
   std::string name_;
   std::uint32_t version_ = 0;

@@ -74,37 +74,53 @@ std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8
   return std::move(bytes.bytes());
 }
 
+namespace {
+
+// The checks of DecodeAo that need only the node counts: the header, and the raw size against
+// `nodes` (the first `nodes` bytes when `whole` is false). The section's payload when they hold.
+std::optional<std::pair<std::span<const std::uint8_t>, std::uint64_t>> CheckAoHeader(
+    std::span<const std::uint8_t> section, const std::string& name, std::uint32_t depth,
+    std::uint64_t nodes, bool whole, IssueSink& sink, std::uint32_t& codec) {
+  ByteReader in(section, name + ": AOCC");
+  std::uint32_t levels = 0;
+  std::uint64_t raw = 0, stored = 0;
+  if (!in.Get(levels).ok() || !in.Get(codec).ok() || !in.Get(raw).ok() || !in.Get(stored).ok()) {
+    sink.Add("ao", name, "the AOCC section is shorter than its header");
+    return std::nullopt;
+  }
+  if (levels != depth + 1 || (codec != kStored && codec != kZstd) ||
+      stored != section.size() - kAoHeader || (codec == kStored && stored != raw)) {
+    sink.Add("ao", name, "the AOCC section's header is inconsistent ({} levels, codec {})", levels,
+             codec);
+    return std::nullopt;
+  }
+  if (whole ? raw != nodes : raw < nodes) {
+    sink.Add("ao", name, "the AOCC section holds {} bytes for {} nodes", raw, nodes);
+    return std::nullopt;
+  }
+  return std::pair{section.subspan(kAoHeader, stored), raw};
+}
+
+}  // namespace
+
 bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo) {
   const std::optional<std::span<const std::uint8_t>> section = Loaded(file, kAo);
   if (!section) return true;
   const std::string& name = file.name();
-  ByteReader in(*section, name + ": AOCC");
-  std::uint32_t levels = 0, codec = 0;
-  std::uint64_t raw = 0, stored = 0;
-  if (!in.Get(levels).ok() || !in.Get(codec).ok() || !in.Get(raw).ok() || !in.Get(stored).ok()) {
-    sink.Add("ao", name, "the AOCC section is shorter than its header");
-    return false;
-  }
-  if (levels != svo.depth + 1 || (codec != kStored && codec != kZstd) ||
-      stored != section->size() - kAoHeader || (codec == kStored && stored != raw)) {
-    sink.Add("ao", name, "the AOCC section's header is inconsistent ({} levels, codec {})", levels,
-             codec);
-    return false;
-  }
   // Levels past `last` were not decoded: their bytes follow the decoded levels' and are dropped.
   std::uint64_t nodes = 0;
   for (std::uint32_t l = 0; l <= last && l < svo.levels.size(); ++l)
     nodes += svo.levels[l].node_count;
   // A whole octree needs every byte; one read down to `last` the first `nodes` (levels in order).
-  if (last >= svo.depth ? raw != nodes : raw < nodes) {
-    sink.Add("ao", name, "the AOCC section holds {} bytes for {} nodes", raw, nodes);
-    return false;
-  }
+  std::uint32_t codec = 0;
+  const auto payload =
+      CheckAoHeader(*section, name, svo.depth, nodes, last >= svo.depth, sink, codec);
+  if (!payload) return false;
+  const auto [p, raw] = *payload;
   std::vector<std::uint8_t> bytes(nodes);
-  const std::uint8_t* p = section->data() + kAoHeader;
   if (codec == kStored) {
-    std::copy(p, p + nodes, bytes.begin());
-  } else if (ZSTD_getFrameContentSize(p, stored) != raw || !DecompressPrefix({p, stored}, bytes)) {
+    std::copy(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(nodes), bytes.begin());
+  } else if (ZSTD_getFrameContentSize(p.data(), p.size()) != raw || !DecompressPrefix(p, bytes)) {
     sink.Add("ao", name, "the AOCC stream does not decode to its {} bytes", raw);
     return false;
   }
@@ -116,6 +132,36 @@ bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink,
   }
   svo.has_ao = true;
   return true;
+}
+
+bool CheckAo(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
+             IssueSink& sink) {
+  const std::optional<std::span<const std::uint8_t>> section = Loaded(file, kAo);
+  if (!section) return true;
+  const std::string& name = file.name();
+  std::uint32_t codec = 0;
+  const auto payload = CheckAoHeader(*section, name, depth, nodes, true, sink, codec);
+  if (!payload) return false;
+  if (codec == kStored) return true;
+  // Decoded through a small buffer: the stream's length is what DecodeAo would check.
+  const auto [p, raw] = *payload;
+  bool ok = ZSTD_getFrameContentSize(p.data(), p.size()) == raw;
+  ZSTD_DCtx* ctx = ZSTD_createDCtx();
+  std::vector<std::uint8_t> buffer(std::size_t{1} << 20);
+  ZSTD_inBuffer in{p.data(), p.size(), 0};
+  std::uint64_t out = 0;
+  while (ok && out < raw) {
+    ZSTD_outBuffer to{buffer.data(), std::min<std::uint64_t>(buffer.size(), raw - out), 0};
+    const std::size_t in_before = in.pos;
+    const std::size_t r = ZSTD_decompressStream(ctx, &to, &in);
+    out += to.pos;
+    if (ZSTD_isError(r) || (r == 0 && out < raw) || (in.pos == in_before && to.pos == 0)) {
+      ok = !ZSTD_isError(r) && out == raw;
+    }
+  }
+  ZSTD_freeDCtx(ctx);
+  if (!ok) sink.Add("ao", name, "the AOCC stream does not decode to its {} bytes", raw);
+  return ok;
 }
 
 }  // namespace svo_detail

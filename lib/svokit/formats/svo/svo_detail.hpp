@@ -78,6 +78,11 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
 std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8_t>> ao);
 /// Reads the file's `AOCC` section, if any, into the decoded levels (0 .. `last`) of `svo`.
 bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo);
+/// DecodeAo's checks of a whole octree of `depth` and `nodes` nodes in all, keeping nothing.
+bool CheckAo(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
+             IssueSink& sink);
+/// The stable key of a frame issue (ReadSvoLenient's kinds).
+const char* FrameIssueKind(container::Frame::IssueKind kind);
 
 /// A version-2 file's frame, parsed and checked (HEAD, page table): what a page decoder needs.
 struct Version2 {
@@ -100,6 +105,8 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink);
 /// The top chunk (empty when the page level is 0).
 StatusOr<SvoChunk> DecodeTop(const Version2& v, const std::string& name,
                              ChunkParts parts = ChunkParts::kAll);
+/// The top chunk, its last level checked against the page table's keys; a problem goes to `sink`.
+StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, IssueSink& sink);
 /// Page `page`, its checksum verified; a problem also goes to `sink` when given.
 StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::string& name,
                               IssueSink* sink = nullptr, ChunkParts parts = ChunkParts::kAll);

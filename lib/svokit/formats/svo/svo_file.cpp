@@ -21,6 +21,24 @@ bool SectionsToLoad(Tag tag, const void* context) {
   return level <= *static_cast<const std::uint32_t*>(context);
 }
 
+const char* FrameIssueKind(container::Frame::IssueKind kind) {
+  switch (kind) {
+    case container::Frame::IssueKind::kFileSize:
+      return "file_size";
+    case container::Frame::IssueKind::kSectionTable:
+      return "section_table";
+    case container::Frame::IssueKind::kHeaderChecksum:
+      return "header_checksum";
+    case container::Frame::IssueKind::kSectionBounds:
+      return "section_bounds";
+    case container::Frame::IssueKind::kSectionChecksum:
+      return "section_checksum";
+    case container::Frame::IssueKind::kLayout:
+      return "layout";
+  }
+  return "frame";
+}
+
 }  // namespace svo_detail
 
 namespace {
@@ -50,24 +68,6 @@ StatusOr<Svo> DecodeStrict(const StatusOr<container::Frame>& opened,
                                                       : sink.issues().front().message);
   }
   return svo;
-}
-
-const char* FrameIssueKind(container::Frame::IssueKind kind) {
-  switch (kind) {
-    case container::Frame::IssueKind::kFileSize:
-      return "file_size";
-    case container::Frame::IssueKind::kSectionTable:
-      return "section_table";
-    case container::Frame::IssueKind::kHeaderChecksum:
-      return "header_checksum";
-    case container::Frame::IssueKind::kSectionBounds:
-      return "section_bounds";
-    case container::Frame::IssueKind::kSectionChecksum:
-      return "section_checksum";
-    case container::Frame::IssueKind::kLayout:
-      return "layout";
-  }
-  return "frame";
 }
 
 StatusOr<LenientSvo> DecodeLenient(const StatusOr<container::Frame>& opened) {

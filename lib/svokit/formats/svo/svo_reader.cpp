@@ -175,6 +175,55 @@ StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts) const {
   return page;
 }
 
+StatusOr<SvoChunk> SvoReader::Page(std::size_t i, ChunkParts parts, SvoIssue* issue) const {
+  StatusOr<SvoChunk> page = Page(i, parts);
+  if (!page.ok() && issue != nullptr && i < page_count()) {
+    // Decoded again to word the issue as the lenient reader does (a failed page is rare).
+    svo_detail::IssueSink sink(/*stop_at_first=*/false);
+    (void)svo_detail::DecodePage(state_->v, i, name(), &sink, parts);
+    if (!sink.empty()) *issue = sink.issues().front();
+  }
+  return page;
+}
+
+std::optional<SvoIssue> SvoReader::CheckAo(std::uint64_t nodes) const {
+  svo_detail::IssueSink sink(/*stop_at_first=*/false);
+  if (svo_detail::CheckAo(state_->frame, depth(), nodes, sink)) return std::nullopt;
+  return sink.issues().front();
+}
+
+StatusOr<LenientSvoReader> LenientSvoReader::FromFrame(StatusOr<container::Frame> frame,
+                                                       bool mapped) {
+  if (!frame.ok()) return frame.status();
+  LenientSvoReader out;
+  out.version = frame->version();
+  if (out.version < 2) return out;
+  svo_detail::IssueSink sink(/*stop_at_first=*/false);
+  for (const container::Frame::Issue& issue : frame->issues()) {
+    const char* kind = svo_detail::FrameIssueKind(issue.kind);
+    if (sink.counts()[kind]++ < svo_detail::IssueSink::kMaxExamples) {
+      sink.issues().push_back({kind, issue.message});
+    }
+  }
+  StatusOr<svo_detail::Version2> v = svo_detail::ParseVersion2(*frame, sink);
+  if (v.ok() && svo_detail::DecodeTopOfPages(*v, frame->name(), sink).ok()) {
+    out.reader = SvoReader(std::make_unique<SvoReader::State>(
+        SvoReader::State{std::move(*frame), std::move(*v), mapped}));
+  }
+  out.issues = std::move(sink.issues());
+  out.issue_counts = std::move(sink.counts());
+  return out;
+}
+
+StatusOr<LenientSvoReader> LenientSvoReader::Open(const std::filesystem::path& path) {
+  return FromFrame(container::Frame::Open(path, kSvoFormat), true);
+}
+
+StatusOr<LenientSvoReader> LenientSvoReader::FromBytes(std::span<const std::uint8_t> bytes,
+                                                       const std::string& name) {
+  return FromFrame(container::Frame::FromBytes(bytes, name, kSvoFormat), false);
+}
+
 StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
   const svo_detail::Version2::Page& p = state_->v.pages.at(i);
   StatusOr<ChunkBytes> bytes = ChunkStreamBytes(state_->v.page_bytes.subspan(p.offset, p.size),

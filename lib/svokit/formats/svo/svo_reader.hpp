@@ -7,7 +7,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,6 +74,11 @@ class SvoReader {
   /// Page i, checked. Its mapped file bytes go back to the kernel once it is decoded (read again
   /// if touched), so a pass over every page holds only the pages in flight.
   StatusOr<SvoChunk> Page(std::size_t i, ChunkParts parts = ChunkParts::kAll) const;
+  /// Page(i, parts); when it fails, `issue` receives what ReadSvoLenient reports for the page.
+  StatusOr<SvoChunk> Page(std::size_t i, ChunkParts parts, SvoIssue* issue) const;
+  /// ReadSvoLenient's checks of the `AOCC` section (kind "ao"), for an octree of `nodes` nodes in
+  /// all; nothing when it holds or is absent.
+  std::optional<SvoIssue> CheckAo(std::uint64_t nodes) const;
 
  private:
   struct State;
@@ -79,6 +86,24 @@ class SvoReader {
   // Gives page i's mapped file bytes back to the kernel, and the ones mapped around them.
   void ReleasePage(std::size_t i) const;
   std::unique_ptr<State> state_;
+  friend struct LenientSvoReader;
+};
+
+/// A file opened to be checked page by page (svo-validate) with the checks ReadSvoLenient runs on
+/// it whole: the issues of its frame, header, tables and top chunk, and a reader when they leave
+/// the pages readable (a frame checksum issue does not stop it).
+struct LenientSvoReader {
+  std::uint32_t version = 0;
+  std::vector<SvoIssue> issues;                       ///< in check order, at most 100 per kind
+  std::map<std::string, std::uint64_t> issue_counts;  ///< per kind, all of them
+  std::optional<SvoReader> reader;                    ///< versions 2 and 3
+  /// Fails only as ReadSvoLenient does (not an .svo at all). Version 1: no reader, no issues.
+  static StatusOr<LenientSvoReader> Open(const std::filesystem::path& path);
+  static StatusOr<LenientSvoReader> FromBytes(std::span<const std::uint8_t> bytes,
+                                              const std::string& name);
+
+ private:
+  static StatusOr<LenientSvoReader> FromFrame(StatusOr<container::Frame> frame, bool mapped);
 };
 
 /// A level of a loaded chunk as a renderer uploads it: node keys (Morton at that level), child

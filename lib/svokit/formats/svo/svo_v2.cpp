@@ -361,6 +361,24 @@ StatusOr<SvoChunk> DecodePage(const Version2& v, std::size_t page, const std::st
   return chunk;
 }
 
+StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, IssueSink& sink) {
+  StatusOr<SvoChunk> top = DecodeTop(v, name);
+  if (!top.ok()) {
+    sink.Add("page_decode", name, "{}", top.status().message().substr(name.size() + 2));
+    return top.status();
+  }
+  const std::vector<std::uint64_t> roots =
+      v.page_level == 0 ? std::vector<std::uint64_t>{0} : KeysOfLevel(top->tree, v.page_level);
+  if (roots.size() != v.pages.size() ||
+      !std::equal(roots.begin(), roots.end(), v.pages.begin(),
+                  [](std::uint64_t k, const Version2::Page& p) { return k == p.key; })) {
+    sink.Add("page_table", name, "the page table's keys are not the top chunk's level {}",
+             v.page_level);
+    return Status::BadInput("{}: page table", name);
+  }
+  return top;
+}
+
 namespace {
 
 // What the checks of the whole voxel set need from the pages: keys, attributes, halos.
@@ -387,25 +405,6 @@ struct PageVoxels {
     }
   }
 };
-
-// The top chunk, whose last masks name the pages: the page table's keys, in order.
-StatusOr<SvoChunk> DecodeTopOfPages(const Version2& v, const std::string& name, IssueSink& sink) {
-  StatusOr<SvoChunk> top = DecodeTop(v, name);
-  if (!top.ok()) {
-    sink.Add("page_decode", name, "{}", top.status().message().substr(name.size() + 2));
-    return top.status();
-  }
-  const std::vector<std::uint64_t> roots =
-      v.page_level == 0 ? std::vector<std::uint64_t>{0} : KeysOfLevel(top->tree, v.page_level);
-  if (roots.size() != v.pages.size() ||
-      !std::equal(roots.begin(), roots.end(), v.pages.begin(),
-                  [](std::uint64_t k, const Version2::Page& p) { return k == p.key; })) {
-    sink.Add("page_table", name, "the page table's keys are not the top chunk's level {}",
-             v.page_level);
-    return Status::BadInput("{}: page table", name);
-  }
-  return top;
-}
 
 // Pages, if the levels asked for reach them (one level above, for its contour masks), decode and
 // assemble their bricks in parallel, a batch at a time, and join the octree in order; a failed
