@@ -231,6 +231,9 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   SvoStreamOptions stream{.memory_limit = memory_limit};
   const bool by_slabs = *ext == "binvox";
   if (by_slabs) stream.order = SvoPageOrder::kSlabsAlongX;
+  // A .vdb stores its nodes 4096³ cube by cube, 128³ cube by cube: pages come in that order.
+  if (*ext == "vdb")
+    stream = {.memory_limit = memory_limit, .order = SvoPageOrder::kVdbTree, .level = level};
   const std::uint64_t page_side =
       level < reader.page_level() ? 0 : std::uint64_t{1} << (level - reader.page_level());
   std::vector<std::uint64_t> x_done(reader.page_count(), 0);
