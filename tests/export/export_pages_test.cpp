@@ -161,6 +161,13 @@ TEST_F(ExportPages, HeaderErrorsComeFirstAndVoxNeedsTheWholeOctree) {
   EXPECT_TRUE(ExportStreams(r, Out("x.binvox")));
   const Status vox = ExportSvoPages(r, Out("x.vox"), {}, 0);
   EXPECT_FALSE(vox.ok());
+  // Read whole, it says what it needs before reading.
+  EXPECT_TRUE(CheckWholeExport(r, Out("x.vox"), 0).ok());
+  EXPECT_TRUE(CheckWholeExport(r, Out("x.vdb"), 1 << 20).ok());  // streams
+  const Status whole = CheckWholeExport(r, Out("x.vox"), 1 << 20);
+  ASSERT_FALSE(whole.ok());
+  EXPECT_NE(whole.message().find("reads the octree whole"), std::string::npos) << whole.message();
+  EXPECT_NE(whole.message().find("give"), std::string::npos) << whole.message();
   const Status small = ExportSvoPages(r, Out("x.ply"), {}, 1 << 20);
   ASSERT_FALSE(small.ok());
   EXPECT_NE(small.message().find("give"), std::string::npos) << small.message();

@@ -203,6 +203,24 @@ bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path) {
   return !reader.shape().solid && LowerExtension(path) != "vox";
 }
 
+Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& path,
+                        std::uint64_t memory_limit) {
+  if (memory_limit == 0 || ExportStreams(reader, path)) return Status::Ok();
+  std::uint64_t bytes = 0;
+  for (std::size_t i = 0; i < reader.page_count(); ++i) {
+    StatusOr<std::uint64_t> page = PageDecodedBytes(reader, i);
+    if (!page.ok()) return page.status();
+    bytes += *page;
+  }
+  if (bytes <= memory_limit) return Status::Ok();
+  const std::uint64_t mib = (bytes + (1 << 20) - 1) >> 20;
+  return Status::BadInput(
+      "{}: {} reads the octree whole: its pages alone need {} MiB, over the memory limit of {} "
+      "MiB (give {}M or more)",
+      path.string(), reader.shape().solid ? "a solid's export" : "a .vox export", mib,
+      memory_limit >> 20, mib);
+}
+
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
                       const ExportOptions& options, std::uint64_t memory_limit,
                       Progress::Stage* stage) {
