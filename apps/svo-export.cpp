@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
       ->option_text("L");
   memory_limit.Add(cli,
                    "Bytes of pages held at once (default: a few per thread); .vox and solids "
-                   "read the octree whole");
+                   "read the octree whole, refused when its pages alone pass the limit");
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
   return app::Run(tool, cli, argc, argv, input, [&] {
@@ -63,6 +63,10 @@ int main(int argc, char** argv) {
       nodes = reader->NodeCount(exported);
       node_size = reader->grid().voxel_size() * static_cast<double>(1u << (depth - exported));
     } else {
+      if (reader.ok()) {
+        const Status fits = CheckWholeExport(*reader, output, limit->value_or(0));
+        if (!fits.ok()) return app::Fail(tool, fits);
+      }
       StatusOr<Svo> svo = ReadSvoStage(progress, input, level);
       if (!svo.ok()) return app::Fail(tool, svo.status());
       const Status written =

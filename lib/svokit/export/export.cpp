@@ -203,6 +203,24 @@ bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path) {
   return !reader.shape().solid && LowerExtension(path) != "vox";
 }
 
+Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& path,
+                        std::uint64_t memory_limit) {
+  if (memory_limit == 0 || ExportStreams(reader, path)) return Status::Ok();
+  std::uint64_t bytes = 0;
+  for (std::size_t i = 0; i < reader.page_count(); ++i) {
+    StatusOr<std::uint64_t> page = PageDecodedBytes(reader, i);
+    if (!page.ok()) return page.status();
+    bytes += *page;
+  }
+  if (bytes <= memory_limit) return Status::Ok();
+  const std::uint64_t mib = (bytes + (1 << 20) - 1) >> 20;
+  return Status::BadInput(
+      "{}: {} reads the octree whole: its pages alone need {} MiB, over the memory limit of {} "
+      "MiB (give {}M or more)",
+      path.string(), reader.shape().solid ? "a solid's export" : "a .vox export", mib,
+      memory_limit >> 20, mib);
+}
+
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
                       const ExportOptions& options, std::uint64_t memory_limit,
                       Progress::Stage* stage) {
@@ -231,6 +249,9 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   SvoStreamOptions stream{.memory_limit = memory_limit};
   const bool by_slabs = *ext == "binvox";
   if (by_slabs) stream.order = SvoPageOrder::kSlabsAlongX;
+  // A .vdb stores its nodes 4096³ cube by cube, 128³ cube by cube: pages come in that order.
+  if (*ext == "vdb")
+    stream = {.memory_limit = memory_limit, .order = SvoPageOrder::kVdbTree, .level = level};
   const std::uint64_t page_side =
       level < reader.page_level() ? 0 : std::uint64_t{1} << (level - reader.page_level());
   std::vector<std::uint64_t> x_done(reader.page_count(), 0);

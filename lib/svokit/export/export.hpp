@@ -37,10 +37,16 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
 /// palette and models need every voxel) for an octree without full leaves.
 bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path);
 
+/// For an export that reads the octree whole (not ExportStreams: .vox, a solid's interior), said
+/// before reading: a bad-input error naming what it needs when its decoded pages alone pass
+/// `memory_limit` (0: no limit); what the writer then holds (a solid's grids) comes on top.
+Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& path,
+                        std::uint64_t memory_limit);
+
 /// ExportSvo of a paged file read page by page, holding at most `memory_limit` bytes of pages
-/// (0: a few per thread) besides what the output's writer holds (an OpenVDB grid; a binvox slab's
-/// runs): the same file as ExportSvo of the octree read whole. Errors that need only the header
-/// (format, level) come before any page is read.
+/// (0: a few per thread) besides what the output's writer holds (a .vdb's open 128³ node and 9
+/// bytes a leaf for its metadata; a binvox slab's runs): the same file as ExportSvo of the octree
+/// read whole. Errors that need only the header (format, level) come before any page is read.
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
                       const ExportOptions& options, std::uint64_t memory_limit,
                       Progress::Stage* stage = nullptr);

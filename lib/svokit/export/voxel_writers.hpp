@@ -46,9 +46,16 @@ StatusOr<std::unique_ptr<VoxelFileWriter>> OpenXyzWriter(const VoxelFileHeader& 
 StatusOr<std::unique_ptr<VoxelFileWriter>> OpenBinvoxWriter(const VoxelFileHeader& header,
                                                             const InteriorCubes* interior,
                                                             const std::filesystem::path& path);
+/// .vdb: without interior cubes the grids are written node by node as the voxels come (parts in
+/// SvoPageOrder::kVdbTree, each 128³ node's voxels given together; a part may hold several nodes),
+/// holding one 128³ node and the rest in scratch files beside the output. With them, the grids
+/// whole in memory (OpenVdbGridWriter), written by OpenVDB's io::Archive: the same bytes.
 StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbWriter(const VoxelFileHeader& header,
                                                          const InteriorCubes* interior,
                                                          const std::filesystem::path& path);
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbGridWriter(const VoxelFileHeader& header,
+                                                             const InteriorCubes* interior,
+                                                             const std::filesystem::path& path);
 
 /// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
 /// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).

@@ -1,6 +1,7 @@
 #include "svokit/formats/svo/svo_stream.hpp"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include "svokit/core/morton.hpp"
@@ -33,12 +34,35 @@ void SortBySlabs(const SvoReader& reader, std::vector<std::size_t>& pages) {
   });
 }
 
+// Pages by the OpenVDB nodes that hold them over the voxels of `level` (a stable sort of pages in
+// key order): 4096³ cubes, then 128³ cubes, each in x, y, z order. Above the page level the top
+// chunk holds them all.
+void SortForVdb(const SvoReader& reader, std::uint32_t level, std::vector<std::size_t>& pages) {
+  if (level < reader.page_level()) return;
+  const std::uint32_t shift = level - reader.page_level();
+  const auto rank = [&](std::size_t page) {
+    const MortonCoord c = MortonDecode(reader.page(page).key);
+    const std::uint64_t x = std::uint64_t{c.x} << shift >> 7, y = std::uint64_t{c.y} << shift >> 7,
+                        z = std::uint64_t{c.z} << shift >> 7;
+    return std::array<std::uint64_t, 6>{x >> 5, y >> 5, z >> 5, x & 31, y & 31, z & 31};
+  };
+  std::stable_sort(pages.begin(), pages.end(),
+                   [&](std::size_t a, std::size_t b) { return rank(a) < rank(b); });
+}
+
+void Sort(const SvoReader& reader, SvoPageOrder order, std::uint32_t level,
+          std::vector<std::size_t>& pages) {
+  if (order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, pages);
+  if (order == SvoPageOrder::kVdbTree) SortForVdb(reader, level, pages);
+}
+
 }  // namespace
 
-std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order) {
+std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order,
+                                   std::uint32_t level) {
   std::vector<std::size_t> pages(reader.page_count());
   for (std::size_t i = 0; i < pages.size(); ++i) pages[i] = i;
-  if (order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, pages);
+  Sort(reader, order, level, pages);
   return pages;
 }
 
@@ -68,7 +92,7 @@ StatusOr<SvoStreamPlan> PlanStream(
     const std::function<std::uint64_t(std::uint64_t, std::uint64_t)>& per_page) {
   SvoStreamPlan plan;
   plan.pages = options.box ? reader.PagesIn(*options.box) : PageOrder(reader, SvoPageOrder::kKeys);
-  if (options.order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, plan.pages);
+  Sort(reader, options.order, options.level, plan.pages);
   std::uint64_t item = 1;
   for (const std::size_t i : plan.pages) {
     StatusOr<std::uint64_t> bytes = PageDecodedBytes(reader, i);

@@ -25,9 +25,12 @@
 
 namespace svokit {
 
-/// The order a streamed read visits pages in: by key (Morton order), or by slabs of page cubes
-/// along x (ascending x, then by key), the order of formats that run along x (binvox).
-enum class SvoPageOrder { kKeys, kSlabsAlongX };
+/// The order a streamed read visits pages in: by key (Morton order); by slabs of page cubes along x
+/// (ascending x, then by key), the order of formats that run along x (binvox); or by the nodes of
+/// an OpenVDB tree over the voxels of SvoStreamOptions::level (kVdbTree): its 4096³ cubes in x,
+/// y, z order, within each its 128³ cubes in x, y, z order, then by key; the order a .vdb file
+/// stores its nodes in.
+enum class SvoPageOrder { kKeys, kSlabsAlongX, kVdbTree };
 
 /// Which pages a streamed read visits, in which order, and the bytes it may hold.
 struct SvoStreamOptions {
@@ -35,10 +38,12 @@ struct SvoStreamOptions {
   std::uint64_t memory_limit = 0;
   std::optional<Box3d> box;  ///< only the pages whose cube meets it (world units)
   SvoPageOrder order = SvoPageOrder::kKeys;
+  std::uint32_t level = 0;  ///< kVdbTree: the level whose nodes are the tree's voxels
 };
 
-/// Every page of `reader`, in `order`.
-std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order);
+/// Every page of `reader`, in `order` (kVdbTree over the voxels of `level`).
+std::vector<std::size_t> PageOrder(const SvoReader& reader, SvoPageOrder order,
+                                   std::uint32_t level = 0);
 
 /// Bytes page i of `reader` takes decoded: its streams' decoded bytes (from its stream directory,
 /// nothing decompressed) and the child offsets a decode adds (8 bytes per node above the voxels).
