@@ -110,6 +110,28 @@ TEST(TraceOctree, ConesGiveTheSameAoAtEveryMemoryLimit) {
   EXPECT_NE(small.status().message().find("scene.svo"), std::string::npos);
 }
 
+// A page whose checksum fails reads as empty while the cones run and is reported after, naming
+// the file and the page: no crash, no value from damaged bytes.
+TEST(TraceOctree, ADamagedPageIsReported) {
+  const auto scene = BakeScene(Icosphere(3), 300);
+  std::vector<std::uint8_t> bytes = scene->bytes;
+  bytes[bytes.size() / 2] ^= 0x55;
+  StatusOr<SvoReader> reader = SvoReader::FromBytes(bytes, "damaged.svo");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  StatusOr<std::unique_ptr<TraceOctree>> octree = TraceOctree::Open(*reader, 0);
+  ASSERT_TRUE(octree.ok()) << octree.status().message();
+  ConeOptions options;
+  options.distance = 2;
+  const StatusOr<ConeTracer> tracer = ConeTracer::Make(**octree, options);
+  ASSERT_TRUE(tracer.ok());
+  std::vector<AoPoint> points = VertexPoints(Icosphere(3));
+  for (AoPoint& p : points) p = {p.position * 0.97, p.normal * -1.0};  // facing in: every page
+  tracer->Occlusion(points);
+  const Status error = (*octree)->error();
+  ASSERT_FALSE(error.ok());
+  EXPECT_NE(error.message().find("damaged.svo: page"), std::string::npos) << error.message();
+}
+
 // svo-bake's octree output: the same file at every memory limit, each node's AO the rounded mean
 // of its voxels' (recomputed from the keys), across the top chunk and the pages.
 TEST(BakeSvoAo, TheSameBakedFileAtEveryMemoryLimit) {

@@ -128,11 +128,13 @@ class Baker {
   }
 
  private:
-  // AO at mesh points by the chosen method.
-  std::vector<float> AtPoints(std::span<const AoPoint> points) const {
+  // AO at mesh points by the chosen method; a page the cones could not decode fails it.
+  StatusOr<std::vector<float>> AtPoints(std::span<const AoPoint> points) const {
     const ConeOptions& c = report_.cones;
-    return r_.rays ? rays_->Occlusion(points, {*r_.rays, c.distance, c.falloff, 0})
-                   : tracer_.Occlusion(points);
+    if (r_.rays) return rays_->Occlusion(points, {*r_.rays, c.distance, c.falloff, 0});
+    std::vector<float> ao = tracer_.Occlusion(points);
+    SVOKIT_RETURN_IF_ERROR(octree_.error());
+    return ao;
   }
 
   // Page by page in key order: each page's voxels traced, their AO and their nodes' kept (a byte
@@ -204,8 +206,10 @@ class Baker {
 
   Status Vertices() {
     const std::vector<AoPoint> points = VertexPoints(*mesh_);
-    const std::vector<float> vertex_ao =
+    const StatusOr<std::vector<float>> traced =
         RunStage(progress_, "vertices", [&] { return AtPoints(points); });
+    if (!traced.ok()) return traced.status();
+    const std::vector<float>& vertex_ao = *traced;
     report_.vertices = AoBakeReport::Points{points.size(), MeanAo(vertex_ao)};
     if (r_.reference) {
       const ConeOptions& c = report_.cones;
@@ -225,8 +229,10 @@ class Baker {
     if (!texels.ok()) {
       return Status::BadInput("{}: {}", r_.mesh.string(), texels.status().message());
     }
-    const std::vector<float> texel_ao =
+    const StatusOr<std::vector<float>> traced =
         RunStage(progress_, "texels", [&] { return AtPoints(texels->points); });
+    if (!traced.ok()) return traced.status();
+    const std::vector<float>& texel_ao = *traced;
     const std::vector<std::uint8_t> pixels = AoTexture(*texels, texel_ao);
     SVOKIT_RETURN_IF_ERROR(RunStage(progress_, "write texture", [&] {
       return WriteImage(r_.texture_out, r_.texture_size, r_.texture_size, 1, pixels);

@@ -162,7 +162,8 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
     const MaskTree& tree = l < page_level ? octree_->top().tree : cursor.page->levels.tree;
     const std::uint32_t k = l - tree.first_level;
     const std::uint64_t i = cursor.index[l];
-    const std::uint8_t mask = tree.masks[k][i];
+    // A page that did not decode reads as empty (TraceOctree::error() reports it).
+    const std::uint8_t mask = k < tree.masks.size() ? tree.masks[k][i] : 0;
     if (((mask >> c) & 1u) == 0) {
       cursor.valid = l;
       return static_cast<int>(l);
@@ -195,6 +196,7 @@ float ConeTracer::Coverage(const Vec3d& v, std::uint32_t level, Cursor& cursor) 
   std::array<float, 8> tap;  // (dx, dy, dz) at dx + 2dy + 4dz
   if (level < depth) {
     const TraceLevels& levels = level < page_level ? octree_->top() : cursor.page->levels;
+    if (level - levels.tree.first_level >= levels.opacity.size()) return 0;  // a damaged page
     const std::uint8_t* brick = levels.opacity[level - levels.tree.first_level].data() +
                                 cursor.index[level] * side * side * side;
     for (int d = 0; d < 8; ++d) {
