@@ -6,6 +6,7 @@
 
 #include "svokit/bake/ray_ao.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/core/held_bytes.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
@@ -70,11 +71,6 @@ StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const SvoReader& octree,
   return mesh;
 }
 
-template <class T>
-std::uint64_t Bytes(const std::vector<T>& v) {
-  return v.size() * sizeof(T);
-}
-
 // What a bake holds besides the octree it traces: the mesh and its points with their AO; for the
 // octree's own bake a page decoded whole with its voxels' points and bricks, and every node's AO.
 std::uint64_t HeldBesides(const AoBakeRequest& r, const SvoReader& reader, const Mesh* mesh) {
@@ -82,8 +78,8 @@ std::uint64_t HeldBesides(const AoBakeRequest& r, const SvoReader& reader, const
   constexpr std::uint64_t kPerPageVoxel = 200;  // keys, points, sums, voxel bricks, the chunk
   std::uint64_t held = 0;
   if (mesh != nullptr) {
-    held += Bytes(mesh->positions) + Bytes(mesh->triangles) + Bytes(mesh->normals) +
-            Bytes(mesh->uvs) + Bytes(mesh->colors) + Bytes(mesh->material_ids);
+    held += HeldBytes(mesh->positions) + HeldBytes(mesh->triangles) + HeldBytes(mesh->normals) +
+            HeldBytes(mesh->uvs) + HeldBytes(mesh->colors) + HeldBytes(mesh->material_ids);
     if (!r.vertex_out.empty() || r.reference) held += mesh->positions.size() * kPerPoint;
     if (!r.texture_out.empty()) {
       held += static_cast<std::uint64_t>(r.texture_size) * r.texture_size * (kPerPoint + 5);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "svokit/core/held_bytes.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/svo/sample_filter.hpp"
@@ -45,13 +46,6 @@ std::vector<DefaultInitVector<std::uint8_t>> OpacityBricks(const SvoChunk& chunk
                    BrickSpans{out[k], {}, {}});
   }
   return out;
-}
-
-template <class T>
-std::uint64_t NestedBytes(const std::vector<T>& v) {
-  std::uint64_t n = 0;
-  for (const auto& inner : v) n += inner.size() * sizeof(inner[0]);
-  return n;
 }
 
 }  // namespace
@@ -157,9 +151,10 @@ StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader
       largest = std::max(largest, *bound);
     }
     const TraceLevels& top = octree->top_;
-    const std::uint64_t fixed = held_besides + NestedBytes(top.tree.masks) +
-                                NestedBytes(top.tree.full) + NestedBytes(top.tree.first_child) +
-                                NestedBytes(top.opacity) + Concurrency() * largest;
+    const std::uint64_t fixed = held_besides + NestedHeldBytes(top.tree.masks) +
+                                NestedHeldBytes(top.tree.full) +
+                                NestedHeldBytes(top.tree.first_child) +
+                                NestedHeldBytes(top.opacity) + Concurrency() * largest;
     StatusOr<std::size_t> fits =
         InFlightWithin(memory_limit, fixed, largest, largest, "this file",
                        "the top levels, cone tracing's pages (one a thread, and one more kept) "
@@ -185,8 +180,8 @@ StatusOr<std::shared_ptr<const TracePage>> TraceOctree::Decode(std::size_t i) co
       keys);
   page->levels.tree = std::move(chunk->tree);
   const MaskTree& t = page->levels.tree;
-  page->bytes = sizeof(TracePage) + NestedBytes(t.masks) + NestedBytes(t.full) +
-                NestedBytes(t.first_child) + NestedBytes(page->levels.opacity) +
+  page->bytes = sizeof(TracePage) + NestedHeldBytes(t.masks) + NestedHeldBytes(t.full) +
+                NestedHeldBytes(t.first_child) + NestedHeldBytes(page->levels.opacity) +
                 page->voxels.bytes();
   return std::shared_ptr<const TracePage>(std::move(page));
 }

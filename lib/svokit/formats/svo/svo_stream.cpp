@@ -4,6 +4,7 @@
 #include <array>
 #include <limits>
 
+#include "svokit/core/held_bytes.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
 
@@ -14,18 +15,6 @@ namespace {
 // Bytes a decode derives per node above the voxels, besides its mask byte: the child offset (8)
 // and the sample layout's orphan mask and first index (4 + 8).
 constexpr std::uint64_t kDerivedBytesPerNode = 20;
-
-template <class V>
-std::uint64_t Bytes(const V& v) {
-  return v.capacity() * sizeof(typename V::value_type);
-}
-
-template <class V>
-std::uint64_t NestedBytes(const std::vector<V>& levels) {
-  std::uint64_t n = Bytes(levels);
-  for (const V& v : levels) n += Bytes(v);
-  return n;
-}
 
 // Pages by their cube's x, then by key (a stable sort of pages in key order).
 void SortBySlabs(const SvoReader& reader, std::vector<std::size_t>& pages) {
@@ -78,12 +67,14 @@ StatusOr<std::uint64_t> PageDecodedBytes(const SvoReader& reader, std::size_t i)
 }
 
 std::uint64_t ChunkHeldBytes(const SvoChunk& c) {
-  std::uint64_t n = sizeof(SvoChunk) + NestedBytes(c.tree.masks) + NestedBytes(c.tree.full) +
-                    NestedBytes(c.tree.first_child) + NestedBytes(c.contours) + Bytes(c.colors) +
-                    Bytes(c.normals) + Bytes(c.halo_keys) + Bytes(c.halo_colors) +
-                    Bytes(c.halo_normals) + Bytes(c.layouts) + Bytes(c.samples);
-  for (const SampleLayout& l : c.layouts) n += Bytes(l.orphans) + Bytes(l.first);
-  for (const LevelSamples& s : c.samples) n += Bytes(s.opacity) + Bytes(s.color) + Bytes(s.normal);
+  std::uint64_t n = sizeof(SvoChunk) + NestedHeldBytes(c.tree.masks) +
+                    NestedHeldBytes(c.tree.full) + NestedHeldBytes(c.tree.first_child) +
+                    NestedHeldBytes(c.contours) + HeldBytes(c.colors) + HeldBytes(c.normals) +
+                    HeldBytes(c.halo_keys) + HeldBytes(c.halo_colors) + HeldBytes(c.halo_normals) +
+                    HeldBytes(c.layouts) + HeldBytes(c.samples);
+  for (const SampleLayout& l : c.layouts) n += HeldBytes(l.orphans) + HeldBytes(l.first);
+  for (const LevelSamples& s : c.samples)
+    n += HeldBytes(s.opacity) + HeldBytes(s.color) + HeldBytes(s.normal);
   return n;
 }
 
