@@ -1,5 +1,5 @@
-// svo-export: .svo → OpenVDB (.vdb), binvox, MagicaVoxel (.vox), PLY points or xyz text, at the
-// voxel level or a coarser one.
+// svo-export: .svo → OpenVDB (.vdb), NanoVDB (.nvdb), binvox, MagicaVoxel (.vox), PLY points or
+// xyz text, at the voxel level or a coarser one.
 
 #include <filesystem>
 #include <optional>
@@ -18,21 +18,24 @@ int main(int argc, char** argv) {
   const std::string tool = "svo-export";
   CLI::App cli{
       "Exports a sparse voxel octree's voxels (or the nodes of a coarser level) as OpenVDB grids "
-      "(.vdb), binvox, MagicaVoxel (.vox), PLY points or xyz text, by the output's extension.",
+      "(.vdb), NanoVDB grids (.nvdb: density, colour, AO), binvox, MagicaVoxel (.vox), PLY points "
+      "or xyz text, by the output's extension.",
       tool};
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
   app::MemoryLimitOption memory_limit;
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
-  app::AddFile(cli, "-o,--output", output, "Output: .vdb, .binvox, .vox, .ply or .xyz")->required();
+  app::AddFile(cli, "-o,--output", output, "Output: .vdb, .nvdb, .binvox, .vox, .ply or .xyz")
+      ->required();
   cli.add_option("--level", level,
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
                  "(default: the voxels)")
       ->option_text("L");
   memory_limit.Add(cli,
                    "Bytes of pages held at once (default: a few per thread); .vox and solids "
-                   "read the octree whole, refused when its pages alone pass the limit");
+                   "read the octree whole and .nvdb grids are built whole, refused when they "
+                   "pass the limit");
   app::AddCommonOptions(cli, common, "svo-export bunny.svo -o bunny.vdb");
 
   return app::Run(tool, cli, argc, argv, input, [&] {

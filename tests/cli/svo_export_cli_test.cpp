@@ -106,7 +106,7 @@ TEST(SvoExportCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{truncated, "-o", "{dir}/out.vdb"}, "truncated.svo"},
       {{corrupt, "-o", "{dir}/out.vox"}, "corrupt.svo"},
       {{garbage, "-o", "{dir}/out.xyz"}, "garbage.svo"},
-      {{svo, "-o", "{dir}/out.obj"}, "output must be a .vdb, .binvox, .vox, .ply, .xyz file"},
+      {{svo, "-o", "{dir}/out.obj"}, "output must be a .vdb, .nvdb, .binvox, .vox, .ply, .xyz file"},
       {{svo, "-o", "{dir}/out"}, "output must be a .vdb"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "7"},
        "torus.svo: level 7 exceeds the octree's depth 6"},

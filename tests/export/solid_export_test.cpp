@@ -8,6 +8,9 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/IO.h>
+
 #include <set>
 
 #include "svokit/core/morton.hpp"
@@ -145,6 +148,30 @@ TEST(SolidExport, BinvoxHoldsTheSurfaceAndTheInterior) {
       if (up == 0) {
         EXPECT_EQ(got.size(), s->svo.voxel_count() + s->svo.InteriorVoxelCount());
       }
+    }
+  }
+}
+
+TEST(SolidExport, NanoVdbDensityIsOneThroughoutTheInterior) {
+  TempDir dir;
+  for (const Solid* s : {&Ball64(), &Holed()}) {
+    for (const std::uint32_t up : {0u, 2u}) {
+      const std::uint32_t level = s->svo.depth - up;
+      SCOPED_TRACE("level " + std::to_string(level));
+      ASSERT_TRUE(Export(s->svo, dir / "s.nvdb", level).ok());
+      const Expected e = ExpectedAt(*s, level);
+      const auto handle = nanovdb::io::readGrid((dir / "s.nvdb").string(), "density");
+      const auto* grid = handle.grid<float>();
+      ASSERT_NE(grid, nullptr);
+      EXPECT_EQ(grid->activeVoxelCount(), e.nodes.size() + e.interior.size());
+      auto at = grid->getAccessor();
+      std::size_t wrong = 0;
+      for (const Coord& c : e.interior) {
+        const nanovdb::Coord ijk(static_cast<int>(c[0]), static_cast<int>(c[1]),
+                                 static_cast<int>(c[2]));
+        wrong += at.isActive(ijk) && at.getValue(ijk) == 1.f ? 0 : 1;
+      }
+      EXPECT_EQ(wrong, 0u) << "of " << e.interior.size() << " interior voxels";
     }
   }
 }

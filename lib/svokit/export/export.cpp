@@ -29,7 +29,8 @@ std::vector<std::uint32_t> NodeSamples(std::uint32_t side) {
 }  // namespace
 
 const std::vector<std::string>& ExportExtensions() {
-  static const std::vector<std::string> kExtensions = {"vdb", "binvox", "vox", "ply", "xyz"};
+  static const std::vector<std::string> kExtensions = {"vdb", "nvdb", "binvox",
+                                                       "vox", "ply",  "xyz"};
   return kExtensions;
 }
 
@@ -44,10 +45,12 @@ GridTransform LevelGrid(const GridTransform& grid, std::uint32_t depth, std::uin
   return GridTransform(grid.origin(), grid.voxel_size() * static_cast<double>(1u << shift), dims);
 }
 
-// Each node's colour and normal from `bricks` (its level's pool, in the order of set.keys).
+// Each node's colour and normal from `bricks` (its level's pool, in the order of set.keys), and
+// when asked for its density: the opacity at its centre (1 without bricks).
 void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_color, bool has_normal,
-                        VoxelSet& set) {
+                        VoxelSet& set, std::vector<float>* density = nullptr) {
   const std::vector<std::uint32_t> samples = NodeSamples(side);
+  if (density != nullptr) density->assign(set.keys.size(), 1.f);
   if (samples.empty()) return;
   if (has_color) set.colors.resize(set.keys.size());
   if (has_normal) set.normals.resize(set.keys.size());
@@ -68,6 +71,7 @@ void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_col
                  color.a + w * b.color.a};
         normal = normal + b.normal * w;
       }
+      if (density != nullptr) (*density)[i] = total / static_cast<float>(s.size());
       if (has_color) set.colors[i] = color;
       if (has_normal) {
         const float len = Length(normal);
@@ -79,13 +83,14 @@ void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_col
 
 }  // namespace
 
-VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level) {
+VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level, std::vector<float>* density) {
   VoxelSet set;
   set.grid = LevelGrid(svo.grid, svo.depth, level);
   set.mode = svo.mode;
   const std::vector<std::uint64_t> keys = svo.LevelKeys(level);
   set.keys.assign(keys.begin(), keys.end());
-  FillNodeAttributes(svo.levels[level], svo.brick_side, svo.has_color, svo.has_normal, set);
+  FillNodeAttributes(svo.levels[level], svo.brick_side, svo.has_color, svo.has_normal, set,
+                     density);
   return set;
 }
 
@@ -162,8 +167,8 @@ StatusOr<std::string> CheckExport(const std::filesystem::path& path) {
   const std::string ext = LowerExtension(path);
   const auto& known = ExportExtensions();
   if (std::find(known.begin(), known.end(), ext) == known.end()) {
-    return Status::BadInput("{}: unknown export format (use .vdb, .binvox, .vox, .ply or .xyz)",
-                            path.string());
+    return Status::BadInput(
+        "{}: unknown export format (use .vdb, .nvdb, .binvox, .vox, .ply or .xyz)", path.string());
   }
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
@@ -185,9 +190,33 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
   }
-  VoxelSet voxels = LevelVoxels(svo, level);
+  std::vector<float> density;
+  VoxelSet voxels = LevelVoxels(svo, level, *ext == "nvdb" ? &density : nullptr);
   const InteriorCubes interior = LevelInterior(svo, level);
   const InteriorCubes* solid = svo.solid ? &interior : nullptr;
+  if (*ext == "nvdb") {
+    std::vector<std::uint8_t> ao = svo.has_ao ? svo.levels[level].ao : std::vector<std::uint8_t>{};
+    if (solid != nullptr) {
+      // Interior voxels are dense and, seen from outside, fully occluded.
+      StatusOr<VoxelSet> all = WithInteriorVoxels(voxels, interior, path);
+      if (!all.ok()) return all.status();
+      std::vector<float> all_density(all->size(), 1.f);
+      std::vector<std::uint8_t> all_ao(ao.empty() ? 0 : all->size(), 255);
+      for (std::size_t i = 0, k = 0; i < voxels.size(); ++i, ++k) {
+        while (all->keys[k] != voxels.keys[i]) ++k;
+        all_density[k] = density[i];
+        if (!ao.empty()) all_ao[k] = ao[i];
+      }
+      voxels = std::move(*all);
+      density = std::move(all_density);
+      ao = std::move(all_ao);
+    }
+    StatusOr<std::unique_ptr<NanoVdbWriter>> writer =
+        OpenNanoVdbWriter(HeaderOf(voxels), !ao.empty(), path);
+    if (!writer.ok()) return writer.status();
+    SVOKIT_RETURN_IF_ERROR((*writer)->Add(voxels, density, ao));
+    return (*writer)->Finish();
+  }
   if (*ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
   if (*ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
   if (*ext == "vox") {
@@ -221,6 +250,54 @@ Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& pa
       memory_limit >> 20, mib);
 }
 
+namespace {
+
+// A .nvdb of a file read page by page: the grids are built whole (NanoVdbWriter), so what they
+// need is checked against the limit before a page is read.
+Status ExportNanoVdbPages(const SvoReader& reader, const VoxelFileHeader& header,
+                          const std::filesystem::path& path, std::uint32_t level,
+                          std::uint64_t memory_limit, Progress::Stage* stage) {
+  auto nodes_above = [&](std::uint32_t up) {
+    return level < up ? 1 : reader.NodeCount(level - up);
+  };
+  const bool ao = reader.has_ao();
+  const std::uint64_t needs =
+      NanoVdbBytes({nodes_above(3), nodes_above(7), nodes_above(12)}, header.colors, ao) +
+      (ao ? reader.NodeCount(level) : 0);
+  if (memory_limit != 0 && needs > memory_limit) {
+    const std::uint64_t mib = (needs + (1 << 20) - 1) >> 20;
+    return Status::BadInput(
+        "{}: a .nvdb is built whole: level {}'s grids need {} MiB, over the memory limit of {} MiB "
+        "(give {}M or more, or export a coarser --level)",
+        path.string(), level, mib, memory_limit >> 20, mib);
+  }
+  StatusOr<std::vector<std::uint8_t>> level_ao = reader.LevelAo(level);
+  if (!level_ao.ok()) return level_ao.status();
+  StatusOr<std::unique_ptr<NanoVdbWriter>> writer = OpenNanoVdbWriter(header, ao, path);
+  if (!writer.ok()) return writer.status();
+  std::uint64_t first = 0;  // the page's first node in the level (pages come in key order)
+  const std::uint32_t side = reader.shape().brick_side;
+  SVOKIT_RETURN_IF_ERROR(ForEachLevelPage(
+      reader, level, side != 0, SvoStreamOptions{.memory_limit = memory_limit},
+      [&](std::size_t, SvoChunkLevel& nodes) {
+        VoxelSet part;
+        part.grid = header.grid;
+        part.mode = reader.mode();
+        part.keys.assign(nodes.keys.begin(), nodes.keys.end());
+        std::vector<float> density;
+        FillNodeAttributes(nodes.bricks, side, header.colors, false, part, &density);
+        const std::span<const std::uint8_t> ao_part =
+            ao ? std::span<const std::uint8_t>(*level_ao).subspan(first, part.size())
+               : std::span<const std::uint8_t>{};
+        first += part.size();
+        return (*writer)->Add(part, density, ao_part);
+      },
+      stage));
+  return (*writer)->Finish();
+}
+
+}  // namespace
+
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
                       const ExportOptions& options, std::uint64_t memory_limit,
                       Progress::Stage* stage) {
@@ -239,6 +316,7 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   const bool normals = shape.brick_side != 0 && shape.has_normal;
   const VoxelFileHeader header{LevelGrid(reader.grid(), reader.depth(), level), colors, normals,
                                reader.NodeCount(level)};
+  if (*ext == "nvdb") return ExportNanoVdbPages(reader, header, path, level, memory_limit, stage);
   StatusOr<std::unique_ptr<VoxelFileWriter>> writer =
       *ext == "vdb"      ? OpenVdbWriter(header, nullptr, path)
       : *ext == "binvox" ? OpenBinvoxWriter(header, nullptr, path)

@@ -1,7 +1,7 @@
 #pragma once
 // svo-export's writers: an Svo (or one of its coarser levels), or a paged file read page by page,
-// as OpenVDB grids, binvox, MagicaVoxel .vox, PLY points or xyz text, chosen by the output
-// extension.
+// as OpenVDB or NanoVDB grids, binvox, MagicaVoxel .vox, PLY points or xyz text, chosen by the
+// output extension.
 //
 // Every format goes through one VoxelSet: the nodes of the exported level as voxels of that
 // level's node size, on the octree's origin, so all writers agree on coordinates and attributes.
@@ -55,7 +55,8 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
 /// size = NodeSize(level), dims = the leaf grid's rounded up to whole nodes; keys = LevelKeys.
 /// A node's colour and normal are its brick's centre sample (side 3) or the opacity-weighted mean
 /// of its 8 corners (side 2); without bricks only occupancy.
-VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level);
+/// With `density`, each node's opacity at its centre too (1 without bricks).
+VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level, std::vector<float>* density = nullptr);
 
 /// A solid's full leaves seen from `level`: cubes of levels ≤ `level` at that resolution (depth =
 /// `level`; deeper full leaves lie inside nodes of `level`). No cubes unless svo.solid.

@@ -4,9 +4,11 @@
 // write .vdb load OpenVDB). Each writes atomically: a complete file or none. All but .vox also take
 // their voxels a part at a time (VoxelFileWriter), so a file read page by page is never whole.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 
 #include "svokit/core/status.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
@@ -56,6 +58,24 @@ StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbWriter(const VoxelFileHeader& 
 StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbGridWriter(const VoxelFileHeader& header,
                                                              const InteriorCubes* interior,
                                                              const std::filesystem::path& path);
+
+/// NanoVDB (.nvdb), built whole by NanoVDB's GridBuilder from the parts given, each grid written
+/// as a segment of its own: float "density" (a fog volume: each voxel's brick opacity at its
+/// centre), Vec3f "color" (linear RGB) when the header has colours, float "ao" (0 to 1) when
+/// baked; every voxel given is active in each. Transform as WriteVoxelsVdb's.
+class NanoVdbWriter {
+ public:
+  virtual ~NanoVdbWriter() = default;
+  /// `density` and (with AO) `ao` hold a value per voxel of `part`.
+  virtual Status Add(const VoxelSet& part, std::span<const float> density,
+                     std::span<const std::uint8_t> ao) = 0;
+  virtual Status Finish() = 0;
+};
+StatusOr<std::unique_ptr<NanoVdbWriter>> OpenNanoVdbWriter(const VoxelFileHeader& header, bool ao,
+                                                           const std::filesystem::path& path);
+/// What NanoVdbWriter holds at most for a level with `nodes` = its node counts 3, 7 and 12 levels
+/// up (its 8³ leaves, 128³ and 4096³ internal nodes).
+std::uint64_t NanoVdbBytes(const std::array<std::uint64_t, 3>& nodes, bool colors, bool ao);
 
 /// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
 /// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).

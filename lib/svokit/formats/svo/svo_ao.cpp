@@ -134,34 +134,49 @@ bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink,
   return true;
 }
 
-bool CheckAo(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
-             IssueSink& sink) {
+bool ReadAoRange(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
+                 std::uint64_t first, std::span<std::uint8_t> out, IssueSink& sink) {
   const std::optional<std::span<const std::uint8_t>> section = Loaded(file, kAo);
   if (!section) return true;
   const std::string& name = file.name();
   std::uint32_t codec = 0;
   const auto payload = CheckAoHeader(*section, name, depth, nodes, true, sink, codec);
   if (!payload) return false;
-  if (codec == kStored) return true;
-  // Decoded through a small buffer: the stream's length is what DecodeAo would check.
   const auto [p, raw] = *payload;
+  if (first + out.size() > raw) {
+    sink.Add("ao", name, "the AOCC section holds no bytes {} to {}", first, first + out.size());
+    return false;
+  }
+  if (codec == kStored) {
+    std::copy_n(p.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+    return true;
+  }
+  // Decoded through a small buffer, the range kept: the stream's length is what DecodeAo checks.
   bool ok = ZSTD_getFrameContentSize(p.data(), p.size()) == raw;
   ZSTD_DCtx* ctx = ZSTD_createDCtx();
   std::vector<std::uint8_t> buffer(std::size_t{1} << 20);
   ZSTD_inBuffer in{p.data(), p.size(), 0};
-  std::uint64_t out = 0;
-  while (ok && out < raw) {
-    ZSTD_outBuffer to{buffer.data(), std::min<std::uint64_t>(buffer.size(), raw - out), 0};
+  std::uint64_t at = 0;
+  while (ok && at < raw) {
+    ZSTD_outBuffer to{buffer.data(), std::min<std::uint64_t>(buffer.size(), raw - at), 0};
     const std::size_t in_before = in.pos;
     const std::size_t r = ZSTD_decompressStream(ctx, &to, &in);
-    out += to.pos;
-    if (ZSTD_isError(r) || (r == 0 && out < raw) || (in.pos == in_before && to.pos == 0)) {
-      ok = !ZSTD_isError(r) && out == raw;
+    // The part of [first, first + out.size()) this piece of the stream holds.
+    const std::uint64_t lo = std::max(at, first), hi = std::min(at + to.pos, first + out.size());
+    if (lo < hi) std::copy_n(buffer.begin() + (lo - at), hi - lo, out.begin() + (lo - first));
+    at += to.pos;
+    if (ZSTD_isError(r) || (r == 0 && at < raw) || (in.pos == in_before && to.pos == 0)) {
+      ok = !ZSTD_isError(r) && at == raw;
     }
   }
   ZSTD_freeDCtx(ctx);
   if (!ok) sink.Add("ao", name, "the AOCC stream does not decode to its {} bytes", raw);
   return ok;
+}
+
+bool CheckAo(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
+             IssueSink& sink) {
+  return ReadAoRange(file, depth, nodes, 0, {}, sink);
 }
 
 }  // namespace svo_detail

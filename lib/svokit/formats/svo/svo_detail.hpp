@@ -78,6 +78,10 @@ bool DecodeVersion2(const container::Frame& file, std::optional<std::uint32_t> m
 std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8_t>> ao);
 /// Reads the file's `AOCC` section, if any, into the decoded levels (0 .. `last`) of `svo`.
 bool DecodeAo(const container::Frame& file, std::uint32_t last, IssueSink& sink, Svo& svo);
+/// DecodeAo's checks of a whole octree of `depth` and `nodes` nodes in all, keeping bytes
+/// `first` .. `first` + out.size() of the stream (levels in order, a byte per node) in `out`.
+bool ReadAoRange(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
+                 std::uint64_t first, std::span<std::uint8_t> out, IssueSink& sink);
 /// DecodeAo's checks of a whole octree of `depth` and `nodes` nodes in all, keeping nothing.
 bool CheckAo(const container::Frame& file, std::uint32_t depth, std::uint64_t nodes,
              IssueSink& sink);

@@ -192,6 +192,27 @@ std::optional<SvoIssue> SvoReader::CheckAo(std::uint64_t nodes) const {
   return sink.issues().front();
 }
 
+bool SvoReader::has_ao() const {
+  return state_->frame.Find(svo_detail::kAo) != nullptr;
+}
+
+StatusOr<std::vector<std::uint8_t>> SvoReader::LevelAo(std::uint32_t level) const {
+  if (level > depth()) {
+    return Status::BadInput("{}: level {} exceeds the octree's depth {}", name(), level, depth());
+  }
+  std::uint64_t nodes = 0, first = 0;
+  for (std::uint32_t l = 0; l <= depth(); ++l) {
+    if (l < level) first += NodeCount(l);
+    nodes += NodeCount(l);
+  }
+  std::vector<std::uint8_t> ao(has_ao() ? NodeCount(level) : 0);
+  svo_detail::IssueSink sink(/*stop_at_first=*/true);
+  if (!svo_detail::ReadAoRange(state_->frame, depth(), nodes, first, ao, sink)) {
+    return Status::BadInput("{}", sink.issues().front().message);
+  }
+  return ao;
+}
+
 StatusOr<LenientSvoReader> LenientSvoReader::FromFrame(StatusOr<container::Frame> frame,
                                                        bool mapped) {
   if (!frame.ok()) return frame.status();

@@ -79,6 +79,11 @@ class SvoReader {
   /// ReadSvoLenient's checks of the `AOCC` section (kind "ao"), for an octree of `nodes` nodes in
   /// all; nothing when it holds or is absent.
   std::optional<SvoIssue> CheckAo(std::uint64_t nodes) const;
+  /// Whether the file holds baked ambient occlusion (an `AOCC` section).
+  bool has_ao() const;
+  /// The baked AO of `level`'s nodes, a byte each in node order (empty when not baked), streamed
+  /// out of the section, which is checked whole.
+  StatusOr<std::vector<std::uint8_t>> LevelAo(std::uint32_t level) const;
 
  private:
   struct State;
