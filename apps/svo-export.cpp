@@ -1,5 +1,5 @@
-// svo-export: .svo → OpenVDB (.vdb), NanoVDB (.nvdb), binvox, MagicaVoxel (.vox), PLY points or
-// xyz text, at the voxel level or a coarser one.
+// svo-export: .svo → OpenVDB (.vdb), NanoVDB (.nvdb), binvox, MagicaVoxel (.vox), PLY points, xyz
+// text or a voxel mesh (.obj, .glb), at the voxel level or a coarser one.
 
 #include <filesystem>
 #include <optional>
@@ -18,20 +18,26 @@ int main(int argc, char** argv) {
   const std::string tool = "svo-export";
   CLI::App cli{
       "Exports a sparse voxel octree's voxels (or the nodes of a coarser level) as OpenVDB grids "
-      "(.vdb), NanoVDB grids (.nvdb: density, colour, AO), binvox, MagicaVoxel (.vox), PLY points "
-      "or xyz text, by the output's extension.",
+      "(.vdb), NanoVDB grids (.nvdb: density, colour, AO), binvox, MagicaVoxel (.vox), PLY "
+      "points, xyz text or a voxel mesh (.obj with a palette .mtl, .glb), by the output's "
+      "extension.",
       tool};
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
   app::MemoryLimitOption memory_limit;
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
-  app::AddFile(cli, "-o,--output", output, "Output: .vdb, .nvdb, .binvox, .vox, .ply or .xyz")
+  app::AddFile(cli, "-o,--output", output,
+               "Output: .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj or .glb")
       ->required();
   cli.add_option("--level", level,
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
                  "(default: the voxels)")
       ->option_text("L");
+  bool no_merge = false;
+  cli.add_flag("--no-merge", no_merge,
+               "Voxel meshes: one quad per voxel face (default: coplanar faces of one colour "
+               "merged into rectangles)");
   memory_limit.Add(cli,
                    "Bytes of pages held at once (default: a few per thread); .vox and solids "
                    "read the octree whole and .nvdb grids are built whole, refused when they "
@@ -48,6 +54,7 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     ExportOptions options;
     options.level = level;
+    options.merge_faces = !no_merge;
 
     // A paged file streams its pages into the writer; version 1, .vox and solids read whole.
     std::uint32_t depth = 0;

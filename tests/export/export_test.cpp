@@ -527,7 +527,7 @@ TEST(Export, BadInputIsReportedAndLeavesNoFile) {
   };
   std::filesystem::create_directory(dir / "taken.vdb");
   const std::vector<Case> cases = {
-      {dir / "out.obj", std::nullopt, "unknown export format"},
+      {dir / "out.stl", std::nullopt, "unknown export format"},
       {dir / "out", std::nullopt, "unknown export format"},
       {dir / "out.vdb", svo.depth + 1, "level 4 does not exist"},
       {dir / "taken.vdb", std::nullopt, "is a directory"},

@@ -28,27 +28,32 @@ struct PagedFile {
   }
 };
 
+/// `mesh_path` voxelized at `resolution` with colour and normal, built with 3³ bricks and
+/// contours, written to a temporary named after `name` and the process (removed with the result).
+inline PagedFile BuildPagedFile(const std::filesystem::path& mesh_path, std::uint32_t resolution,
+                                const std::string& name) {
+  PagedFile out;
+  auto mesh = ImportMesh(mesh_path);
+  EXPECT_TRUE(mesh.ok()) << mesh.status().message();
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), resolution);
+  VoxelizeOptions vo;
+  vo.colors = vo.normals = true;
+  auto voxels = Voxelize(*mesh, *grid, vo);
+  EXPECT_TRUE(voxels.ok());
+  out.voxels = std::move(*voxels);
+  BuildOptions bo;
+  bo.brick_side = 3;
+  auto svo = BuildCompactSvo(out.voxels, &*mesh, bo, R"({"source":"test"})");
+  EXPECT_TRUE(svo.ok());
+  // Every test process (ctest runs them side by side) writes its own.
+  out.path = std::filesystem::temp_directory_path() /
+             ("svokit_" + name + "_" + std::to_string(::getpid()) + ".svo");
+  EXPECT_TRUE(WriteSvo(*svo, out.path).ok());
+  return out;
+}
+
 inline const PagedFile& PagedTorus() {
-  static const PagedFile f = [] {
-    PagedFile out;
-    // Every test process (ctest runs them side by side) writes its own.
-    auto mesh = ImportMesh(test::DataDir() / "uv-torus.obj");
-    EXPECT_TRUE(mesh.ok()) << mesh.status().message();
-    auto grid = GridTransform::FitResolution(mesh->Bounds(), 512);
-    VoxelizeOptions vo;
-    vo.colors = vo.normals = true;
-    auto voxels = Voxelize(*mesh, *grid, vo);
-    EXPECT_TRUE(voxels.ok());
-    out.voxels = std::move(*voxels);
-    BuildOptions bo;
-    bo.brick_side = 3;
-    auto svo = BuildCompactSvo(out.voxels, &*mesh, bo, R"({"source":"test"})");
-    EXPECT_TRUE(svo.ok());
-    out.path = std::filesystem::temp_directory_path() /
-               ("svokit_paged_torus_" + std::to_string(::getpid()) + ".svo");
-    EXPECT_TRUE(WriteSvo(*svo, out.path).ok());
-    return out;
-  }();
+  static const PagedFile f = BuildPagedFile(test::DataDir() / "uv-torus.obj", 512, "paged_torus");
   return f;
 }
 

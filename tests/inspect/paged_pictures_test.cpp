@@ -161,24 +161,7 @@ TEST(PagedSlice, PageSvoPeakBoundsWhatAPageHolds) {
 
 // The torus at 100³: depth 7, so page level 0 and the whole tree one page.
 const PagedFile& OnePageTorus() {
-  static const PagedFile f = [] {
-    PagedFile out;
-    auto mesh = ImportMesh(DataDir() / "uv-torus.obj");
-    EXPECT_TRUE(mesh.ok());
-    auto grid = GridTransform::FitResolution(mesh->Bounds(), 100);
-    VoxelizeOptions vo;
-    vo.colors = vo.normals = true;
-    auto voxels = Voxelize(*mesh, *grid, vo);
-    EXPECT_TRUE(voxels.ok());
-    BuildOptions bo;
-    bo.brick_side = 3;
-    auto svo = BuildCompactSvo(std::move(*voxels), &*mesh, bo, R"({"source":"test"})");
-    EXPECT_TRUE(svo.ok());
-    out.path = std::filesystem::temp_directory_path() /
-               ("svokit_one_page_torus_" + std::to_string(::getpid()) + ".svo");
-    EXPECT_TRUE(WriteSvo(*svo, out.path).ok());
-    return out;
-  }();
+  static const PagedFile f = BuildPagedFile(DataDir() / "uv-torus.obj", 100, "one_page_torus");
   return f;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include <fmt/format.h>
+
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
@@ -29,8 +31,8 @@ std::vector<std::uint32_t> NodeSamples(std::uint32_t side) {
 }  // namespace
 
 const std::vector<std::string>& ExportExtensions() {
-  static const std::vector<std::string> kExtensions = {"vdb", "nvdb", "binvox",
-                                                       "vox", "ply",  "xyz"};
+  static const std::vector<std::string> kExtensions = {"vdb", "nvdb", "binvox", "vox",
+                                                       "ply", "xyz",  "obj",    "glb"};
   return kExtensions;
 }
 
@@ -168,7 +170,8 @@ StatusOr<std::string> CheckExport(const std::filesystem::path& path) {
   const auto& known = ExportExtensions();
   if (std::find(known.begin(), known.end(), ext) == known.end()) {
     return Status::BadInput(
-        "{}: unknown export format (use .vdb, .nvdb, .binvox, .vox, .ply or .xyz)", path.string());
+        "{}: unknown export format (use .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj or .glb)",
+        path.string());
   }
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
@@ -217,6 +220,15 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
     SVOKIT_RETURN_IF_ERROR((*writer)->Add(voxels, density, ao));
     return (*writer)->Finish();
   }
+  if (*ext == "obj" || *ext == "glb") {
+    // A solid's interior voxels are meshed with the surface's, so only its outside has faces.
+    if (solid != nullptr) {
+      StatusOr<VoxelSet> all = WithInteriorVoxels(std::move(voxels), interior, path);
+      if (!all.ok()) return all.status();
+      voxels = std::move(*all);
+    }
+    return WriteVoxelMesh(voxels, options.merge_faces, path).status();
+  }
   if (*ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
   if (*ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
   if (*ext == "vox") {
@@ -252,6 +264,18 @@ Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& pa
 
 namespace {
 
+// What an export holding `needs` bytes says when they pass `memory_limit` (0: none), before
+// reading.
+Status CheckHeld(const std::filesystem::path& path, const std::string& what, std::uint64_t needs,
+                 std::uint64_t memory_limit) {
+  if (memory_limit == 0 || needs <= memory_limit) return Status::Ok();
+  const std::uint64_t mib = (needs + (1 << 20) - 1) >> 20;
+  return Status::BadInput(
+      "{}: {} need {} MiB, over the memory limit of {} MiB (give {}M or more, or export a coarser "
+      "--level)",
+      path.string(), what, mib, memory_limit >> 20, mib);
+}
+
 // A .nvdb of a file read page by page: the grids are built whole (NanoVdbWriter), so what they
 // need is checked against the limit before a page is read.
 Status ExportNanoVdbPages(const SvoReader& reader, const VoxelFileHeader& header,
@@ -264,13 +288,8 @@ Status ExportNanoVdbPages(const SvoReader& reader, const VoxelFileHeader& header
   const std::uint64_t needs =
       NanoVdbBytes({nodes_above(3), nodes_above(7), nodes_above(12)}, header.colors, ao) +
       (ao ? reader.NodeCount(level) : 0);
-  if (memory_limit != 0 && needs > memory_limit) {
-    const std::uint64_t mib = (needs + (1 << 20) - 1) >> 20;
-    return Status::BadInput(
-        "{}: a .nvdb is built whole: level {}'s grids need {} MiB, over the memory limit of {} MiB "
-        "(give {}M or more, or export a coarser --level)",
-        path.string(), level, mib, memory_limit >> 20, mib);
-  }
+  SVOKIT_RETURN_IF_ERROR(CheckHeld(
+      path, fmt::format("a .nvdb is built whole: level {}'s grids", level), needs, memory_limit));
   StatusOr<std::vector<std::uint8_t>> level_ao = reader.LevelAo(level);
   if (!level_ao.ok()) return level_ao.status();
   StatusOr<std::unique_ptr<NanoVdbWriter>> writer = OpenNanoVdbWriter(header, ao, path);
@@ -296,6 +315,36 @@ Status ExportNanoVdbPages(const SvoReader& reader, const VoxelFileHeader& header
   return (*writer)->Finish();
 }
 
+// A voxel mesh of a file read page by page: the level's nodes (key and colour, 16 bytes each) are
+// gathered, since a face needs its neighbours across pages, and checked against the limit first.
+Status ExportVoxelMeshPages(const SvoReader& reader, const VoxelFileHeader& header,
+                            const std::filesystem::path& path, std::uint32_t level, bool merge,
+                            std::uint64_t memory_limit, Progress::Stage* stage) {
+  const std::uint64_t nodes = reader.NodeCount(level);
+  const std::uint64_t needs = nodes * (sizeof(std::uint64_t) + sizeof(HalfRgba));
+  SVOKIT_RETURN_IF_ERROR(CheckHeld(
+      path, fmt::format("a voxel mesh's {} nodes of level {}", nodes, level), needs, memory_limit));
+  VoxelSet all;
+  all.grid = header.grid;
+  all.mode = reader.mode();
+  all.keys.reserve(nodes);
+  if (header.colors) all.colors.reserve(nodes);
+  const std::uint32_t side = reader.shape().brick_side;
+  SVOKIT_RETURN_IF_ERROR(ForEachLevelPage(
+      reader, level, header.colors, SvoStreamOptions{.memory_limit = memory_limit},
+      [&](std::size_t, SvoChunkLevel& page) {
+        VoxelSet part;
+        part.grid = header.grid;
+        part.keys.assign(page.keys.begin(), page.keys.end());
+        FillNodeAttributes(page.bricks, side, header.colors, false, part);
+        all.keys.insert(all.keys.end(), part.keys.begin(), part.keys.end());
+        all.colors.insert(all.colors.end(), part.colors.begin(), part.colors.end());
+        return Status::Ok();
+      },
+      stage));
+  return WriteVoxelMesh(all, merge, path).status();
+}
+
 }  // namespace
 
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
@@ -317,6 +366,10 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   const VoxelFileHeader header{LevelGrid(reader.grid(), reader.depth(), level), colors, normals,
                                reader.NodeCount(level)};
   if (*ext == "nvdb") return ExportNanoVdbPages(reader, header, path, level, memory_limit, stage);
+  if (*ext == "obj" || *ext == "glb") {
+    return ExportVoxelMeshPages(reader, header, path, level, options.merge_faces, memory_limit,
+                                stage);
+  }
   StatusOr<std::unique_ptr<VoxelFileWriter>> writer =
       *ext == "vdb"      ? OpenVdbWriter(header, nullptr, path)
       : *ext == "binvox" ? OpenBinvoxWriter(header, nullptr, path)

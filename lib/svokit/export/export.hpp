@@ -1,7 +1,7 @@
 #pragma once
 // svo-export's writers: an Svo (or one of its coarser levels), or a paged file read page by page,
-// as OpenVDB or NanoVDB grids, binvox, MagicaVoxel .vox, PLY points or xyz text, chosen by the
-// output extension.
+// as OpenVDB or NanoVDB grids, binvox, MagicaVoxel .vox, PLY points, xyz text or a voxel mesh
+// (.obj, .glb), chosen by the output extension.
 //
 // Every format goes through one VoxelSet: the nodes of the exported level as voxels of that
 // level's node size, on the octree's origin, so all writers agree on coordinates and attributes.
@@ -24,6 +24,8 @@ namespace svokit {
 struct ExportOptions {
   /// The octree level whose nodes become the exported voxels; the finest (voxel) level if unset.
   std::optional<std::uint32_t> level;
+  /// Voxel meshes (.obj, .glb): coplanar faces of one colour merged into rectangles.
+  bool merge_faces = true;
 };
 
 /// The extensions ExportSvo understands, lower case, without the dot.

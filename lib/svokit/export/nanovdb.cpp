@@ -73,8 +73,8 @@ class NanoVdbWriterImpl final : public NanoVdbWriter {
       segment.meta[0].fileSize = handle.size();
       std::ostringstream header(std::ios::binary);
       segment.write(header);
-      const std::string h = std::move(header).str();
-      SVOKIT_RETURN_IF_ERROR(out_.Write(h.data(), h.size()));
+      const std::string head = std::move(header).str();
+      SVOKIT_RETURN_IF_ERROR(out_.Write(head.data(), head.size()));
       return out_.Write(handle.data(), handle.size());
     };
     SVOKIT_RETURN_IF_ERROR(write(density_, "density"));

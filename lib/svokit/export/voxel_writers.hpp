@@ -77,6 +77,21 @@ StatusOr<std::unique_ptr<NanoVdbWriter>> OpenNanoVdbWriter(const VoxelFileHeader
 /// up (its 8³ leaves, 128³ and 4096³ internal nodes).
 std::uint64_t NanoVdbBytes(const std::array<std::uint64_t, 3>& nodes, bool colors, bool ao);
 
+/// A voxel mesh: the faces between a voxel and an empty neighbour (or the grid's edge), as quads
+/// of the voxel size, outward and counter-clockwise, each voxel's colour on its faces. `.obj`:
+/// world-space vertices, one normal per axis direction, faces by material from a palette of at
+/// most 255 colours (MedianCut; Kd linear) in the side file NAME.mtl. `.glb`: glTF 2.0 binary with
+/// positions, normals, linear RGBA8 vertex colours and 32-bit indices (two triangles a quad). With
+/// `merge`, coplanar faces of one colour within each 128³ cube of voxels are merged into rectangles
+/// (greedy meshing). Without voxels, or past a .glb's 32-bit sizes, bad input.
+struct VoxelMeshStats {
+  std::uint64_t quads = 0;
+};
+StatusOr<VoxelMeshStats> WriteVoxelMesh(const VoxelSet& voxels, bool merge,
+                                        const std::filesystem::path& path);
+/// The quads WriteVoxelMesh writes without merging: one per voxel side without a neighbour.
+std::uint64_t NaiveFaceCount(const VoxelSet& voxels);
+
 /// binvox: a dims³ cube (dims = the longest axis), `translate` = grid origin, `scale` = the cube's
 /// edge, run-length encoded with y running fastest, then z, then x (the spec's voxel order).
 /// A solid's `interior` cubes (at the voxels' resolution; null for none) are filled.
