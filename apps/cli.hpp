@@ -22,6 +22,7 @@ namespace svokit::app {
 
 struct CommonOptions {
   bool quiet = false;
+  bool json = false;        ///< the report as one JSON object (Report)
   std::size_t threads = 0;  // 0 = all cores
 
   Progress MakeProgress() const {
@@ -58,13 +59,17 @@ class HelpFormatter : public CLI::Formatter {
   }
 };
 
-/// What every tool's command line has: --version, --quiet, --threads, the help's layout and, at
-/// its end, `example`: one command line that shows the tool at work.
+/// What every tool's command line has: --version, --quiet, --json, --threads, the help's layout
+/// and, at its end, `example`: one command line that shows the tool at work.
 inline void AddCommonOptions(CLI::App& cli, CommonOptions& options, std::string_view example) {
   cli.formatter(std::make_shared<HelpFormatter>());
   cli.footer(fmt::format("Example:\n  {}", example));
   cli.set_version_flag("--version", std::string("svokit ") + SVOKIT_VERSION);
-  cli.add_flag("-q,--quiet", options.quiet, "No progress output on stderr");
+  cli.add_flag("-q,--quiet", options.quiet,
+               "No progress on stderr and no report on stdout (errors and warnings still go to "
+               "stderr; --json still prints)");
+  cli.add_flag("--json", options.json,
+               "Print the report as one JSON object on stdout, with the text's keys");
   cli.add_option("-j,--threads", options.threads, "Worker threads; 0 = all cores")
       ->option_text("N")
       ->capture_default_str()

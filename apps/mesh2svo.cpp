@@ -16,25 +16,39 @@ namespace {
 using namespace svokit;
 
 void PrintSummary(const MeshToSvoRequest& request, const MeshToSvoReport& report,
-                  const std::string& mode, const Progress& progress, std::size_t warnings) {
-  const std::string output = request.output.string();
+                  const std::string& mode, const Progress& progress, std::size_t warnings,
+                  const app::CommonOptions& common) {
+  app::Report out(common);
   if (report.part) {
-    fmt::print("part        {} of {}: {} pages ({} cubes), {} voxels\n", request.part->part,
-               request.part->parts, report.part->pages, report.part->cells, report.part->voxels);
-    app::PrintTimes(progress);
-    fmt::print("warnings    {}\n", warnings);
-    fmt::print("output      {}\n", output);
+    out.Line("part",
+             {{"part", request.part->part},
+              {"parts", request.part->parts},
+              {"pages", report.part->pages},
+              {"cubes", report.part->cells},
+              {"voxels", report.part->voxels}},
+             fmt::format("{} of {}: {} pages ({} cubes), {} voxels", request.part->part,
+                         request.part->parts, report.part->pages, report.part->cells,
+                         report.part->voxels));
+    app::AddTimes(out, progress);
+    out.Line("warnings", warnings, fmt::format("{}", warnings));
+    app::AddOutput(out, request.output, std::nullopt);
+    out.Print();
     return;
   }
   const OctreeReport& octree = report.octree;
-  app::PrintMeshAndGrid(request.input.string(), report.triangles, report.grid, true);
-  if (octree.memory.by_pages()) fmt::print("build       by pages {}\n", octree.memory.WithinText());
-  fmt::print("voxels      {} ({})\n", octree.voxels, mode);
-  if (octree.interior) app::PrintInterior(*octree.interior);
-  app::PrintOctreeSummary(octree);
-  app::PrintTimes(progress);
-  fmt::print("warnings    {}\n", warnings);
-  fmt::print("output      {} ({} bytes)\n", output, octree.file.file_bytes);
+  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.grid, true);
+  if (octree.memory.by_pages()) {
+    out.Line("build", {{"by_pages", true}, {"within", octree.memory.WithinText()}},
+             fmt::format("by pages {}", octree.memory.WithinText()));
+  }
+  out.Line("voxels", {{"count", octree.voxels}, {"mode", mode}},
+           fmt::format("{} ({})", octree.voxels, mode));
+  if (octree.interior) app::AddInterior(out, *octree.interior);
+  app::AddOctreeSummary(out, octree, request.output);
+  app::AddTimes(out, progress);
+  out.Line("warnings", warnings, fmt::format("{}", warnings));
+  app::AddOutput(out, request.output, octree.file.file_bytes);
+  out.Print();
 }
 
 }  // namespace
@@ -97,7 +111,7 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     StatusOr<MeshToSvoReport> report = MeshToSvo(request, progress);
     if (!report.ok()) return fail(report.status());
-    PrintSummary(request, *report, voxelize.ModeName(), progress, import.warnings);
+    PrintSummary(request, *report, voxelize.ModeName(), progress, import.warnings, common);
     return 0;
   });
 }

@@ -1,68 +1,168 @@
 #pragma once
-// The one-screen summaries the chain's tools print on stdout: the grid, the octree's levels and
-// what each kind of array takes in the file, a solid's interior, and the stages' times.
+// The one-screen reports the tools print on stdout: as text, one "key  value" line each (tables as
+// they are), or with --json as one JSON object with the same keys and their values as numbers,
+// strings and arrays; nothing with --quiet unless --json asks for it. The parts the chain's tools
+// share: the grid, the octree's levels and what each kind of array takes in the file, a solid's
+// interior, and the stages' times.
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include "apps/cli.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/pipeline/chain.hpp"
 
 namespace svokit::app {
 
-/// The octree part of svo-build's and mesh2svo's summary: what each kind of array takes in the
-/// file (stored and decoded, per voxel) and the pages.
-inline void PrintFileSummary(const SvoFileStats& stats) {
+using Json = nlohmann::ordered_json;
+
+class Report {
+ public:
+  explicit Report(const CommonOptions& common) : json_(common.json), quiet_(common.quiet) {}
+
+  /// The line "key  text" (the key padded to 11), and key: value in JSON.
+  void Line(const std::string& key, Json value, const std::string& text) {
+    entries_.push_back({key, std::move(value), fmt::format("{:<11} {}\n", key, text)});
+  }
+  /// Lines of text as they are (a table, each line ending in a newline), and key: value in JSON.
+  void Block(const std::string& key, Json value, std::string text) {
+    entries_.push_back({key, std::move(value), std::move(text)});
+  }
+  /// Text that JSON leaves out (it has its values elsewhere).
+  void Text(std::string text) { entries_.push_back({"", nullptr, std::move(text)}); }
+
+  void Print() const {
+    if (json_) {
+      Json out = Json::object();
+      for (const Entry& e : entries_) {
+        if (!e.key.empty()) out[e.key] = e.value;
+      }
+      fmt::print("{}\n", out.dump(2));
+      return;
+    }
+    if (quiet_) return;
+    for (const Entry& e : entries_) fmt::print("{}", e.text);
+  }
+
+ private:
+  struct Entry {
+    std::string key;
+    Json value;
+    std::string text;
+  };
+  bool json_, quiet_;
+  std::vector<Entry> entries_;
+};
+
+/// The octree part of svo-build's, mesh2svo's and svo-merge's report: what each kind of array
+/// takes in the file (stored and decoded, per voxel) and the pages.
+inline void AddFileSummary(Report& report, const SvoFileStats& stats) {
   const double voxels = static_cast<double>(stats.voxels);
-  fmt::print("{:<14} {:>12} {:>12} {:>11}\n", "section", "stored B", "raw B", "B/voxel");
+  std::string table =
+      fmt::format("{:<14} {:>12} {:>12} {:>11}\n", "section", "stored B", "raw B", "B/voxel");
+  Json sections = Json::array();
   for (const SvoSectionBytes& s : stats.sections) {
-    fmt::print("{:<14} {:>12} {:>12} {:>11.3f}\n", s.name, s.stored, s.raw,
-               static_cast<double>(s.stored) / voxels);
+    table += fmt::format("{:<14} {:>12} {:>12} {:>11.3f}\n", s.name, s.stored, s.raw,
+                         static_cast<double>(s.stored) / voxels);
+    sections.push_back({{"name", s.name}, {"stored_bytes", s.stored}, {"raw_bytes", s.raw}});
   }
-  fmt::print("{:<14} {:>12} {:>12} {:>11.3f}\n", "file", stats.file_bytes, "",
-             static_cast<double>(stats.file_bytes) / voxels);
-  fmt::print("pages       {} below level {} ({} to {} bytes)\n", stats.pages, stats.page_level,
-             stats.smallest_page, stats.largest_page);
+  table += fmt::format("{:<14} {:>12} {:>12} {:>11.3f}\n", "file", stats.file_bytes, "",
+                       static_cast<double>(stats.file_bytes) / voxels);
+  report.Block("sections", sections, table);
+  report.Line("pages",
+              {{"count", stats.pages},
+               {"page_level", stats.page_level},
+               {"smallest_bytes", stats.smallest_page},
+               {"largest_bytes", stats.largest_page}},
+              fmt::format("{} below level {} ({} to {} bytes)", stats.pages, stats.page_level,
+                          stats.smallest_page, stats.largest_page));
 }
 
-/// The levels (an octree built whole) and the file.
-inline void PrintOctreeSummary(const OctreeReport& octree) {
-  fmt::print("{}", octree.level_table);
-  PrintFileSummary(octree.file);
+/// The levels of the octree written to `output` (its HEAD: nodes and contours per level), as
+/// JSON.
+inline Json LevelsJson(const std::filesystem::path& output) {
+  StatusOr<SvoReader> reader = SvoReader::Open(output);
+  if (!reader.ok()) return nullptr;
+  Json levels = Json::array();
+  for (std::uint32_t l = 0; l <= reader->depth(); ++l) {
+    const double size = reader->grid().voxel_size() *
+                        static_cast<double>(std::uint64_t{1} << (reader->depth() - l));
+    levels.push_back({{"level", l},
+                      {"node_size", size},
+                      {"nodes", reader->NodeCount(l)},
+                      {"contours", reader->ContourCount(l)}});
+  }
+  return levels;
 }
 
-/// The summary's line of a solid's interior.
-inline void PrintInterior(const InteriorSummary& interior) {
-  fmt::print("interior    {} voxels in {} cubes, by {}\n", interior.voxels, interior.cubes,
-             interior.method == FillMethod::kColumns
-                 ? "exact crossings (closed surface)"
-                 : fmt::format("winding numbers ({} open edges)", interior.open_edges));
+/// The levels (an octree built whole: its table) and the file.
+inline void AddOctreeSummary(Report& report, const OctreeReport& octree,
+                             const std::filesystem::path& output) {
+  report.Block("levels", LevelsJson(output), octree.level_table);
+  AddFileSummary(report, octree.file);
+}
+
+/// The report's line of a solid's interior.
+inline void AddInterior(Report& report, const InteriorSummary& interior) {
+  const bool columns = interior.method == FillMethod::kColumns;
+  std::string text =
+      fmt::format("{} voxels in {} cubes, by {}", interior.voxels, interior.cubes,
+                  columns ? "exact crossings (closed surface)"
+                          : fmt::format("winding numbers ({} open edges)", interior.open_edges));
   if (interior.cubes == 0) {
-    fmt::print("            the surface encloses no voxel centre: the solid is its surface\n");
+    text += "\n            the surface encloses no voxel centre: the solid is its surface";
   }
+  report.Line("interior",
+              {{"voxels", interior.voxels},
+               {"cubes", interior.cubes},
+               {"method", columns ? "crossings" : "winding_numbers"},
+               {"open_edges", interior.open_edges}},
+              text);
 }
 
-/// The summary's lines of the mesh and the grid it was voxelized in (`depth`: the octree's).
-inline void PrintMeshAndGrid(const std::string& mesh, std::uint64_t triangles,
-                             const GridTransform& grid, bool depth) {
+/// The report's lines of the mesh and the grid it was voxelized in (`depth`: the octree's).
+inline void AddMeshAndGrid(Report& report, const std::string& mesh, std::uint64_t triangles,
+                           const GridTransform& grid, bool depth) {
   const auto& d = grid.dims();
-  fmt::print("mesh        {} ({} triangles)\n", mesh, triangles);
-  fmt::print("grid        {} x {} x {} voxels of {:.9g}{}\n", d[0], d[1], d[2], grid.voxel_size(),
-             depth ? fmt::format(", octree depth {}", OctreeDepth(grid)) : "");
+  report.Line("mesh", {{"path", mesh}, {"triangles", triangles}},
+              fmt::format("{} ({} triangles)", mesh, triangles));
+  Json g = {{"dims", {d[0], d[1], d[2]}},
+            {"voxel_size", grid.voxel_size()},
+            {"origin", {grid.origin().x, grid.origin().y, grid.origin().z}}};
+  if (depth) g["depth"] = OctreeDepth(grid);
+  report.Line("grid", g,
+              fmt::format("{} x {} x {} voxels of {:.9g}{}", d[0], d[1], d[2], grid.voxel_size(),
+                          depth ? fmt::format(", octree depth {}", OctreeDepth(grid)) : ""));
 }
 
-/// The summary's line of stage times.
-inline void PrintTimes(const Progress& progress) {
+/// The report's line of stage times.
+inline void AddTimes(Report& report, const Progress& progress) {
   std::string times;
   double total = 0;
+  Json seconds = Json::object();
   for (const Progress::Timing& t : progress.timings()) {
     times += fmt::format("{} {:.2f} s, ", t.stage, t.seconds);
+    seconds[t.stage] = t.seconds;
     total += t.seconds;
   }
-  fmt::print("time        {}total {:.2f} s\n", times, total);
+  seconds["total"] = total;
+  report.Line("time", seconds, fmt::format("{}total {:.2f} s", times, total));
+}
+
+/// The report's line of the output file and its size.
+inline void AddOutput(Report& report, const std::filesystem::path& output,
+                      std::optional<std::uint64_t> bytes) {
+  Json value = {{"path", output.string()}};
+  if (bytes) value["bytes"] = *bytes;
+  report.Line("output", value,
+              bytes ? fmt::format("{} ({} bytes)", output.string(), *bytes) : output.string());
 }
 
 }  // namespace svokit::app

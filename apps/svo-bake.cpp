@@ -30,8 +30,7 @@ struct BakeCli {
     app::AddFile(cli, "input", request.input,
                  "Octree (.svo from svo-build or mesh2svo, with bricks)")
         ->required();
-    cli.add_flag("--ao", ao, "Bake ambient occlusion (required: the one term svo-bake bakes)")
-        ->required();
+    cli.add_flag("--ao", ao, "Bake ambient occlusion (the default: the one term svo-bake bakes)");
     app::AddFile(cli, "-o,--output", request.output, "The octree again, with AO per node (.svo)");
     app::AddFile(cli, "--mesh", request.mesh,
                  "The mesh the octree was made from (for --vertex-out, --texture-out, "
@@ -122,42 +121,70 @@ struct BakeCli {
 };
 
 void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress& progress,
-                  std::size_t warnings) {
+                  std::size_t warnings, const app::CommonOptions& common) {
+  using app::Json;
   const AoBakeRequest& r = cli.request;
   const ConeOptions& c = report.cones;
-  fmt::print("octree      {} (depth {}, {} voxels)\n", r.input.string(), report.depth,
-             report.voxels);
-  fmt::print(
-      "cones       {} (aperture x{}), distance {:.6g}, falloff {}, offset {} voxel diagonals{}\n",
-      c.cones, c.aperture, c.distance, c.falloff, c.offset,
-      c.jitter_seed ? fmt::format(", jitter seed {}", *c.jitter_seed) : std::string());
-  fmt::print("pages       {} read by the cones, at most {:.1f} MiB held of {:.0f} MiB\n",
-             report.pages_decoded, static_cast<double>(report.cache_peak) / (1 << 20),
-             static_cast<double>(report.cache_capacity) / (1 << 20));
+  app::Report out(common);
+  out.Line("octree",
+           {{"path", r.input.string()}, {"depth", report.depth}, {"voxels", report.voxels}},
+           fmt::format("{} (depth {}, {} voxels)", r.input.string(), report.depth, report.voxels));
+  Json cones = {{"cones", c.cones},
+                {"aperture", c.aperture},
+                {"distance", c.distance},
+                {"falloff", c.falloff},
+                {"offset", c.offset}};
+  if (c.jitter_seed) cones["jitter_seed"] = *c.jitter_seed;
+  out.Line(
+      "cones", cones,
+      fmt::format("{} (aperture x{}), distance {:.6g}, falloff {}, offset {} voxel diagonals{}",
+                  c.cones, c.aperture, c.distance, c.falloff, c.offset,
+                  c.jitter_seed ? fmt::format(", jitter seed {}", *c.jitter_seed) : std::string()));
+  out.Line("pages",
+           {{"read", report.pages_decoded},
+            {"peak_bytes", report.cache_peak},
+            {"capacity_bytes", report.cache_capacity}},
+           fmt::format("{} read by the cones, at most {:.1f} MiB held of {:.0f} MiB",
+                       report.pages_decoded, static_cast<double>(report.cache_peak) / (1 << 20),
+                       static_cast<double>(report.cache_capacity) / (1 << 20)));
   if (report.octree) {
-    fmt::print("voxels      {} traced, mean AO {:.4f}\n", report.octree->count,
-               report.octree->mean_ao);
-    fmt::print("output      {} ({} bytes)\n", r.output.string(), report.output_bytes);
+    out.Line(
+        "voxels", {{"traced", report.octree->count}, {"mean_ao", report.octree->mean_ao}},
+        fmt::format("{} traced, mean AO {:.4f}", report.octree->count, report.octree->mean_ao));
+    app::AddOutput(out, r.output, report.output_bytes);
   }
   if (report.vertices) {
-    fmt::print("vertices    {} traced ({}), mean AO {:.4f}\n", report.vertices->count, cli.method,
-               report.vertices->mean_ao);
+    out.Line("vertices",
+             {{"traced", report.vertices->count},
+              {"method", cli.method},
+              {"mean_ao", report.vertices->mean_ao}},
+             fmt::format("{} traced ({}), mean AO {:.4f}", report.vertices->count, cli.method,
+                         report.vertices->mean_ao));
   }
   if (report.reference_mean_ao) {
     const AoErrors& e = report.reference_errors;
-    fmt::print(
-        "reference   {} rays per vertex, mean AO {:.4f}; error: mean {:.4f}, 95th percentile "
-        "{:.4f}, max {:.4f}\n",
-        *r.reference, *report.reference_mean_ao, e.mean, e.p95, e.max);
+    out.Line("reference",
+             {{"rays", *r.reference},
+              {"mean_ao", *report.reference_mean_ao},
+              {"error", {{"mean", e.mean}, {"p95", e.p95}, {"max", e.max}}}},
+             fmt::format("{} rays per vertex, mean AO {:.4f}; error: mean {:.4f}, 95th "
+                         "percentile {:.4f}, max {:.4f}",
+                         *r.reference, *report.reference_mean_ao, e.mean, e.p95, e.max));
   }
-  if (!r.vertex_out.empty()) fmt::print("vertex-out  {}\n", r.vertex_out.string());
+  if (!r.vertex_out.empty()) out.Line("vertex-out", r.vertex_out.string(), r.vertex_out.string());
   if (report.texels) {
-    fmt::print("texture-out {} ({}x{}, {} texels covered, mean AO {:.4f})\n",
-               r.texture_out.string(), r.texture_size, r.texture_size, report.texels->count,
-               report.texels->mean_ao);
+    out.Line(
+        "texture-out",
+        {{"path", r.texture_out.string()},
+         {"size", r.texture_size},
+         {"texels", report.texels->count},
+         {"mean_ao", report.texels->mean_ao}},
+        fmt::format("{} ({}x{}, {} texels covered, mean AO {:.4f})", r.texture_out.string(),
+                    r.texture_size, r.texture_size, report.texels->count, report.texels->mean_ao));
   }
-  app::PrintTimes(progress);
-  if (!r.mesh.empty()) fmt::print("warnings    {}\n", warnings);
+  app::AddTimes(out, progress);
+  if (!r.mesh.empty()) out.Line("warnings", warnings, fmt::format("{}", warnings));
+  out.Print();
 }
 
 }  // namespace
@@ -185,7 +212,7 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     StatusOr<AoBakeReport> report = BakeSvoAo(bake.request, progress);
     if (!report.ok()) return app::Fail(tool, report.status());
-    PrintSummary(bake, *report, progress, import.warnings);
+    PrintSummary(bake, *report, progress, import.warnings, common);
     return 0;
   });
 }

@@ -14,18 +14,26 @@
 namespace {
 
 using namespace svokit;
+using app::Json;
 
 void PrintSummary(const VoxelsToSvoRequest& request, const OctreeReport& octree,
-                  const std::string& bricks, const Progress& progress, std::size_t warnings) {
-  fmt::print("input       {} ({} voxels)\n", request.input.string(), octree.voxels);
-  if (octree.interior) app::PrintInterior(*octree.interior);
-  fmt::print("octree      depth {}, bricks {}, contours {}{}\n", octree.depth, bricks,
-             request.build.contours ? "on" : "off",
-             octree.memory.by_pages() ? ", by pages " + octree.memory.WithinText() : "");
-  app::PrintOctreeSummary(octree);
-  if (octree.memory.by_pages()) app::PrintTimes(progress);
-  if (!request.mesh.empty()) fmt::print("warnings    {}\n", warnings);
-  fmt::print("output      {} ({} bytes)\n", request.output.string(), octree.file.file_bytes);
+                  const std::string& bricks, const Progress& progress, std::size_t warnings,
+                  const app::CommonOptions& common) {
+  app::Report out(common);
+  out.Line("input", {{"path", request.input.string()}, {"voxels", octree.voxels}},
+           fmt::format("{} ({} voxels)", request.input.string(), octree.voxels));
+  if (octree.interior) app::AddInterior(out, *octree.interior);
+  Json tree = {{"depth", octree.depth}, {"bricks", bricks}, {"contours", request.build.contours}};
+  if (octree.memory.by_pages()) tree["by_pages"] = octree.memory.WithinText();
+  out.Line("octree", tree,
+           fmt::format("depth {}, bricks {}, contours {}{}", octree.depth, bricks,
+                       request.build.contours ? "on" : "off",
+                       octree.memory.by_pages() ? ", by pages " + octree.memory.WithinText() : ""));
+  app::AddOctreeSummary(out, octree, request.output);
+  if (octree.memory.by_pages()) app::AddTimes(out, progress);
+  if (!request.mesh.empty()) out.Line("warnings", warnings, fmt::format("{}", warnings));
+  app::AddOutput(out, request.output, octree.file.file_bytes);
+  out.Print();
 }
 
 }  // namespace
@@ -76,7 +84,7 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     StatusOr<OctreeReport> octree = VoxelsToSvo(request, progress);
     if (!octree.ok()) return fail(octree.status());
-    PrintSummary(request, *octree, build.bricks, progress, import.warnings);
+    PrintSummary(request, *octree, build.bricks, progress, import.warnings, common);
     return 0;
   });
 }

@@ -86,9 +86,14 @@ int main(int argc, char** argv) {
       nodes = svo->levels[level.value_or(depth)].node_count;
       node_size = svo->NodeSize(level.value_or(depth));
     }
-    fmt::print("octree      {} (depth {})\n", input.string(), depth);
-    fmt::print("level       {} ({} nodes of {:.9g})\n", level.value_or(depth), nodes, node_size);
-    fmt::print("output      {}\n", output.string());
+    app::Report report(common);
+    report.Line("octree", {{"path", input.string()}, {"depth", depth}},
+                fmt::format("{} (depth {})", input.string(), depth));
+    report.Line("level",
+                {{"level", level.value_or(depth)}, {"nodes", nodes}, {"node_size", node_size}},
+                fmt::format("{} ({} nodes of {:.9g})", level.value_or(depth), nodes, node_size));
+    app::AddOutput(report, output, std::nullopt);
+    report.Print();
     return 0;
   });
 }

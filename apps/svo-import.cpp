@@ -20,13 +20,11 @@ int main(int argc, char** argv) {
       "report and writes a normalized mesh (.svm) for svo-voxelize.",
       tool};
   std::filesystem::path input, output;
-  bool json = false;
   ReportOptions report_options;
   app::CommonOptions common;
   app::ImportCli import;
   app::AddFile(cli, "input", input, "Mesh file")->required();
   app::AddFile(cli, "-o,--output", output, "Normalized mesh to write (.svm)");
-  cli.add_flag("--json", json, "Print the report as JSON (stable keys, see README)");
   cli.add_flag("--self-intersections", report_options.self_intersections,
                "Also count self-intersecting triangle pairs (exact, slower)");
   import.Add(cli);
@@ -59,8 +57,10 @@ int main(int argc, char** argv) {
           [&](const Status&) { return output.string(); });
       if (!written.ok()) return app::Fail(tool, written);
     }
-    const std::string text = json ? FormatReportJson(report) : FormatReportText(report);
-    std::fwrite(text.data(), 1, text.size(), stdout);
+    if (common.json || !common.quiet) {
+      const std::string text = common.json ? FormatReportJson(report) : FormatReportText(report);
+      std::fwrite(text.data(), 1, text.size(), stdout);
+    }
     return 0;
   });
 }

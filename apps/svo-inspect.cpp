@@ -23,7 +23,6 @@ struct InspectCli {
 
   void Add(CLI::App& cli) {
     app::AddFile(cli, "input", request.input, "Octree (.svo)")->required();
-    cli.add_flag("--json", request.json, "Print the statistics as one JSON object (stable keys)");
     cli.add_flag("--levels", request.levels, "Add the per-level table");
     cli.add_flag("--histograms", request.histograms,
                  "Add histograms: children per node, brick opacity, contour extent");
@@ -90,11 +89,12 @@ int main(int argc, char** argv) {
                         "svo-inspect bunny.svo --levels --render bunny.png --view iso");
   return app::Run(tool, cli, argc, argv, inspect.request.input, [&] {
     if (Status s = inspect.Parse(); !s.ok()) return app::Fail(tool, s);
+    inspect.request.json = common.json;
     ThreadLimit threads(common.threads);
     Progress progress = common.MakeProgress();
     StatusOr<std::string> report = InspectSvo(inspect.request, progress);
     if (!report.ok()) return app::Fail(tool, report.status());
-    fmt::print("{}", *report);
+    if (common.json || !common.quiet) fmt::print("{}", *report);
     return 0;
   });
 }

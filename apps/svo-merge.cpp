@@ -41,11 +41,13 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     StatusOr<SvoFileStats> written = MergeSvoParts(parts, output, progress, merge);
     if (!written.ok()) return app::Fail(tool, written.status());
-    fmt::print("parts       {}\n", parts.size());
-    fmt::print("voxels      {}\n", written->voxels);
-    app::PrintFileSummary(*written);
-    app::PrintTimes(progress);
-    fmt::print("output      {} ({} bytes)\n", output.string(), written->file_bytes);
+    app::Report report(common);
+    report.Line("parts", parts.size(), fmt::format("{}", parts.size()));
+    report.Line("voxels", written->voxels, fmt::format("{}", written->voxels));
+    app::AddFileSummary(report, *written);
+    app::AddTimes(report, progress);
+    app::AddOutput(report, output, written->file_bytes);
+    report.Print();
     return 0;
   });
 }

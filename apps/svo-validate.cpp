@@ -27,7 +27,6 @@ int main(int argc, char** argv) {
       "distance field of the surface and the contour slabs against sampled surface points.",
       tool};
   std::filesystem::path input, mesh_path;
-  bool json = false;
   app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
   app::ImportCli import;
@@ -35,7 +34,6 @@ int main(int argc, char** argv) {
   app::AddFile(cli, "--mesh", mesh_path,
                "The mesh the octree was built from (.svm or any mesh file): enables the "
                "occupancy and contour-surface checks");
-  cli.add_flag("--json", json, "Print the report as one JSON object");
   memory_limit.Add(cli,
                    "Bytes a paged file's pages and their checks (a page's distance field, its "
                    "neighbours' borders) hold at once, besides the mesh (default: a few pages per "
@@ -86,12 +84,12 @@ int main(int argc, char** argv) {
               : validate::ValidatePaged(*paged, input.string(), options, progress);
     if (!checked.ok()) return app::Fail(tool, checked.status());
     const validate::Report& report = *checked;
-    if (json) {
+    if (common.json) {
       // The mesh's import warnings belong to the run, not to the octree's report.
       nlohmann::ordered_json j = nlohmann::ordered_json::parse(report.Json());
       if (mesh) j["warnings"] = import.warnings;
       fmt::print("{}\n", j.dump(2));
-    } else {
+    } else if (!common.quiet) {
       fmt::print("{}", report.Text());
       if (mesh) fmt::print("warnings    {} (mesh import)\n", import.warnings);
     }

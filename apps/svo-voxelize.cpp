@@ -17,15 +17,19 @@ namespace {
 using namespace svokit;
 
 void PrintSummary(const MeshToVoxelsRequest& request, const MeshToVoxelsReport& report,
-                  const std::string& mode, std::size_t warnings) {
-  app::PrintMeshAndGrid(request.input.string(), report.triangles, report.grid, false);
+                  const std::string& mode, std::size_t warnings, const app::CommonOptions& common) {
+  app::Report out(common);
+  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.grid, false);
   if (report.memory.by_pages()) {
-    fmt::print("voxelize    by cubes {}\n", report.memory.WithinText());
+    out.Line("voxelize", {{"by_cubes", true}, {"within", report.memory.WithinText()}},
+             fmt::format("by cubes {}", report.memory.WithinText()));
   }
-  fmt::print("voxels      {} ({})\n", report.voxels, mode);
-  if (report.interior) app::PrintInterior(*report.interior);
-  fmt::print("warnings    {}\n", warnings);
-  fmt::print("output      {}\n", request.output.string());
+  out.Line("voxels", {{"count", report.voxels}, {"mode", mode}},
+           fmt::format("{} ({})", report.voxels, mode));
+  if (report.interior) app::AddInterior(out, *report.interior);
+  out.Line("warnings", warnings, fmt::format("{}", warnings));
+  app::AddOutput(out, request.output, std::nullopt);
+  out.Print();
 }
 
 // Option combinations refused before any work.
@@ -87,7 +91,7 @@ int main(int argc, char** argv) {
     Progress progress = common.MakeProgress();
     StatusOr<MeshToVoxelsReport> report = MeshToVoxels(request, progress);
     if (!report.ok()) return fail(report.status());
-    PrintSummary(request, *report, voxelize.ModeName(), import.warnings);
+    PrintSummary(request, *report, voxelize.ModeName(), import.warnings, common);
     return 0;
   });
 }

@@ -1,7 +1,13 @@
 // Every tool's --help as a newcomer reads it: values as words and choices ("conservative|thin",
-// not CLI11's enum maps), defaults after the descriptions, and one example at the end.
+// not CLI11's enum maps), defaults after the descriptions, and one example at the end. And one
+// convention for every tool's report: --json gives one JSON object with the text's keys, -q prints
+// nothing on success.
 
 #include <gtest/gtest.h>
+
+#include <set>
+
+#include <nlohmann/json.hpp>
 
 #include "tests/cli/run_tool.hpp"
 
@@ -77,6 +83,73 @@ TEST(HelpCli, EverySpellingOfAChoiceIsStillAccepted) {
   const ToolResult bad = RunTool("svo-voxelize", {mesh, "-o", (dir / "t.vfrag").string(), "-r",
                                                   "16", "--mode", "thick", "-q"});
   EXPECT_EQ(bad.exit_code, 2);
+}
+
+// Each tool on a small chain of files, as a pipeline runs it (its arguments after the input), and
+// the keys its report has, in text and in JSON.
+struct ToolRun {
+  std::string tool;
+  std::vector<std::string> args;
+  std::vector<std::string> keys;
+};
+std::vector<ToolRun> Runs(const TempDir& dir) {
+  const std::string mesh = (DataDir() / "tetra.off").string();
+  const std::string svm = (dir / "t.svm").string(), vfrag = (dir / "t.vfrag").string();
+  const std::string svo = (dir / "t.svo").string();
+  const std::vector<std::string> octree = {"levels", "sections", "pages", "output"};
+  auto with = [](std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  };
+  return {
+      {"svo-import", {mesh, "-o", svm}, {"source", "triangles", "bounds", "warnings"}},
+      {"svo-voxelize", {svm, "-r", "24", "-o", vfrag}, {"mesh", "grid", "voxels", "output"}},
+      {"svo-build",
+       {vfrag, "--mesh", mesh, "-o", svo},
+       with({"input", "octree", "warnings"}, octree)},
+      {"mesh2svo",
+       {mesh, "-r", "24", "-o", (dir / "m.svo").string()},
+       with({"mesh", "grid", "voxels", "time", "warnings"}, octree)},
+      {"mesh2svo",
+       {mesh, "-r", "200", "--pages", "0/2", "-o", (dir / "p0.svopart").string()},
+       {"part", "time", "output"}},
+      {"mesh2svo",
+       {mesh, "-r", "200", "--pages", "1/2", "-o", (dir / "p1.svopart").string()},
+       {"part", "output"}},
+      {"svo-merge",
+       {(dir / "p0.svopart").string(), (dir / "p1.svopart").string(), "-o",
+        (dir / "merged.svo").string()},
+       {"parts", "voxels", "sections", "pages", "time", "output"}},
+      {"svo-export", {svo, "-o", (dir / "t.glb").string()}, {"octree", "level", "output"}},
+      {"svo-bake",
+       {svo, "-o", (dir / "ao.svo").string()},
+       {"octree", "cones", "pages", "voxels", "output"}},
+      {"svo-inspect", {svo}, {"file", "grid", "octree", "voxels"}},
+      {"svo-validate", {svo, "--mesh", mesh}, {"file", "valid", "findings", "warnings"}},
+  };
+}
+
+TEST(ReportCli, EveryToolAnswersJsonAndQuietPrintsNothing) {
+  TempDir dir;
+  std::set<std::string> tools;
+  for (const ToolRun& run : Runs(dir)) {
+    tools.insert(run.tool);
+    std::vector<std::string> json = run.args, quiet = run.args;
+    json.push_back("--json");
+    quiet.push_back("-q");
+    const ToolResult q = RunTool(run.tool, quiet);
+    ASSERT_EQ(q.exit_code, 0) << run.tool << ": " << q.err;
+    EXPECT_EQ(q.out + q.err, "") << run.tool << " -q";
+    const ToolResult j = RunTool(run.tool, json);
+    ASSERT_EQ(j.exit_code, 0) << run.tool << ": " << j.err;
+    nlohmann::json report;
+    ASSERT_NO_THROW(report = nlohmann::json::parse(j.out)) << run.tool << " --json:\n" << j.out;
+    ASSERT_TRUE(report.is_object()) << run.tool;
+    for (const std::string& key : run.keys) {
+      EXPECT_TRUE(report.contains(key)) << run.tool << ": no \"" << key << "\" in\n" << j.out;
+    }
+  }
+  EXPECT_EQ(tools.size(), std::size(kTools));
 }
 
 }  // namespace

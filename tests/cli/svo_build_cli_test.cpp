@@ -30,13 +30,14 @@ TEST(SvoBuildCli, ChainEqualsMesh2svoByteForByte) {
   const std::string vfrag = (dir / "t.vfrag").string();
   RunOk("svo-voxelize", {Torus(), "-o", vfrag, "-r", "48", "-q"});
   const std::string chained = (dir / "chain.svo").string(), direct = (dir / "direct.svo").string();
-  ToolResult build = RunTool("svo-build", {vfrag, "-o", chained, "--mesh", Torus(), "-q"});
+  ToolResult build =
+      RunTool("svo-build", {vfrag, "-o", chained, "--mesh", Torus(), "-q", "--json"});
   ASSERT_EQ(build.exit_code, 0) << build.err;
   EXPECT_TRUE(build.err.empty()) << build.err;
   EXPECT_NE(build.out.find("chain.svo"), std::string::npos) << build.out;
-  ToolResult m2s = RunTool("mesh2svo", {Torus(), "-o", direct, "-r", "48", "-q"});
+  ToolResult m2s = RunTool("mesh2svo", {Torus(), "-o", direct, "-r", "48", "-q", "--json"});
   ASSERT_EQ(m2s.exit_code, 0) << m2s.err;
-  EXPECT_NE(m2s.out.find("2304 triangles"), std::string::npos) << m2s.out;
+  EXPECT_NE(m2s.out.find("\"triangles\": 2304"), std::string::npos) << m2s.out;
   const std::string a = ReadText(chained), b = ReadText(direct);
   ASSERT_FALSE(a.empty());
   auto sa = ReadSvo(chained), sb = ReadSvo(direct);
@@ -273,7 +274,7 @@ TEST(SvoBuildCli, PartsMergeIntoTheSameFile) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   std::vector<std::string> merge = parts;
-  merge.insert(merge.end(), {"-o", (dir / "merged.svo").string(), "-q"});
+  merge.insert(merge.end(), {"-o", (dir / "merged.svo").string(), "-q", "--json"});
   const ToolResult merged = RunTool("svo-merge", merge);
   ASSERT_EQ(merged.exit_code, 0) << merged.err;
   EXPECT_NE(merged.out.find("voxels"), std::string::npos) << merged.out;

@@ -44,7 +44,7 @@ TEST(SvoExportCli, EveryFormatFromTheChain) {
   TempDir out;
   for (const char* ext : {"vdb", "binvox", "vox", "ply", "xyz"}) {
     const std::filesystem::path path = out / (std::string("torus.") + ext);
-    const ToolResult r = RunTool("svo-export", {svo, "-o", path.string(), "-q"});
+    const ToolResult r = RunTool("svo-export", {svo, "-o", path.string(), "-q", "--json"});
     ASSERT_EQ(r.exit_code, 0) << ext << ": " << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
     EXPECT_NE(r.out.find(path.string()), std::string::npos) << r.out;

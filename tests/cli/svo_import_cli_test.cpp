@@ -59,7 +59,7 @@ TEST(SvoImportCli, MissingTextureIsAWarningNotAnError) {
   dir.Write("m.mtl", "newmtl skin\nKd 0.5 0.5 0.5\nmap_Kd skin.png\n");
   const auto in =
       dir.Write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n");
-  ToolResult r = RunTool("svo-import", {in.string(), "-o", (dir / "m.svm").string(), "-q"});
+  ToolResult r = RunTool("svo-import", {in.string(), "-o", (dir / "m.svm").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("texture skin.png MISSING, base colour used"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("warning            material 'skin': texture 'skin.png' not found"),

@@ -79,7 +79,8 @@ TEST(SvoVoxelizeCli, ThinIsASubsetAndXyzListsTheSameVoxels) {
                     {in, "-o", (dir / "t.vfrag").string(), "-r", "40", "--mode", "thin", "-q"})
                 .exit_code,
             0);
-  ToolResult r = RunTool("svo-voxelize", {in, "-o", (dir / "c.xyz").string(), "-r", "40", "-q"});
+  ToolResult r =
+      RunTool("svo-voxelize", {in, "-o", (dir / "c.xyz").string(), "-r", "40", "-q", "--json"});
   ASSERT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("voxels"), std::string::npos);
   const auto c = ReadVfrag(dir / "c.vfrag"), t = ReadVfrag(dir / "t.vfrag");

@@ -58,9 +58,9 @@ Picture ReadPng(const std::filesystem::path& path) {
 }
 
 TEST(SvoInspectCli, TextReport) {
-  const ToolResult r = RunTool("svo-inspect", {TorusSvo(), "--levels", "--histograms", "-q"});
+  const ToolResult r = RunTool("svo-inspect", {TorusSvo(), "--levels", "--histograms"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;  // progress lines alone
   for (const char* key : {"file ", "grid ", "bounds ", "octree ", "voxels ", "bricks ", "opacity ",
                           "colour (linear) ", "normals ", "contours ", "mean thickness ",
                           "source             uv-torus.obj", "generator ", "voxelize ", "build ",
@@ -169,7 +169,7 @@ TEST(SvoInspectCli, LevelReadsOnlyTheTopLevels) {
   const StatusOr<Svo> svo = ReadSvo(TorusSvo(), 3);
   ASSERT_TRUE(svo.ok());
   EXPECT_EQ(j["voxels"], svo->levels[3].node_count);
-  const ToolResult text = RunTool("svo-inspect", {TorusSvo(), "--level", "3", "-q"});
+  const ToolResult text = RunTool("svo-inspect", {TorusSvo(), "--level", "3"});
   EXPECT_NE(text.out.find("levels read        0..3 of 0..5"), std::string::npos) << text.out;
 }
 

@@ -37,9 +37,9 @@ const TempDir& Files() {
 
 TEST(SvoValidateCli, ValidFileExitsZeroWithTextAndJson) {
   const std::string svo = (Files() / "t.svo").string();
-  ToolResult r = RunTool("svo-validate", {svo, "--mesh", Torus(), "-q"});
+  ToolResult r = RunTool("svo-validate", {svo, "--mesh", Torus()});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;  // progress lines alone
   for (const char* line :
        {"structure       passed", "bricks          passed", "occupancy       passed",
         "contour_surface passed", "result          valid"}) {
