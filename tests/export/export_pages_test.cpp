@@ -84,6 +84,7 @@ void ExpectSameVdb(const std::filesystem::path& a, const std::filesystem::path& 
   fa.open();
   fb.open();
   ExpectSameGrid<openvdb::BoolGrid>(fa, fb, "occupancy");
+  ExpectSameGrid<openvdb::FloatGrid>(fa, fb, "density");
   if (attributes) {
     ExpectSameGrid<openvdb::Vec3fGrid>(fa, fb, "color");
     ExpectSameGrid<openvdb::Vec3fGrid>(fa, fb, "normal");
@@ -95,10 +96,14 @@ TEST_F(ExportPages, StreamedVdbIsOpenVdbsOwnFile) {
   StatusOr<Svo> whole = ReadSvo(test::PagedTorus().path);
   ASSERT_TRUE(whole.ok());
   for (const std::uint32_t level : {r.depth(), r.page_level(), r.page_level() - 1}) {
-    const VoxelSet voxels = LevelVoxels(*whole, level);
+    std::vector<float> density;
+    const VoxelSet voxels = LevelVoxels(*whole, level, &density);
     const std::filesystem::path expected = Out("grids.vdb");
     written_.push_back(expected);
-    ASSERT_TRUE(WriteWhole(OpenVdbGridWriter(HeaderOf(voxels), nullptr, expected), voxels).ok());
+    VoxelFileHeader header = HeaderOf(voxels);
+    header.density = true;
+    ASSERT_TRUE(
+        WriteWhole(OpenVdbGridWriter(header, nullptr, expected), voxels, {density, {}}).ok());
     const std::vector<std::uint8_t> want = test::ReadBytes(expected);
     for (const auto& [limit, threads] : {std::pair<std::uint64_t, std::size_t>{0, 2},
                                          {std::uint64_t{24} << 20, 1},
@@ -143,8 +148,18 @@ TEST_F(ExportPages, VdbOfSeveralTopNodesAndOfNothingIsOpenVdbsOwnFile) {
     const std::filesystem::path expected = Out("grids.vdb"), got = Out("streamed.vdb");
     written_.push_back(expected);
     written_.push_back(got);
-    ASSERT_TRUE(WriteWhole(OpenVdbGridWriter(HeaderOf(*voxels), nullptr, expected), *voxels).ok());
-    const Status s = WriteVoxelsVdb(*voxels, nullptr, got);
+    // Density and AO values that differ from voxel to voxel, as the float grids stream them.
+    std::vector<float> density;
+    std::vector<std::uint8_t> ao;
+    for (std::size_t i = 0; i < voxels->size(); ++i) {
+      density.push_back(static_cast<float>(i % 13) / 13.f);
+      ao.push_back(static_cast<std::uint8_t>(i * 7 % 256));
+    }
+    VoxelFileHeader header = HeaderOf(*voxels);
+    header.density = header.ao = true;
+    ASSERT_TRUE(
+        WriteWhole(OpenVdbGridWriter(header, nullptr, expected), *voxels, {density, ao}).ok());
+    const Status s = WriteWhole(OpenVdbWriter(header, nullptr, got), *voxels, {density, ao});
     ASSERT_TRUE(s.ok()) << s.message();
     EXPECT_TRUE(test::ReadBytes(got) == test::ReadBytes(expected)) << voxels->size() << " voxels";
     ExpectSameVdb(expected, got, voxels->has_colors());

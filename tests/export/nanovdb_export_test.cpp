@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
 #include <nanovdb/NanoVDB.h>
 #include <nanovdb/util/IO.h>
 
@@ -113,6 +116,50 @@ TEST_F(NanoVdbExport, EveryNodeIsAVoxelWithItsBrickValuesAndAo) {
       wrong += ok ? 0 : 1;
     }
     EXPECT_EQ(wrong, 0u) << "level " << level << " of " << keys.size() << " nodes";
+  }
+}
+
+TEST_F(NanoVdbExport, VdbHasTheSameDensityAndAoGrids) {
+  StatusOr<Svo> svo = ReadSvo(*baked_);
+  ASSERT_TRUE(svo.ok());
+  StatusOr<SvoReader> reader = SvoReader::Open(*baked_);
+  ASSERT_TRUE(reader.ok());
+  openvdb::initialize();
+  for (const std::uint32_t level : {svo->depth, svo->depth - 1, reader->page_level()}) {
+    const std::filesystem::path out = Written("level.vdb");
+    // Pages come in the .vdb's node order, not key order: AO by each page's first node.
+    const Status s = ExportSvoPages(*reader, out, {level}, 0);
+    ASSERT_TRUE(s.ok()) << s.message();
+    openvdb::io::File file(out.string());
+    file.open();
+    const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("density"));
+    const auto ao = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("ao"));
+    ASSERT_TRUE(density && ao);
+    EXPECT_EQ(density->getGridClass(), openvdb::GRID_FOG_VOLUME);
+    const SvoLevel& lv = svo->levels[level];
+    const std::vector<std::uint64_t> keys = svo->LevelKeys(level);
+    EXPECT_EQ(density->activeVoxelCount(), keys.size());
+    EXPECT_EQ(ao->activeVoxelCount(), keys.size());
+    auto d = density->getConstAccessor();
+    auto a = ao->getConstAccessor();
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const MortonCoord m = MortonDecode(keys[i]);
+      const openvdb::Coord ijk(static_cast<int>(m.x), static_cast<int>(m.y), static_cast<int>(m.z));
+      wrong += d.getValue(ijk) == DecodeUnorm8(lv.opacity[i * 27 + 13]) &&
+                       a.getValue(ijk) == static_cast<float>(lv.ao[i]) / 255.f
+                   ? 0
+                   : 1;
+    }
+    EXPECT_EQ(wrong, 0u) << "level " << level << " of " << keys.size() << " nodes";
+    // OpenVDB's own tool lists the grids (Debian's libopenvdb-tools).
+    const std::filesystem::path listing = Written("vdb_print.txt");
+    ASSERT_EQ(std::system(("vdb_print " + out.string() + " > " + listing.string()).c_str()), 0);
+    const std::vector<std::uint8_t> bytes = test::ReadBytes(listing);
+    const std::string text(bytes.begin(), bytes.end());
+    for (const char* grid : {"occupancy", "density", "ao", "color", "normal"}) {
+      EXPECT_NE(text.find(std::string(grid) + " "), std::string::npos) << grid << " in\n" << text;
+    }
   }
 }
 

@@ -199,8 +199,7 @@ TEST_F(VoxelMesh, PagesGiveTheWholeOctreesFiles) {
   }
   const Status small = ExportSvoPages(*reader, Out("small.glb"), {}, std::uint64_t{1} << 10);
   EXPECT_EQ(small.code(), StatusCode::kBadInput);
-  EXPECT_NE(small.message().find("a voxel mesh's"), std::string::npos)
-      << small.message();
+  EXPECT_NE(small.message().find("a voxel mesh's"), std::string::npos) << small.message();
 }
 
 }  // namespace

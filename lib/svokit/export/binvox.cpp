@@ -40,7 +40,7 @@ class BinvoxWriter : public VoxelFileWriter {
   }
   const Status& status() const { return out_.status(); }
 
-  Status Add(const VoxelSet& part, std::uint64_t x_done) override {
+  Status Add(const VoxelSet& part, const VoxelValues&, std::uint64_t x_done) override {
     for (const std::uint64_t key : part.keys) {
       const MortonCoord c = MortonDecode(key);
       runs_.push_back({Index(c.x, c.y, c.z), 1});

@@ -193,12 +193,20 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
   }
+  const bool grids = *ext == "vdb" || *ext == "nvdb";
   std::vector<float> density;
-  VoxelSet voxels = LevelVoxels(svo, level, *ext == "nvdb" ? &density : nullptr);
+  VoxelSet voxels = LevelVoxels(svo, level, grids ? &density : nullptr);
   const InteriorCubes interior = LevelInterior(svo, level);
   const InteriorCubes* solid = svo.solid ? &interior : nullptr;
+  std::vector<std::uint8_t> ao =
+      grids && svo.has_ao ? svo.levels[level].ao : std::vector<std::uint8_t>{};
+  if (*ext == "vdb") {
+    VoxelFileHeader header = HeaderOf(voxels);
+    header.density = true;
+    header.ao = svo.has_ao;
+    return WriteWhole(OpenVdbWriter(header, solid, path), voxels, {density, ao});
+  }
   if (*ext == "nvdb") {
-    std::vector<std::uint8_t> ao = svo.has_ao ? svo.levels[level].ao : std::vector<std::uint8_t>{};
     if (solid != nullptr) {
       // Interior voxels are dense and, seen from outside, fully occluded.
       StatusOr<VoxelSet> all = WithInteriorVoxels(voxels, interior, path);
@@ -214,11 +222,10 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
       density = std::move(all_density);
       ao = std::move(all_ao);
     }
-    StatusOr<std::unique_ptr<NanoVdbWriter>> writer =
-        OpenNanoVdbWriter(HeaderOf(voxels), !ao.empty(), path);
-    if (!writer.ok()) return writer.status();
-    SVOKIT_RETURN_IF_ERROR((*writer)->Add(voxels, density, ao));
-    return (*writer)->Finish();
+    VoxelFileHeader header = HeaderOf(voxels);
+    header.density = true;
+    header.ao = !ao.empty();
+    return WriteWhole(OpenNanoVdbWriter(header, path), voxels, {density, ao});
   }
   if (*ext == "obj" || *ext == "glb") {
     // A solid's interior voxels are meshed with the surface's, so only its outside has faces.
@@ -229,7 +236,6 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
     }
     return WriteVoxelMesh(voxels, options.merge_faces, path).status();
   }
-  if (*ext == "vdb") return WriteVoxelsVdb(voxels, solid, path);
   if (*ext == "binvox") return WriteVoxelsBinvox(voxels, solid, path);
   if (*ext == "vox") {
     if (solid == nullptr) return WriteVoxelsVox(voxels, path);
@@ -276,43 +282,35 @@ Status CheckHeld(const std::filesystem::path& path, const std::string& what, std
       path.string(), what, mib, memory_limit >> 20, mib);
 }
 
-// A .nvdb of a file read page by page: the grids are built whole (NanoVdbWriter), so what they
-// need is checked against the limit before a page is read.
-Status ExportNanoVdbPages(const SvoReader& reader, const VoxelFileHeader& header,
-                          const std::filesystem::path& path, std::uint32_t level,
-                          std::uint64_t memory_limit, Progress::Stage* stage) {
+// A .nvdb's grids are built whole (OpenNanoVdbWriter): what they need, from HEAD alone, against
+// the limit before a page is read.
+Status CheckNanoVdbFits(const SvoReader& reader, const VoxelFileHeader& header,
+                        const std::filesystem::path& path, std::uint32_t level,
+                        std::uint64_t memory_limit) {
   auto nodes_above = [&](std::uint32_t up) {
     return level < up ? 1 : reader.NodeCount(level - up);
   };
-  const bool ao = reader.has_ao();
   const std::uint64_t needs =
-      NanoVdbBytes({nodes_above(3), nodes_above(7), nodes_above(12)}, header.colors, ao) +
-      (ao ? reader.NodeCount(level) : 0);
-  SVOKIT_RETURN_IF_ERROR(CheckHeld(
-      path, fmt::format("a .nvdb is built whole: level {}'s grids", level), needs, memory_limit));
-  StatusOr<std::vector<std::uint8_t>> level_ao = reader.LevelAo(level);
-  if (!level_ao.ok()) return level_ao.status();
-  StatusOr<std::unique_ptr<NanoVdbWriter>> writer = OpenNanoVdbWriter(header, ao, path);
-  if (!writer.ok()) return writer.status();
-  std::uint64_t first = 0;  // the page's first node in the level (pages come in key order)
-  const std::uint32_t side = reader.shape().brick_side;
-  SVOKIT_RETURN_IF_ERROR(ForEachLevelPage(
-      reader, level, side != 0, SvoStreamOptions{.memory_limit = memory_limit},
-      [&](std::size_t, SvoChunkLevel& nodes) {
-        VoxelSet part;
-        part.grid = header.grid;
-        part.mode = reader.mode();
-        part.keys.assign(nodes.keys.begin(), nodes.keys.end());
-        std::vector<float> density;
-        FillNodeAttributes(nodes.bricks, side, header.colors, false, part, &density);
-        const std::span<const std::uint8_t> ao_part =
-            ao ? std::span<const std::uint8_t>(*level_ao).subspan(first, part.size())
-               : std::span<const std::uint8_t>{};
-        first += part.size();
-        return (*writer)->Add(part, density, ao_part);
-      },
-      stage));
-  return (*writer)->Finish();
+      NanoVdbBytes({nodes_above(3), nodes_above(7), nodes_above(12)}, header.colors, header.ao) +
+      (header.ao ? reader.NodeCount(level) : 0);
+  return CheckHeld(path, fmt::format("a .nvdb is built whole: level {}'s grids", level), needs,
+                   memory_limit);
+}
+
+// Per page (in key order), the index of its first node of `level` in the level (the last entry:
+// the level's count): from the page table at the voxel level, else from the pages' masks.
+StatusOr<std::vector<std::uint64_t>> PageFirstNodes(const SvoReader& reader, std::uint32_t level) {
+  std::vector<std::uint64_t> first(reader.page_count() + 1, 0);
+  for (std::size_t i = 0; i < reader.page_count(); ++i) {
+    std::uint64_t nodes = reader.page(i).voxels;
+    if (level < reader.depth()) {
+      StatusOr<SvoChunk> page = reader.Page(i, ChunkParts::kCounts);
+      if (!page.ok()) return page.status();
+      nodes = page->tree.NodeCount(level);
+    }
+    first[i + 1] = first[i] + nodes;
+  }
+  return first;
 }
 
 // A voxel mesh of a file read page by page: the level's nodes (key and colour, 16 bytes each) are
@@ -363,15 +361,34 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   }
   const bool colors = shape.brick_side != 0 && shape.has_color;
   const bool normals = shape.brick_side != 0 && shape.has_normal;
-  const VoxelFileHeader header{LevelGrid(reader.grid(), reader.depth(), level), colors, normals,
-                               reader.NodeCount(level)};
-  if (*ext == "nvdb") return ExportNanoVdbPages(reader, header, path, level, memory_limit, stage);
+  VoxelFileHeader header{LevelGrid(reader.grid(), reader.depth(), level), colors, normals,
+                         reader.NodeCount(level)};
+  header.density = *ext == "vdb" || *ext == "nvdb";
+  header.ao = header.density && reader.has_ao();
+  if (*ext == "nvdb") {
+    SVOKIT_RETURN_IF_ERROR(CheckNanoVdbFits(reader, header, path, level, memory_limit));
+  }
   if (*ext == "obj" || *ext == "glb") {
     return ExportVoxelMeshPages(reader, header, path, level, options.merge_faces, memory_limit,
                                 stage);
   }
+  // AO by node index in the level, each page's nodes from its first on (pages may come in any
+  // order, a .vdb's).
+  std::vector<std::uint8_t> level_ao;
+  std::vector<std::uint64_t> first_node;
+  if (header.ao) {
+    StatusOr<std::vector<std::uint8_t>> ao = reader.LevelAo(level);
+    if (!ao.ok()) return ao.status();
+    level_ao = std::move(*ao);
+    if (level >= reader.page_level()) {
+      StatusOr<std::vector<std::uint64_t>> first = PageFirstNodes(reader, level);
+      if (!first.ok()) return first.status();
+      first_node = std::move(*first);
+    }
+  }
   StatusOr<std::unique_ptr<VoxelFileWriter>> writer =
       *ext == "vdb"      ? OpenVdbWriter(header, nullptr, path)
+      : *ext == "nvdb"   ? OpenNanoVdbWriter(header, path)
       : *ext == "binvox" ? OpenBinvoxWriter(header, nullptr, path)
       : *ext == "ply"    ? OpenPlyWriter(header, path)
                          : OpenXyzWriter(header, path);
@@ -395,14 +412,22 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
     }
   }
   SVOKIT_RETURN_IF_ERROR(ForEachLevelPage(
-      reader, level, shape.brick_side != 0 && (colors || normals), stream,
+      reader, level, shape.brick_side != 0 && (colors || normals || header.density), stream,
       [&](std::size_t page, SvoChunkLevel& nodes) {
         VoxelSet part;
         part.grid = header.grid;
         part.mode = reader.mode();
         part.keys.assign(nodes.keys.begin(), nodes.keys.end());
-        FillNodeAttributes(nodes.bricks, shape.brick_side, colors, normals, part);
-        return (*writer)->Add(part, page < x_done.size() ? x_done[page] : ~std::uint64_t{0});
+        std::vector<float> density;
+        FillNodeAttributes(nodes.bricks, shape.brick_side, colors, normals, part,
+                           header.density ? &density : nullptr);
+        VoxelValues values{density, {}};
+        if (header.ao) {
+          const std::uint64_t first = page < first_node.size() ? first_node[page] : 0;
+          values.ao = std::span<const std::uint8_t>(level_ao).subspan(first, part.size());
+        }
+        return (*writer)->Add(part, values,
+                              page < x_done.size() ? x_done[page] : ~std::uint64_t{0});
       },
       stage));
   return (*writer)->Finish();

@@ -26,10 +26,10 @@ std::uint64_t GridBufferBytes(const std::array<std::uint64_t, 3>& nodes) {
          nodes[1] * sizeof(nanovdb::NanoLower<T>) + nodes[0] * sizeof(nanovdb::NanoLeaf<T>);
 }
 
-class NanoVdbWriterImpl final : public NanoVdbWriter {
+class NanoVdbWriter final : public VoxelFileWriter {
  public:
-  NanoVdbWriterImpl(const VoxelFileHeader& header, bool ao, const std::filesystem::path& path)
-      : header_(header), out_(path), has_ao_(ao) {
+  NanoVdbWriter(const VoxelFileHeader& header, const std::filesystem::path& path)
+      : header_(header), out_(path), has_ao_(header.ao) {
     density_.emplace(0.f, nanovdb::GridClass::FogVolume);
     color_.emplace(nanovdb::Vec3f(0.f));
     ao_.emplace(0.f);
@@ -37,8 +37,7 @@ class NanoVdbWriterImpl final : public NanoVdbWriter {
 
   Status Open() { return out_.Open(); }
 
-  Status Add(const VoxelSet& part, std::span<const float> density,
-             std::span<const std::uint8_t> ao) override {
+  Status Add(const VoxelSet& part, const VoxelValues& values, std::uint64_t) override {
     auto density_at = density_->getAccessor();
     auto color_at = color_->getAccessor();
     auto ao_at = ao_->getAccessor();
@@ -46,12 +45,13 @@ class NanoVdbWriterImpl final : public NanoVdbWriter {
       const MortonCoord c = MortonDecode(part.keys[i]);
       const nanovdb::Coord ijk(static_cast<std::int32_t>(c.x), static_cast<std::int32_t>(c.y),
                                static_cast<std::int32_t>(c.z));
-      density_at.setValue(ijk, density[i]);  // active whatever its value, as every node is
+      // Active whatever its value, as every node is.
+      density_at.setValue(ijk, header_.density ? values.density[i] : 1.f);
       if (header_.colors) {
         const Rgba rgba = part.color(i);
         color_at.setValue(ijk, nanovdb::Vec3f(rgba.r, rgba.g, rgba.b));
       }
-      if (has_ao_) ao_at.setValue(ijk, static_cast<float>(ao[i]) / 255.f);
+      if (has_ao_) ao_at.setValue(ijk, static_cast<float>(values.ao[i]) / 255.f);
     }
     return Status::Ok();
   }
@@ -103,11 +103,11 @@ std::uint64_t NanoVdbBytes(const std::array<std::uint64_t, 3>& nodes, bool color
   return (builders + std::max(scalar, vector)) / 8 * 9;
 }
 
-StatusOr<std::unique_ptr<NanoVdbWriter>> OpenNanoVdbWriter(const VoxelFileHeader& header, bool ao,
-                                                           const std::filesystem::path& path) {
-  auto writer = std::make_unique<NanoVdbWriterImpl>(header, ao, path);
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenNanoVdbWriter(const VoxelFileHeader& header,
+                                                             const std::filesystem::path& path) {
+  auto writer = std::make_unique<NanoVdbWriter>(header, path);
   SVOKIT_RETURN_IF_ERROR(writer->Open());
-  return std::unique_ptr<NanoVdbWriter>(std::move(writer));
+  return std::unique_ptr<VoxelFileWriter>(std::move(writer));
 }
 
 }  // namespace svokit

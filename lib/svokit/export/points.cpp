@@ -22,7 +22,7 @@ class XyzWriter : public VoxelFileWriter {
                          header.grid.voxel_size(), d[0], d[1], d[2]));
   }
   const Status& status() const { return out_.status(); }
-  Status Add(const VoxelSet& part, std::uint64_t) override {
+  Status Add(const VoxelSet& part, const VoxelValues&, std::uint64_t) override {
     std::string text;
     text.reserve(part.keys.size() * 16);
     for (const std::uint64_t key : part.keys) {
@@ -53,7 +53,7 @@ class PlyWriter : public VoxelFileWriter {
     out_.Put(text);
   }
   const Status& status() const { return out_.status(); }
-  Status Add(const VoxelSet& part, std::uint64_t) override {
+  Status Add(const VoxelSet& part, const VoxelValues&, std::uint64_t) override {
     const auto to_byte = [](float linear) {
       return static_cast<std::uint8_t>(
           std::lround(255.f * LinearToSrgb(std::clamp(linear, 0.f, 1.f))));
@@ -114,9 +114,10 @@ VoxelFileHeader HeaderOf(const VoxelSet& set) {
   return {set.grid, set.has_colors(), set.has_normals(), set.size()};
 }
 
-Status WriteWhole(StatusOr<std::unique_ptr<VoxelFileWriter>> writer, const VoxelSet& set) {
+Status WriteWhole(StatusOr<std::unique_ptr<VoxelFileWriter>> writer, const VoxelSet& set,
+                  const VoxelValues& values) {
   if (!writer.ok()) return writer.status();
-  SVOKIT_RETURN_IF_ERROR((*writer)->Add(set, ~std::uint64_t{0}));
+  SVOKIT_RETURN_IF_ERROR((*writer)->Add(set, values, ~std::uint64_t{0}));
   return (*writer)->Finish();
 }
 

@@ -54,14 +54,20 @@ class VdbArchive : public openvdb::io::Archive {
   }
 };
 
-// The three grids' names, metadata and transform, their trees empty.
+// The grids' names, metadata and transform, their trees empty.
 struct VdbGrids {
   openvdb::BoolGrid::Ptr occupancy = openvdb::BoolGrid::create(false);
+  openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.f);
+  openvdb::FloatGrid::Ptr ao = openvdb::FloatGrid::create(0.f);
   openvdb::Vec3fGrid::Ptr color = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
   openvdb::Vec3fGrid::Ptr normal = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
 
   explicit VdbGrids(const GridTransform& grid) {
     occupancy->setName("occupancy");
+    // What Blender's, Houdini's and OpenVDB renderers' volume shaders read.
+    density->setName("density");
+    density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    ao->setName("ao");
     color->setName("color");
     color->setVectorType(openvdb::VEC_INVARIANT);
     color->insertMeta("color_space", openvdb::StringMetadata("linear sRGB"));
@@ -74,7 +80,7 @@ struct VdbGrids {
     transform->postTranslate(openvdb::Vec3d(o.x + 0.5 * h, o.y + 0.5 * h, o.z + 0.5 * h));
     for (const openvdb::GridBase::Ptr& g : All()) g->setTransform(transform);
   }
-  openvdb::GridPtrVec All() const { return {occupancy, color, normal}; }
+  openvdb::GridPtrVec All() const { return {occupancy, density, ao, color, normal}; }
 };
 
 openvdb::MetaMap FileMeta() {
@@ -121,12 +127,14 @@ class VdbGridWriter : public VoxelFileWriter {
                 const std::filesystem::path& path)
       : header_(header), interior_(interior), path_(path) {}
 
-  Status Add(const VoxelSet& part, std::uint64_t) override {
+  Status Add(const VoxelSet& part, const VoxelValues& values, std::uint64_t) override {
     for (std::size_t i = 0; i < part.size(); ++i) {
       const MortonCoord c = MortonDecode(part.keys[i]);
       const openvdb::Coord ijk(static_cast<openvdb::Int32>(c.x), static_cast<openvdb::Int32>(c.y),
                                static_cast<openvdb::Int32>(c.z));
       occupied_.setValueOn(ijk, true);
+      if (header_.density) dense_.setValueOn(ijk, values.density[i]);
+      if (header_.ao) occluded_.setValueOn(ijk, static_cast<float>(values.ao[i]) / 255.f);
       if (header_.colors) {
         const Rgba rgba = part.color(i);
         colored_.setValueOn(ijk, openvdb::Vec3f(rgba.r, rgba.g, rgba.b));
@@ -149,11 +157,16 @@ class VdbGridWriter : public VoxelFileWriter {
                                   static_cast<openvdb::Int32>(c.y) * side,
                                   static_cast<openvdb::Int32>(c.z) * side);
           // sparseFill makes a tile of every whole, aligned node: a cube costs its surface's nodes.
-          occupancy_->tree().sparseFill(openvdb::CoordBBox(lo, lo.offsetBy(side - 1)), true, true);
+          const openvdb::CoordBBox box(lo, lo.offsetBy(side - 1));
+          occupancy_->tree().sparseFill(box, true, true);
+          if (header_.density) density_->tree().sparseFill(box, 1.f, true);
+          if (header_.ao) ao_->tree().sparseFill(box, 1.f, true);
         }
       }
     }
     openvdb::GridPtrVec grids{occupancy_};
+    if (header_.density) grids.push_back(density_);
+    if (header_.ao) grids.push_back(ao_);
     if (header_.colors) grids.push_back(color_);
     if (header_.normals) grids.push_back(normal_);
 
@@ -179,9 +192,13 @@ class VdbGridWriter : public VoxelFileWriter {
   std::filesystem::path path_;
   VdbGrids grids_{header_.grid};
   openvdb::BoolGrid::Ptr occupancy_ = grids_.occupancy;
+  openvdb::FloatGrid::Ptr density_ = grids_.density;
+  openvdb::FloatGrid::Ptr ao_ = grids_.ao;
   openvdb::Vec3fGrid::Ptr color_ = grids_.color;
   openvdb::Vec3fGrid::Ptr normal_ = grids_.normal;
   openvdb::BoolGrid::Accessor occupied_ = occupancy_->getAccessor();
+  openvdb::FloatGrid::Accessor dense_ = density_->getAccessor();
+  openvdb::FloatGrid::Accessor occluded_ = ao_->getAccessor();
   openvdb::Vec3fGrid::Accessor colored_ = color_->getAccessor();
   openvdb::Vec3fGrid::Accessor oriented_ = normal_->getAccessor();
 };
@@ -356,7 +373,7 @@ class StreamedGrid {
     meta->insertMeta(openvdb::GridBase::META_FILE_COMPRESSION,
                      openvdb::StringMetadata(
                          openvdb::io::compressionToString(openvdb::io::getDataCompression(frame))));
-    if (!leaf_masks_.empty()) {
+    if constexpr (kDelayedLoad) {  // an empty numeric grid gets it too, with no leaves
       openvdb::io::DelayedLoadMetadata delayed;
       delayed.resizeMask(leaf_masks_.size());
       for (std::size_t i = 0; i < leaf_masks_.size(); ++i) delayed.setMask(i, leaf_masks_[i]);
@@ -441,12 +458,14 @@ class VdbStreamWriter : public VoxelFileWriter {
   Status Open() {
     SVOKIT_RETURN_IF_ERROR(out_.Open());
     SVOKIT_RETURN_IF_ERROR(occupancy_.Open(out_));
+    if (header_.density) SVOKIT_RETURN_IF_ERROR(density_.Open(out_));
+    if (header_.ao) SVOKIT_RETURN_IF_ERROR(ao_.Open(out_));
     if (header_.colors) SVOKIT_RETURN_IF_ERROR(color_.Open(out_));
     if (header_.normals) SVOKIT_RETURN_IF_ERROR(normal_.Open(out_));
     return Status::Ok();
   }
 
-  Status Add(const VoxelSet& part, std::uint64_t) override {
+  Status Add(const VoxelSet& part, const VoxelValues& values, std::uint64_t) override {
     // Runs of voxels in one 128³ node (consecutive in Morton order), in the file's order.
     std::vector<std::pair<std::size_t, std::size_t>> runs;
     for (std::size_t i = 0; i < part.size(); ++i) {
@@ -464,6 +483,8 @@ class VdbStreamWriter : public VoxelFileWriter {
                                  static_cast<openvdb::Int32>(c.z));
         bbox_.expand(ijk);
         occupancy_.Set(ijk, true);
+        if (header_.density) density_.Set(ijk, values.density[i]);
+        if (header_.ao) ao_.Set(ijk, static_cast<float>(values.ao[i]) / 255.f);
         if (header_.colors) {
           const Rgba rgba = part.color(i);
           color_.Set(ijk, openvdb::Vec3f(rgba.r, rgba.g, rgba.b));
@@ -482,12 +503,15 @@ class VdbStreamWriter : public VoxelFileWriter {
     SVOKIT_RETURN_IF_ERROR(CloseNode4());
     const VdbArchive archive;
     std::ostringstream head;
-    const std::int32_t count = 1 + int{header_.colors} + int{header_.normals};
+    const std::int32_t count =
+        1 + int{header_.density} + int{header_.ao} + int{header_.colors} + int{header_.normals};
     archive.WriteHead(head, FileMeta(), count);
     const std::string_view bytes = head.view();
     SVOKIT_RETURN_IF_ERROR(out_.Write(bytes.data(), bytes.size()));
     try {
       SVOKIT_RETURN_IF_ERROR(WriteGrid(archive, occupancy_));
+      if (header_.density) SVOKIT_RETURN_IF_ERROR(WriteGrid(archive, density_));
+      if (header_.ao) SVOKIT_RETURN_IF_ERROR(WriteGrid(archive, ao_));
       if (header_.colors) SVOKIT_RETURN_IF_ERROR(WriteGrid(archive, color_));
       if (header_.normals) SVOKIT_RETURN_IF_ERROR(WriteGrid(archive, normal_));
     } catch (const openvdb::Exception& e) {
@@ -524,11 +548,15 @@ class VdbStreamWriter : public VoxelFileWriter {
       node5_origins_.push_back(origin5);
       node5_children_.emplace_back();
       occupancy_.BeginNode5();
+      if (header_.density) density_.BeginNode5();
+      if (header_.ao) ao_.BeginNode5();
       if (header_.colors) color_.BeginNode5();
       if (header_.normals) normal_.BeginNode5();
     }
     node5_children_.back().setOn(Node5::coordToOffset(origin));
     occupancy_.BeginNode4(origin);
+    if (header_.density) density_.BeginNode4(origin);
+    if (header_.ao) ao_.BeginNode4(origin);
     if (header_.colors) color_.BeginNode4(origin);
     if (header_.normals) normal_.BeginNode4(origin);
     rank_ = rank;
@@ -541,6 +569,8 @@ class VdbStreamWriter : public VoxelFileWriter {
     if (!open_) return Status::Ok();
     open_ = false;
     SVOKIT_RETURN_IF_ERROR(occupancy_.EndNode4(out_));
+    if (header_.density) SVOKIT_RETURN_IF_ERROR(density_.EndNode4(out_));
+    if (header_.ao) SVOKIT_RETURN_IF_ERROR(ao_.EndNode4(out_));
     if (header_.colors) SVOKIT_RETURN_IF_ERROR(color_.EndNode4(out_));
     if (header_.normals) SVOKIT_RETURN_IF_ERROR(normal_.EndNode4(out_));
     return Status::Ok();
@@ -556,6 +586,8 @@ class VdbStreamWriter : public VoxelFileWriter {
   VdbGrids grids_{header_.grid};
   std::uint32_t compression_ = VdbArchive().compression();
   StreamedGrid<openvdb::BoolGrid> occupancy_{grids_.occupancy, compression_};
+  StreamedGrid<openvdb::FloatGrid> density_{grids_.density, compression_};
+  StreamedGrid<openvdb::FloatGrid> ao_{grids_.ao, compression_};
   StreamedGrid<openvdb::Vec3fGrid> color_{grids_.color, compression_};
   StreamedGrid<openvdb::Vec3fGrid> normal_{grids_.normal, compression_};
   std::vector<openvdb::Coord> node5_origins_;

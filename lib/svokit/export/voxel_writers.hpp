@@ -22,6 +22,15 @@ struct VoxelFileHeader {
   GridTransform grid;
   bool colors = false, normals = false;
   std::uint64_t count = 0;
+  bool density = false, ao = false;  ///< VoxelValues come with the parts
+};
+
+/// Per voxel of a part, what the grid formats (.vdb, .nvdb) store besides occupancy, colour and
+/// normal: its density (the brick opacity at its centre; when the header has density) and its
+/// baked AO byte (when the header has AO).
+struct VoxelValues {
+  std::span<const float> density;
+  std::span<const std::uint8_t> ao;
 };
 
 /// One of these formats written from voxels given a part at a time (a page's), all on the header's
@@ -32,12 +41,13 @@ class VoxelFileWriter {
   virtual ~VoxelFileWriter() = default;
   /// `x_done`: every voxel with x < x_done has been given once this part is (binvox, whose order
   /// runs along x, writes them out then and holds only the rest).
-  virtual Status Add(const VoxelSet& part, std::uint64_t x_done) = 0;
+  virtual Status Add(const VoxelSet& part, const VoxelValues& values, std::uint64_t x_done) = 0;
   virtual Status Finish() = 0;
 };
 /// The header of a whole set, and the set written as the one part of `writer`'s file.
 VoxelFileHeader HeaderOf(const VoxelSet& set);
-Status WriteWhole(StatusOr<std::unique_ptr<VoxelFileWriter>> writer, const VoxelSet& set);
+Status WriteWhole(StatusOr<std::unique_ptr<VoxelFileWriter>> writer, const VoxelSet& set,
+                  const VoxelValues& values = {});
 
 StatusOr<std::unique_ptr<VoxelFileWriter>> OpenPlyWriter(const VoxelFileHeader& header,
                                                          const std::filesystem::path& path);
@@ -60,19 +70,11 @@ StatusOr<std::unique_ptr<VoxelFileWriter>> OpenVdbGridWriter(const VoxelFileHead
                                                              const std::filesystem::path& path);
 
 /// NanoVDB (.nvdb), built whole by NanoVDB's GridBuilder from the parts given, each grid written
-/// as a segment of its own: float "density" (a fog volume: each voxel's brick opacity at its
-/// centre), Vec3f "color" (linear RGB) when the header has colours, float "ao" (0 to 1) when
-/// baked; every voxel given is active in each. Transform as WriteVoxelsVdb's.
-class NanoVdbWriter {
- public:
-  virtual ~NanoVdbWriter() = default;
-  /// `density` and (with AO) `ao` hold a value per voxel of `part`.
-  virtual Status Add(const VoxelSet& part, std::span<const float> density,
-                     std::span<const std::uint8_t> ao) = 0;
-  virtual Status Finish() = 0;
-};
-StatusOr<std::unique_ptr<NanoVdbWriter>> OpenNanoVdbWriter(const VoxelFileHeader& header, bool ao,
-                                                           const std::filesystem::path& path);
+/// as a segment of its own: float "density" (a fog volume; 1 where the header has no density),
+/// Vec3f "color" (linear RGB) when the header has colours, float "ao" (0 to 1) when it has AO;
+/// every voxel given is active in each. Transform as WriteVoxelsVdb's.
+StatusOr<std::unique_ptr<VoxelFileWriter>> OpenNanoVdbWriter(const VoxelFileHeader& header,
+                                                             const std::filesystem::path& path);
 /// What NanoVdbWriter holds at most for a level with `nodes` = its node counts 3, 7 and 12 levels
 /// up (its 8³ leaves, 128³ and 4096³ internal nodes).
 std::uint64_t NanoVdbBytes(const std::array<std::uint64_t, 3>& nodes, bool colors, bool ao);
@@ -100,10 +102,11 @@ Status WriteVoxelsBinvox(const VoxelSet& voxels, const InteriorCubes* interior,
 /// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
 /// scene graph at its grid position; colours median-cut into at most 255 palette entries.
 Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
-/// OpenVDB: BoolGrid "occupancy", Vec3f grids "color" (linear RGB) and "normal" when present, all
-/// sharing a transform whose voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp).
-/// A solid's `interior` cubes are active in the occupancy grid, as tiles where they are whole
-/// nodes of the tree (8³ voxels and up); colour and normal grids leave them inactive.
+/// OpenVDB: BoolGrid "occupancy", float "density" (a fog volume) and "ao" when the header has
+/// them, Vec3f grids "color" (linear RGB) and "normal" when present, all sharing a transform whose
+/// voxel (i, j, k) centre is origin + (i + ½)·h (export_vdb.cpp). A solid's `interior` cubes are
+/// active in the occupancy, density (1) and AO (1) grids, as tiles where they are whole nodes of
+/// the tree (8³ voxels and up); colour and normal grids leave them inactive.
 Status WriteVoxelsVdb(const VoxelSet& voxels, const InteriorCubes* interior,
                       const std::filesystem::path& path);
 
