@@ -370,9 +370,9 @@ TEST(Export, VoxExactPaletteForFewColours) {
   const VoxelSet in = HandVoxels();
   const Svo svo = Build(in);
   ASSERT_TRUE(Export(svo, dir / "hand.vox").ok());
-  const VoxFile vox = ReadVox(dir / "hand.vox");
+  const VoxFile vox = InSvokitFrame(ReadVox(dir / "hand.vox"), in.grid.dims());
   ASSERT_EQ(vox.sizes.size(), 1u);
-  EXPECT_EQ(vox.sizes[0], (std::array<std::int32_t, 3>{5, 3, 4}));
+  EXPECT_EQ(vox.sizes[0], (std::array<std::int32_t, 3>{5, 4, 3}));  // z-up: y and z swap
   ASSERT_EQ(vox.voxels.size(), in.size());
   for (std::size_t i = 0; i < in.size(); ++i) {
     const auto it = vox.voxels.find(CoordOf(in.keys[i]));
@@ -381,6 +381,22 @@ TEST(Export, VoxExactPaletteForFewColours) {
     EXPECT_EQ(vox.palette[it->second] >> 24, 255u);
   }
   EXPECT_EQ(vox.UsedIndices().size(), 5u);
+}
+
+TEST(Export, VoxIsZUpAsMagicaVoxelIs) {
+  // An L on the floor with a tower at its corner: +y (svokit's up) must become the .vox's +z, and
+  // +z (towards the viewer) its −y, so the model stands as it does in a y-up viewer.
+  TempDir dir;
+  const std::vector<Coord> coords = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 0, 1}};
+  std::vector<HandVoxel> voxels;
+  for (const Coord& c : coords) voxels.push_back({c, Srgb(200, 10, 10), {0, 1, 0}});
+  const VoxelSet in = MakeVoxels(GridTransform({0, 0, 0}, 1.0, {2, 3, 2}), voxels);
+  ASSERT_TRUE(Export(Build(in, 0), dir / "l.vox").ok());
+  const VoxFile vox = ReadVox(dir / "l.vox");  // in the .vox's own frame
+  std::set<Coord> got;
+  for (const auto& [c, index] : vox.voxels) got.insert(c);
+  EXPECT_EQ(got, (std::set<Coord>{{0, 1, 0}, {1, 1, 0}, {0, 1, 1}, {0, 1, 2}, {0, 0, 0}}));
+  EXPECT_EQ(vox.sizes[0], (std::array<std::int32_t, 3>{2, 2, 3}));
 }
 
 TEST(Export, VoxSplitsGridsLargerThan256IntoPlacedModels) {
@@ -394,7 +410,7 @@ TEST(Export, VoxSplitsGridsLargerThan256IntoPlacedModels) {
   const VoxelSet in = MakeVoxels(GridTransform({0, 0, 0}, 1.0, {600, 20, 300}), voxels);
   const Svo svo = Build(in, 0);  // no bricks: occupancy only, every voxel gets the one colour
   ASSERT_TRUE(Export(svo, dir / "big.vox").ok());
-  const VoxFile vox = ReadVox(dir / "big.vox");
+  const VoxFile vox = InSvokitFrame(ReadVox(dir / "big.vox"), in.grid.dims());
   // Tiles (x/256, z/256): (0,0), (1,0), (2,0), (0,1), (1,1), (2,1).
   ASSERT_EQ(vox.sizes.size(), 6u);
   for (const auto& s : vox.sizes) {
@@ -411,7 +427,7 @@ TEST(Export, VoxSplitsGridsLargerThan256IntoPlacedModels) {
   // With colours the same split holds; each voxel keeps its exact colour (8 ≤ 255 colours).
   const Svo colored = Build(in);
   ASSERT_TRUE(Export(colored, dir / "big.vox").ok());
-  const VoxFile vox2 = ReadVox(dir / "big.vox");
+  const VoxFile vox2 = InSvokitFrame(ReadVox(dir / "big.vox"), in.grid.dims());
   for (std::size_t i = 0; i < in.size(); ++i) {
     EXPECT_EQ(RgbOf(vox2.ColorAt(CoordOf(in.keys[i]))), ToSrgb8(in.colors[i]));
   }
@@ -421,7 +437,7 @@ TEST(Export, VoxMedianCutPaletteOnTheTexturedTorus) {
   TempDir dir;
   const Svo svo = Build(TorusVoxels());
   ASSERT_TRUE(Export(svo, dir / "torus.vox").ok());
-  const VoxFile vox = ReadVox(dir / "torus.vox");
+  const VoxFile vox = InSvokitFrame(ReadVox(dir / "torus.vox"), svo.grid.dims());
   const std::vector<Node> nodes = ExpectedNodes(svo, svo.depth);
   ASSERT_EQ(vox.voxels.size(), nodes.size());
   std::set<Rgb8> distinct;

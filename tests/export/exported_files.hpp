@@ -222,4 +222,15 @@ inline VoxFile ReadVox(const std::filesystem::path& path) {
   return file;
 }
 
+/// `vox` with its voxels in svokit's frame: a .vox is z-up, svokit's grid y-up, so a voxel at
+/// (x, y, z) of a grid of `dims` is written at (x, dims.z − 1 − z, y) (formats: docs/tools).
+inline VoxFile InSvokitFrame(VoxFile vox, const std::array<std::uint32_t, 3>& dims) {
+  std::map<Coord, std::uint8_t> voxels;
+  for (const auto& [c, index] : vox.voxels) {
+    voxels[{c[0], c[2], static_cast<std::int64_t>(dims[2]) - 1 - c[1]}] = index;
+  }
+  vox.voxels = std::move(voxels);
+  return vox;
+}
+
 }  // namespace svokit::test

@@ -204,7 +204,7 @@ TEST(SolidExport, VoxListsTheInteriorInTheSurfacesMeanColour) {
   TempDir dir;
   for (const Solid* s : {&Ball64(), &Torus(), &Holed()}) {
     ASSERT_TRUE(Export(s->svo, dir / "s.vox").ok());
-    const VoxFile vox = ReadVox(dir / "s.vox");
+    const VoxFile vox = InSvokitFrame(ReadVox(dir / "s.vox"), s->svo.grid.dims());
     EXPECT_EQ(vox.sizes.size(), 1u);  // within one 256³ tile: one model
     const Expected e = ExpectedAt(*s, s->svo.depth);
     std::set<Coord> got;

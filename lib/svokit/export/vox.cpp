@@ -48,13 +48,20 @@ Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path)
   }
   const Palette palette = MedianCut(rgb);
 
+  // MagicaVoxel is z-up, svokit's grid y-up (glTF's convention): (x, y, z) ↦ (x, −z, y), a
+  // rotation about x, on the grid's dims.
+  const auto& grid_dims = voxels.grid.dims();
+  const std::array<std::uint32_t, 3> dims{grid_dims[0], grid_dims[2], grid_dims[1]};
+  auto vox_coord = [&](std::uint64_t key) {
+    const MortonCoord c = MortonDecode(key);
+    return std::array<std::uint32_t, 3>{c.x, grid_dims[2] - 1 - c.z, c.y};
+  };
   // Voxels grouped by 256³ tile, in Morton order within each tile.
   std::map<std::array<std::uint32_t, 3>, std::vector<std::size_t>> tiles;
   for (std::size_t i = 0; i < voxels.size(); ++i) {
-    const MortonCoord c = MortonDecode(voxels.keys[i]);
-    tiles[{c.x / kVoxTile, c.y / kVoxTile, c.z / kVoxTile}].push_back(i);
+    const std::array<std::uint32_t, 3> c = vox_coord(voxels.keys[i]);
+    tiles[{c[0] / kVoxTile, c[1] / kVoxTile, c[2] / kVoxTile}].push_back(i);
   }
-  const auto& dims = voxels.grid.dims();
   ByteWriter models, scene;
   // Scene graph: root transform 0 → group 1 → per model m, transform 2 + 2m → shape 3 + 2m.
   ByteWriter root, group;
@@ -81,8 +88,9 @@ Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path)
     PutChunk(models, "SIZE", std::move(size_chunk));
     xyzi.Put(static_cast<std::uint32_t>(members.size()));
     for (std::size_t i : members) {
-      const MortonCoord c = MortonDecode(voxels.keys[i]);
-      for (std::uint32_t v : {c.x, c.y, c.z}) xyzi.Put(static_cast<std::uint8_t>(v % kVoxTile));
+      for (std::uint32_t v : vox_coord(voxels.keys[i])) {
+        xyzi.Put(static_cast<std::uint8_t>(v % kVoxTile));
+      }
       xyzi.Put(palette.index[i]);
     }
     PutChunk(models, "XYZI", std::move(xyzi));

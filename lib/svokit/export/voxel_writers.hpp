@@ -99,8 +99,9 @@ std::uint64_t NaiveFaceCount(const VoxelSet& voxels);
 /// A solid's `interior` cubes (at the voxels' resolution; null for none) are filled.
 Status WriteVoxelsBinvox(const VoxelSet& voxels, const InteriorCubes* interior,
                          const std::filesystem::path& path);
-/// MagicaVoxel .vox (version 150): one model per non-empty 256³ tile, placed by an nTRN/nGRP/nSHP
-/// scene graph at its grid position; colours median-cut into at most 255 palette entries.
+/// MagicaVoxel .vox (version 150), z-up: voxel (x, y, z) at (x, dims.z − 1 − z, y); one model per
+/// non-empty 256³ tile, placed by an nTRN/nGRP/nSHP scene graph at its grid position; colours
+/// median-cut into at most 255 palette entries.
 Status WriteVoxelsVox(const VoxelSet& voxels, const std::filesystem::path& path);
 /// OpenVDB: BoolGrid "occupancy", float "density" (a fog volume) and "ao" when the header has
 /// them, Vec3f grids "color" (linear RGB) and "normal" when present, all sharing a transform whose
