@@ -15,6 +15,7 @@
 #include "apps/cli.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
+#include "svokit/formats/svo/section_key.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/pipeline/chain.hpp"
@@ -71,7 +72,7 @@ inline void AddFileSummary(Report& report, const SvoFileStats& stats) {
   for (const SvoSectionBytes& s : stats.sections) {
     table += fmt::format("{:<14} {:>12} {:>12} {:>11.3f}\n", s.name, s.stored, s.raw,
                          static_cast<double>(s.stored) / voxels);
-    sections.push_back({{"name", s.name}, {"stored_bytes", s.stored}, {"raw_bytes", s.raw}});
+    sections.push_back({{"name", SectionKey(s.name)}, {"stored", s.stored}, {"raw", s.raw}});
   }
   table += fmt::format("{:<14} {:>12} {:>12} {:>11.3f}\n", "file", stats.file_bytes, "",
                        static_cast<double>(stats.file_bytes) / voxels);

@@ -145,6 +145,23 @@ TEST(ReportCli, EveryToolAnswersJsonAndQuietPrintsNothing) {
     nlohmann::json report;
     ASSERT_NO_THROW(report = nlohmann::json::parse(j.out)) << run.tool << " --json:\n" << j.out;
     ASSERT_TRUE(report.is_object()) << run.tool;
+    // One spelling in JSON keys and names, "color" (text and messages may say colour).
+    std::vector<const nlohmann::json*> todo{&report};
+    while (!todo.empty()) {
+      const nlohmann::json* node = todo.back();
+      todo.pop_back();
+      if (node->is_object()) {
+        for (const auto& [key, value] : node->items()) {
+          EXPECT_EQ(key.find("colour"), std::string::npos) << run.tool << ": key " << key;
+          if (key == "name" && value.is_string()) {
+            EXPECT_EQ(value.get<std::string>().find("colour"), std::string::npos) << run.tool;
+          }
+          todo.push_back(&value);
+        }
+      } else if (node->is_array()) {
+        for (const auto& value : *node) todo.push_back(&value);
+      }
+    }
     for (const std::string& key : run.keys) {
       EXPECT_TRUE(report.contains(key)) << run.tool << ": no \"" << key << "\" in\n" << j.out;
     }

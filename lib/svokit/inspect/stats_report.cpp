@@ -10,6 +10,7 @@
 
 #include "svokit/core/utf8.hpp"
 #include "svokit/formats/provenance.hpp"
+#include "svokit/formats/svo/section_key.hpp"
 
 namespace svokit {
 
@@ -297,7 +298,7 @@ Json Ranges(const std::array<ValueRange, N>& r) {
 Json SectionsJson(const std::vector<SvoSectionBytes>& list, std::uint64_t voxels) {
   Json out = Json::array();
   for (const SvoSectionBytes& sec : list) {
-    out.push_back({{"name", sec.name},
+    out.push_back({{"name", SectionKey(sec.name)},
                    {"stored", sec.stored},
                    {"raw", sec.raw},
                    {"stored_per_voxel", Share(sec.stored, voxels)},
