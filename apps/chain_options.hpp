@@ -3,8 +3,10 @@
 // voxelization options, svo-build and mesh2svo the build options, into the pipeline's requests.
 
 #include <charconv>
+#include <cmath>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -28,6 +30,7 @@ inline const std::map<std::string, VoxelMethod> kVoxelMethods = {
 struct VoxelizeCli {
   std::uint32_t resolution = 0, pad = 0;
   double voxel_size = 0;
+  std::vector<double> bounds;  ///< empty, or MINX MINY MINZ MAXX MAXY MAXZ
   std::string attributes = "color,normal";
   std::string fill = "surface";
   /// Mode, method and cutoff as given.
@@ -43,6 +46,11 @@ struct VoxelizeCli {
                      ->check(PositiveFinite());
     res->excludes(size);
     size->excludes(res);
+    cli.add_option("--bounds", bounds,
+                   "Fit the grid to this world box instead of the mesh's bounds, so that meshes "
+                   "given one box share one grid (origin and voxel size); the mesh must lie in it")
+        ->expected(6)
+        ->option_text("MINX MINY MINZ MAXX MAXY MAXZ");
     cli.add_option("--pad", pad, "Empty voxels added on every side")
         ->option_text("N")
         ->capture_default_str()
@@ -78,7 +86,19 @@ struct VoxelizeCli {
       return Status::BadInput("give the grid as --resolution N or --voxel-size S");
     }
     VoxelizeRequest r;
-    r.grid = {resolution, resolution > 0 ? 0 : voxel_size, pad};
+    r.grid = {resolution, resolution > 0 ? 0 : voxel_size, pad, std::nullopt};
+    if (!bounds.empty()) {
+      const Box3d box{{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}};
+      for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || !(box.lo[a] < box.hi[a])) {
+          return Status::BadInput(
+              "--bounds {} {} {} {} {} {}: give finite MINX MINY MINZ MAXX MAXY MAXZ, each min "
+              "below its max",
+              bounds[0], bounds[1], bounds[2], bounds[3], bounds[4], bounds[5]);
+        }
+      }
+      r.grid.bounds = box;
+    }
     r.settings.mode = parsed.mode;
     r.settings.colors = attributes.find("color") != std::string::npos;
     r.settings.normals = attributes.find("normal") != std::string::npos;

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/ranges.h>
 
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
@@ -89,6 +91,51 @@ TEST(SvoVoxelizeCli, ThinIsASubsetAndXyzListsTheSameVoxels) {
   EXPECT_TRUE(std::includes(c->keys.begin(), c->keys.end(), t->keys.begin(), t->keys.end()));
   const std::string xyz = ReadText(dir / "c.xyz");
   EXPECT_EQ(static_cast<std::size_t>(std::count(xyz.begin(), xyz.end(), '\n')), c->size() + 3);
+}
+
+// Two meshes given one --bounds share one grid (origin, voxel size, dims), as binvox's -bb gives
+// several assets one; the box is recorded, so svo-bake still matches the mesh to its octree.
+TEST(SvoVoxelizeCli, BoundsGiveMeshesOneGrid) {
+  TempDir dir;
+  const std::vector<std::string> box = {"--bounds", "-2", "-1.5", "-2", "2", "1.5", "2.5"};
+  const std::string tetra = (DataDir() / "tetra.off").string();
+  const std::string torus = (DataDir() / "uv-torus.obj").string();
+  std::vector<GridTransform> grids;
+  for (const std::string& mesh : {tetra, torus}) {
+    const std::string out = (dir / (std::filesystem::path(mesh).stem().string() + ".svo")).string();
+    std::vector<std::string> args = {mesh, "-r", "64", "-o", out, "-q"};
+    args.insert(args.end(), box.begin(), box.end());
+    const ToolResult r = RunTool("mesh2svo", args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    StatusOr<SvoReader> reader = SvoReader::Open(out);
+    ASSERT_TRUE(reader.ok()) << reader.status().message();
+    grids.push_back(reader->grid());
+  }
+  EXPECT_EQ(grids[0].origin(), grids[1].origin());
+  EXPECT_EQ(grids[0].voxel_size(), grids[1].voxel_size());
+  EXPECT_EQ(grids[0].dims(), grids[1].dims());
+  // The box's longest side (4.5) over 64 and its corner within a voxel, not the mesh's (the fit
+  // centres the box in whole voxels).
+  const double h = grids[0].voxel_size();
+  EXPECT_NEAR(h, 4.5 / 64, 1e-4 * h);
+  EXPECT_NEAR(grids[0].origin().x, -2, h);
+  // svo-bake fits the grid as the build did, from the box in META.
+  const ToolResult bake = RunTool("svo-bake", {(dir / "uv-torus.svo").string(), "--mesh", torus,
+                                               "--vertex-out", (dir / "ao.ply").string(), "-q"});
+  EXPECT_EQ(bake.exit_code, 0) << bake.err;
+  // A mesh reaching outside the box, or a box that is not one: one line, exit 2, no file.
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--bounds", "0", "0", "0", "1", "1", "1"},
+        std::vector<std::string>{"--bounds", "0", "0", "0", "0", "1", "1"},
+        std::vector<std::string>{"--bounds", "0", "0", "0", "inf", "1", "1"}}) {
+    std::vector<std::string> args = {torus, "-r", "64", "-o", (dir / "bad.svo").string(), "-q"};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const ToolResult r = RunTool("mesh2svo", args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("bounds"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.svo"));
+  }
 }
 
 TEST(SvoVoxelizeCli, BadInputIsOneLineExitTwoAndNoOutput) {

@@ -118,9 +118,22 @@ std::uint32_t OctreeDepth(const GridTransform& grid) {
   return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::bit_width(grid.max_dim() - 1)));
 }
 
-StatusOr<GridTransform> GridFit::Fit(const Box3d& bounds) const {
-  return resolution > 0 ? GridTransform::FitResolution(bounds, resolution, pad)
-                        : GridTransform::FitVoxelSize(bounds, voxel_size, pad);
+StatusOr<GridTransform> GridFit::Fit(const Box3d& mesh) const {
+  if (this->bounds) {
+    const Box3d& b = *this->bounds;
+    for (int a = 0; a < 3; ++a) {
+      if (!mesh.empty() && (mesh.lo[a] < b.lo[a] || mesh.hi[a] > b.hi[a])) {
+        return Status::BadInput(
+            "the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] reach outside "
+            "--bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}]",
+            mesh.lo.x, mesh.lo.y, mesh.lo.z, mesh.hi.x, mesh.hi.y, mesh.hi.z, b.lo.x, b.lo.y,
+            b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+      }
+    }
+  }
+  const Box3d& box = this->bounds ? *this->bounds : mesh;
+  return resolution > 0 ? GridTransform::FitResolution(box, resolution, pad)
+                        : GridTransform::FitVoxelSize(box, voxel_size, pad);
 }
 
 }  // namespace svokit

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "svokit/core/box.hpp"
 #include "svokit/core/status.hpp"
@@ -76,12 +77,15 @@ class GridTransform {
 std::uint32_t OctreeDepth(const GridTransform& grid);
 
 /// How a grid is fitted to a mesh's bounds: `resolution` voxels along the longest axis, or (with
-/// resolution 0) voxels of `voxel_size`; and `pad` empty voxels on every side.
+/// resolution 0) voxels of `voxel_size`; and `pad` empty voxels on every side. With `bounds`, the
+/// grid is fitted to that box instead, so that meshes given one box share one grid.
 struct GridFit {
   std::uint32_t resolution = 0;
   double voxel_size = 0;
   std::uint32_t pad = 0;
+  std::optional<Box3d> bounds;
 
+  /// Bad input: a mesh whose `bounds` reach outside the given box.
   StatusOr<GridTransform> Fit(const Box3d& bounds) const;
   bool operator==(const GridFit&) const = default;
 };

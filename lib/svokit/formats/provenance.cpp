@@ -1,6 +1,8 @@
 #include "svokit/formats/provenance.hpp"
 
+#include <array>
 #include <charconv>
+#include <cmath>
 #include <map>
 #include <sstream>
 #include <string_view>
@@ -22,6 +24,10 @@ Json GridJson(const GridFit& g) {
     j["resolution"] = g.resolution;
   } else {
     j["voxel_size"] = g.voxel_size;
+  }
+  if (g.bounds) {
+    const Box3d& b = *g.bounds;
+    j["bounds"] = {b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z};
   }
   return j;
 }
@@ -214,6 +220,18 @@ Provenance ParseProvenance(std::string_view text) {
   p.triangles = Member<std::uint64_t>(j, "triangles").value_or(0);
   if (const auto grid = j.find("grid"); grid != j.end() && grid->is_object()) {
     p.grid = GridFrom(JsonFields{*grid});
+    // Six finite numbers, min before max; anything else reads as absent.
+    const auto b = grid->find("bounds");
+    if (p.grid && b != grid->end() && b->is_array() && b->size() == 6) {
+      std::array<double, 6> v{};
+      bool ok = true;
+      for (std::size_t k = 0; k < 6; ++k) {
+        ok = ok && (*b)[k].is_number() && std::isfinite(v[k] = (*b)[k].get<double>());
+      }
+      if (ok && v[0] < v[3] && v[1] < v[4] && v[2] < v[5]) {
+        p.grid->bounds = Box3d{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+      }
+    }
   }
   // Each stage: a typed object, or (files written before) its option text.
   for (const char* key : {"voxelize", "options"}) {
