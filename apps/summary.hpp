@@ -36,15 +36,11 @@ class Report {
   void Block(const std::string& key, Json value, std::string text) {
     entries_.push_back({key, std::move(value), std::move(text)});
   }
-  /// Text that JSON leaves out (it has its values elsewhere).
-  void Text(std::string text) { entries_.push_back({"", nullptr, std::move(text)}); }
 
   void Print() const {
     if (json_) {
       Json out = Json::object();
-      for (const Entry& e : entries_) {
-        if (!e.key.empty()) out[e.key] = e.value;
-      }
+      for (const Entry& e : entries_) out[e.key] = e.value;
       fmt::print("{}\n", out.dump(2));
       return;
     }

@@ -97,6 +97,21 @@ struct VoxFile {
   }
 };
 
+/// Faces between a voxel of `filled` and a cell that is not in it: a closed surface's area.
+inline std::uint64_t BoundaryFaces(const std::set<Coord>& filled) {
+  std::uint64_t faces = 0;
+  for (const Coord& c : filled) {
+    for (int a = 0; a < 3; ++a) {
+      for (const int step : {-1, 1}) {
+        Coord n = c;
+        n[a] += step;
+        faces += filled.count(n) ? 0 : 1;
+      }
+    }
+  }
+  return faces;
+}
+
 /// Little-endian values read one after another from a file's bytes.
 class Bytes {
  public:

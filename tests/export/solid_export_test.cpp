@@ -180,17 +180,7 @@ TEST(SolidExport, VoxelMeshHasTheOutsideFacesOnly) {
   TempDir dir;
   for (const Solid* s : {&Ball64(), &Holed()}) {
     const Expected e = ExpectedAt(*s, s->svo.depth);
-    const std::set<Coord> all = e.All();
-    std::uint64_t outside = 0;  // faces of the filled set with no filled neighbour
-    for (const Coord& c : all) {
-      for (int a = 0; a < 3; ++a) {
-        for (const int step : {-1, 1}) {
-          Coord n = c;
-          n[a] += step;
-          outside += all.count(n) ? 0 : 1;
-        }
-      }
-    }
+    const std::uint64_t outside = test::BoundaryFaces(e.All());
     ExportOptions options;
     options.merge_faces = false;
     ASSERT_TRUE(ExportSvo(s->svo, dir / "s.glb", options).ok());

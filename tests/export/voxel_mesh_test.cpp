@@ -15,6 +15,7 @@
 #include "svokit/export/export.hpp"
 #include "svokit/export/voxel_writers.hpp"
 #include "svokit/svo/sample_codec.hpp"
+#include "tests/export/exported_files.hpp"
 #include "tests/formats/paged_torus.hpp"
 
 namespace svokit {
@@ -29,17 +30,7 @@ std::uint64_t BoundaryFaces(const std::vector<std::uint64_t>& keys) {
     const MortonCoord c = MortonDecode(k);
     filled.insert({c.x, c.y, c.z});
   }
-  std::uint64_t faces = 0;
-  for (const Point& p : filled) {
-    for (int a = 0; a < 3; ++a) {
-      for (const int s : {-1, 1}) {
-        Point n = p;
-        n[a] += s;
-        faces += filled.count(n) ? 0 : 1;
-      }
-    }
-  }
-  return faces;
+  return test::BoundaryFaces(filled);
 }
 
 // The mesh's directed edges in grid units, axis-aligned ones cut into unit steps; closed when every

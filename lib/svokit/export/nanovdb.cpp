@@ -29,7 +29,7 @@ std::uint64_t GridBufferBytes(const std::array<std::uint64_t, 3>& nodes) {
 class NanoVdbWriter final : public VoxelFileWriter {
  public:
   NanoVdbWriter(const VoxelFileHeader& header, const std::filesystem::path& path)
-      : header_(header), out_(path), has_ao_(header.ao) {
+      : header_(header), out_(path) {
     density_.emplace(0.f, nanovdb::GridClass::FogVolume);
     color_.emplace(nanovdb::Vec3f(0.f));
     ao_.emplace(0.f);
@@ -51,7 +51,7 @@ class NanoVdbWriter final : public VoxelFileWriter {
         const Rgba rgba = part.color(i);
         color_at.setValue(ijk, nanovdb::Vec3f(rgba.r, rgba.g, rgba.b));
       }
-      if (has_ao_) ao_at.setValue(ijk, static_cast<float>(values.ao[i]) / 255.f);
+      if (header_.ao) ao_at.setValue(ijk, static_cast<float>(values.ao[i]) / 255.f);
     }
     return Status::Ok();
   }
@@ -79,14 +79,13 @@ class NanoVdbWriter final : public VoxelFileWriter {
     };
     SVOKIT_RETURN_IF_ERROR(write(density_, "density"));
     if (header_.colors) SVOKIT_RETURN_IF_ERROR(write(color_, "color"));
-    if (has_ao_) SVOKIT_RETURN_IF_ERROR(write(ao_, "ao"));
+    if (header_.ao) SVOKIT_RETURN_IF_ERROR(write(ao_, "ao"));
     return out_.Commit();
   }
 
  private:
   VoxelFileHeader header_;
   AtomicFileWriter out_;
-  bool has_ao_ = false;
   std::optional<nanovdb::GridBuilder<float>> density_;
   std::optional<nanovdb::GridBuilder<nanovdb::Vec3f>> color_;
   std::optional<nanovdb::GridBuilder<float>> ao_;
