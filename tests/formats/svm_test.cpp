@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 
 #include "svokit/core/file_io.hpp"
@@ -61,6 +62,35 @@ TEST(Svm, RoundTripWithoutOptionalAttributes) {
   auto back = DecodeSvm(EncodeSvm(m, "x"), "mem.svm");
   ASSERT_TRUE(back.ok());
   ExpectSameMesh(m, *back);
+}
+
+TEST(Svm, AlphaModesRoundTripAndOpaqueMeshesKeepVersionOneBytes) {
+  const Mesh opaque = RichMesh();
+  Mesh alpha = RichMesh();
+  alpha.materials[1].alpha_mode = AlphaMode::kMask;
+  alpha.materials[1].alpha_cutoff = 0.25f;
+  alpha.materials[1].alpha_texture = 0;
+  alpha.materials[2].alpha_mode = AlphaMode::kBlend;
+  const auto bytes = EncodeSvm(alpha, "rich.obj");
+  auto back = DecodeSvm(bytes, "mem.svm");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ExpectSameMesh(alpha, *back);
+  // Only a mesh reading alpha has the ALPH section.
+  const auto plain = EncodeSvm(opaque, "rich.obj");
+  const std::string tag = "ALPH";
+  EXPECT_EQ(std::search(plain.begin(), plain.end(), tag.begin(), tag.end()), plain.end());
+  EXPECT_NE(std::search(bytes.begin(), bytes.end(), tag.begin(), tag.end()), bytes.end());
+  // A mode no version defines, or a coverage texture that does not exist: refused.
+  Mesh bad = alpha;
+  bad.materials[0].alpha_mode = static_cast<AlphaMode>(7);
+  auto r = DecodeSvm(EncodeSvm(bad, "rich.obj"), "bad.svm");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("alpha mode 7"), std::string::npos) << r.status().message();
+  bad = alpha;
+  bad.materials[1].alpha_texture = 5;
+  r = DecodeSvm(EncodeSvm(bad, "rich.obj"), "bad.svm");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("texture 5"), std::string::npos) << r.status().message();
 }
 
 TEST(Svm, FileRoundTripOfImportedTexturedMesh) {

@@ -461,6 +461,93 @@ TEST(GltfImport, UnusableTexturesFallBackToTheBaseColour) {
   }
 }
 
+// One triangle with UVs (0,0) (1,0) (0,1) and one material per primitive copy; `materials` is the
+// JSON array, `texture_info` the base colour texture's members beyond "index".
+fs::path UvTriangleGltf(const fs::path& dir, const std::string& materials, int copies) {
+  std::vector<std::uint8_t> bin;
+  auto put = [&](const void* p, std::size_t n) {
+    bin.insert(bin.end(), static_cast<const std::uint8_t*>(p),
+               static_cast<const std::uint8_t*>(p) + n);
+  };
+  for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(&f, 4);
+  for (float f : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) put(&f, 4);
+  for (const std::uint16_t i : {std::uint16_t{0}, std::uint16_t{1}, std::uint16_t{2}}) put(&i, 2);
+  bin.resize(68);
+  WriteFile(dir / "uv.bin", bin.data(), bin.size());
+  fs::copy_file(kData / "uv-torus.png", dir / "tex.png", fs::copy_options::overwrite_existing);
+  std::string primitives;
+  for (int i = 0; i < copies; ++i) {
+    primitives += fmt::format(R"({}{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}},
+                                  "indices": 2, "material": {}}})",
+                              i ? "," : "", i);
+  }
+  WriteFile(dir / "uv.gltf", fmt::format(R"({{
+  "asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{}]}}],
+  "materials": {},
+  "textures": [{{"source": 0}}], "images": [{{"uri": "tex.png"}}],
+  "buffers": [{{"uri": "uv.bin", "byteLength": 68}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
+                  {{"buffer": 0, "byteOffset": 36, "byteLength": 24}},
+                  {{"buffer": 0, "byteOffset": 60, "byteLength": 6}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+      "min": [0, 0, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5123, "count": 3, "type": "SCALAR"}}]
+}})",
+                                         primitives, materials));
+  return dir / "uv.gltf";
+}
+
+TEST(GltfImport, AlphaModesAndCutoffAreKept) {
+  TempDir dir;
+  const fs::path path = UvTriangleGltf(dir.path(), R"([
+    {"name": "leaf", "alphaMode": "MASK", "alphaCutoff": 0.3,
+     "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+    {"name": "glass", "alphaMode": "BLEND"},
+    {"name": "wall", "alphaMode": "OPAQUE"},
+    {"name": "odd", "alphaMode": "CUTOUT"}])",
+                                       4);
+  StatusOr<Mesh> mesh = ImportGltf(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->materials.size(), 4u);
+  EXPECT_EQ(mesh->materials[0].alpha_mode, AlphaMode::kMask);
+  EXPECT_EQ(mesh->materials[0].alpha_cutoff, 0.3f);
+  EXPECT_EQ(mesh->materials[1].alpha_mode, AlphaMode::kBlend);
+  EXPECT_EQ(mesh->materials[2].alpha_mode, AlphaMode::kOpaque);
+  EXPECT_EQ(mesh->materials[3].alpha_mode, AlphaMode::kOpaque);
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_NE(mesh->warnings[0].find("alphaMode 'CUTOUT'"), std::string::npos) << mesh->warnings[0];
+  EXPECT_TRUE(mesh->has_alpha());
+}
+
+// KHR_texture_transform: uv' = offset + rotation · scale · uv in glTF's frame (v down), per the
+// extension's matrices; svokit's v = 1 − glTF's. Rotation π/2: (u, v) ↦ (sy·v, −sx·u) + offset.
+TEST(GltfImport, TextureTransformMovesTheTextureCoordinates) {
+  TempDir dir;
+  const fs::path path = UvTriangleGltf(dir.path(), R"([
+    {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions":
+      {"KHR_texture_transform": {"offset": [0.25, 0.5], "rotation": 1.5707963267948966,
+                                 "scale": [2, 3]}}}}},
+    {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])",
+                                       2);
+  StatusOr<Mesh> mesh = ImportGltf(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(mesh->warnings.empty()) << mesh->warnings.front();
+  ASSERT_EQ(mesh->uvs.size(), 6u);
+  // glTF (u, v) of the corners, then the transform: u' = 3v + 0.25, v' = −2u + 0.5.
+  const float gltf_uv[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  for (int k = 0; k < 3; ++k) {
+    const double u = gltf_uv[k][0], v = gltf_uv[k][1];
+    EXPECT_NEAR(mesh->uvs[k].u, 3 * v + 0.25, 1e-6) << k;
+    EXPECT_NEAR(mesh->uvs[k].v, 1 - (-2 * u + 0.5), 1e-6) << k;
+    // The second primitive's material has no transform.
+    EXPECT_NEAR(mesh->uvs[3 + k].u, u, 1e-7) << k;
+    EXPECT_NEAR(mesh->uvs[3 + k].v, 1 - v, 1e-7) << k;
+  }
+}
+
 TEST(GltfImport, ImageViewOutsideItsBufferIsRejected) {
   TempDir dir;
   TriangleGltf gltf;

@@ -195,6 +195,48 @@ TEST(ObjImport, MissingLibraryTextureAndMaterialAreWarnings) {
   EXPECT_EQ(m->warnings.size(), 3u);
 }
 
+// MTL has no alpha mode: map_d cuts out (mask), dissolve below 1 blends, and "d 0" (exporters
+// writing Tr as opacity) would be an invisible material, so it is opaque with a warning.
+TEST(ObjImport, CoverageMapsAndDissolveChooseTheAlphaMode) {
+  TempDir dir;
+  std::filesystem::copy_file(test::DataDir() / "uv-torus.png", dir.path() / "leaf.png");
+  dir.Write("a.mtl",
+            "newmtl cut\nmap_Kd leaf.png\nmap_d -imfchan m leaf.png\n"
+            "newmtl glass\nKd 0 0 1\nd 0.25\n"
+            "newmtl veil\nmap_d leaf.png\nTr 0.5\n"
+            "newmtl solid\nKd 1 1 1\nd 1\n"
+            "newmtl invisible\nd 0\n"
+            "newmtl gone\nmap_d absent.png\n");
+  const auto p = dir.Write("a.obj",
+                           "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl cut\nf 1 2 3\n"
+                           "usemtl glass\nf 1 3 2\nusemtl veil\nf 1 2 3\nusemtl solid\nf 1 2 3\n"
+                           "usemtl invisible\nf 1 2 3\nusemtl gone\nf 1 2 3\n");
+  auto m = ImportMesh(p);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->materials.size(), 6u);
+  const Material& cut = m->materials[0];
+  EXPECT_EQ(cut.alpha_mode, AlphaMode::kMask);
+  ASSERT_GE(cut.alpha_texture, 0);
+  // The same file as colour (sRGB) and as coverage (linear data): two textures.
+  EXPECT_NE(cut.alpha_texture, cut.texture);
+  EXPECT_FALSE(m->textures[cut.alpha_texture].srgb());
+  EXPECT_TRUE(m->textures[cut.texture].srgb());
+  EXPECT_EQ(m->materials[1].alpha_mode, AlphaMode::kBlend);
+  EXPECT_EQ(m->materials[1].base_color.a, 0.25f);
+  EXPECT_EQ(m->materials[2].alpha_mode, AlphaMode::kBlend);  // a map and translucency
+  EXPECT_EQ(m->materials[2].alpha_texture, cut.alpha_texture);
+  EXPECT_EQ(m->materials[3].alpha_mode, AlphaMode::kOpaque);
+  EXPECT_EQ(m->materials[4].alpha_mode, AlphaMode::kOpaque);
+  EXPECT_EQ(m->materials[4].base_color.a, 1.f);
+  EXPECT_EQ(m->materials[5].alpha_mode, AlphaMode::kOpaque);  // its map could not be read
+  EXPECT_EQ(m->materials[5].alpha_texture, -1);
+  ASSERT_EQ(m->warnings.size(), 2u);
+  const std::string warnings = m->warnings[0] + "\n" + m->warnings[1];
+  EXPECT_NE(warnings.find("material 'invisible': dissolve 0"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("'absent.png' not found, the material is opaque"), std::string::npos)
+      << warnings;
+}
+
 // A library or texture name longer than a path may be (ENAMETOOLONG) is a name that names no
 // file: a warning. The check whether a spaced name is one file threw instead (found by fuzzing).
 TEST(ObjImport, NamesTooLongForAPathAreWarnings) {

@@ -138,6 +138,7 @@ TEST(AttributeClip, EdgeAndPointContactHaveZeroAreaAndContactColour) {
   // Point contact: only the vertex (1, 1, 1) touches voxel (0, 0, 0).
   TestMesh point({{1, 1, 1}, {2, 1.5, 1.25}, {1.5, 2, 1.75}}, {{0, 1, 2}});
   point.mesh.colors = {{0.25f, 0.5f, 0.75f, 0.5f}, {0, 1, 0, 1}, {0, 0, 1, 1}};
+  point.mesh.materials[0].alpha_mode = AlphaMode::kBlend;  // the vertex alpha is the opacity
   const AttributeSampler ps(point.mesh, point.vertices, true, false);
   const AttributeSample p = ps.Sample(0, 0, 0, 0);
   EXPECT_EQ(p.area, 0.0);
@@ -603,9 +604,10 @@ TEST(AttributeColour, UvOffsetsByWholeTurnsChangeNothing) {
 
 TEST(AttributeColour, BaseVertexAndTextureColoursMultiply) {
   // The right triangle (0,0)–(2,0)–(0,2) at z = 0.5 with red, green, blue corners of different
-  // alphas; base colour (0.5, 0.8, 1, 0.5).
+  // alphas; base colour (0.5, 0.8, 1, 0.5), blended: alpha is the opacity, each factor's mean.
   TestMesh m({{0, 0, 0.5}, {2, 0, 0.5}, {0, 2, 0.5}}, {{0, 1, 2}});
   m.mesh.materials[0].base_color = {0.5f, 0.8f, 1.f, 0.5f};
+  m.mesh.materials[0].alpha_mode = AlphaMode::kBlend;
   const Rgba corner[3] = {{1, 0, 0, 1}, {0, 1, 0, 0.5f}, {0, 0, 1, 0}};
   m.mesh.colors = {corner[0], corner[1], corner[2]};
   auto expected = [&](double b0, double b1, double b2) {
@@ -626,6 +628,15 @@ TEST(AttributeColour, BaseVertexAndTextureColoursMultiply) {
     const Rgba c = s.Sample(0, 0, 1, 0).color;
     ExpectRgbaNear(c, expected(1 / 6.0, 1 / 6.0, 2 / 3.0), 1e-6, "blue");
     EXPECT_NEAR(c.b, 2 / 3.0, 1e-6);
+  }
+  {
+    // Opaque (glTF's default): alpha ignored, the colour unchanged.
+    m.mesh.materials[0].alpha_mode = AlphaMode::kOpaque;
+    const AttributeSampler s(m.mesh, m.vertices, true, false);
+    Rgba e = expected(0.5, 0.25, 0.25);
+    e.a = 1.f;
+    ExpectRgbaNear(s.Sample(0, 0, 0, 0).color, e, 1e-6, "opaque");
+    m.mesh.materials[0].alpha_mode = AlphaMode::kBlend;
   }
   {
     // With the torus texture and every UV at the centre of texel (10, 50): the texture factor is
@@ -650,6 +661,7 @@ TEST(AttributeColour, BaseVertexAndTextureColoursMultiply) {
   }
   {
     // Colour not wanted: left at its default (opaque white), textures not decoded.
+    m.mesh.materials[0].alpha_mode = AlphaMode::kOpaque;
     const AttributeSampler s(m.mesh, m.vertices, false, false);
     EXPECT_TRUE(s.warnings().empty());
     EXPECT_EQ(s.Sample(0, 0, 0, 0).color, Rgba{});

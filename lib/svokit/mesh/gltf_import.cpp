@@ -963,6 +963,11 @@ std::string ImageExtension(const std::string& mime, std::span<const std::uint8_t
 // ---------------------------------------------------------------------------------------------
 // The scene
 
+// A 2-D affine map of texture coordinates, row-major [a b c; d e f]: u' = a·u + b·v + c.
+struct UvTransform {
+  std::array<double, 6> m = {1, 0, 0, 0, 1, 0};
+};
+
 class GltfImporter {
  public:
   GltfImporter(const tinygltf::Model& model, const SideFileRule& rule, Mesh& mesh)
@@ -982,7 +987,10 @@ class GltfImporter {
  private:
   Status CheckRequiredExtensions() {
     for (const std::string& ext : model_.extensionsRequired) {
-      if (ext == "KHR_draco_mesh_compression" || ext == "KHR_mesh_quantization") continue;
+      if (ext == "KHR_draco_mesh_compression" || ext == "KHR_mesh_quantization" ||
+          ext == "KHR_texture_transform") {
+        continue;
+      }
       // Extensions that only change appearance cannot make the geometry wrong.
       bool appearance = false;
       for (const char* prefix :
@@ -1136,6 +1144,17 @@ class GltfImporter {
       const std::size_t first_triangle = mesh_.triangles.size();
       SVOKIT_RETURN_IF_ERROR(
           AppendDracoMesh(**prim, *material, /*flip_v=*/true, mesh_).WithContext(context));
+      if (const auto t = uv_transforms_.find(*material);
+          t != uv_transforms_.end() && mesh_.has_uvs()) {
+        // The transform maps glTF's coordinates (v down); svokit's v was flipped on append.
+        for (std::size_t c = 3 * first_triangle; c < mesh_.uvs.size(); ++c) {
+          Vec2f& uv = mesh_.uvs[c];
+          const std::array<double, 6>& m = t->second.m;
+          const double u = uv.u, v = 1.0 - double{uv.v};
+          uv = {static_cast<float>(m[0] * u + m[1] * v + m[2]),
+                static_cast<float>(1.0 - (m[3] * u + m[4] * v + m[5]))};
+        }
+      }
       TransformAppended(mesh_, first_vertex, first_triangle, world);
     }
     return Status::Ok();
@@ -1190,6 +1209,11 @@ class GltfImporter {
       material.name = "default";
       if (index >= 0) material = ConvertMaterial(index);
       slot = static_cast<std::uint32_t>(mesh_.materials.size());
+      if (index >= 0 && material.texture >= 0) {
+        const tinygltf::TextureInfo& info =
+            model_.materials[index].pbrMetallicRoughness.baseColorTexture;
+        if (auto t = TextureTransform(info, material.name)) uv_transforms_[*slot] = *t;
+      }
       mesh_.materials.push_back(std::move(material));
     }
     return *slot;
@@ -1208,8 +1232,64 @@ class GltfImporter {
           fmt::format("material '{}': baseColorFactor has {} values, expected 4; using white",
                       material.name, factor.size()));
     }
+    if (m.alphaMode == "MASK") {
+      material.alpha_mode = AlphaMode::kMask;
+      material.alpha_cutoff = static_cast<float>(m.alphaCutoff);
+    } else if (m.alphaMode == "BLEND") {
+      material.alpha_mode = AlphaMode::kBlend;
+    } else if (m.alphaMode != "OPAQUE") {
+      mesh_.warnings.push_back(
+          fmt::format("material '{}': alphaMode '{}' is not one of OPAQUE, "
+                      "MASK, BLEND; the material is opaque",
+                      material.name, m.alphaMode));
+    }
     AttachBaseColorTexture(m.pbrMetallicRoughness.baseColorTexture, material);
     return material;
+  }
+
+  // KHR_texture_transform's map of the base colour texture's coordinates (glTF's, v down):
+  // offset · rotation · scale, as the extension defines it; nullopt for the identity.
+  std::optional<UvTransform> TextureTransform(const tinygltf::TextureInfo& info,
+                                              const std::string& material) {
+    const auto ext = info.extensions.find("KHR_texture_transform");
+    if (ext == info.extensions.end()) return std::nullopt;
+    const tinygltf::Value& v = ext->second;
+    auto numbers = [&](const char* key, std::initializer_list<double> fallback) {
+      std::vector<double> out(fallback);
+      if (!v.Has(key)) return out;
+      const tinygltf::Value& x = v.Get(key);
+      if (x.IsNumber() && out.size() == 1) {
+        out[0] = x.GetNumberAsDouble();
+      } else if (x.IsArray() && x.ArrayLen() == out.size()) {
+        for (std::size_t i = 0; i < out.size(); ++i) {
+          const tinygltf::Value& e = x.Get(static_cast<int>(i));
+          if (e.IsNumber()) out[i] = e.GetNumberAsDouble();
+        }
+      }
+      for (double& d : out) {
+        if (!std::isfinite(d)) {
+          mesh_.warnings.push_back(fmt::format(
+              "material '{}': KHR_texture_transform {} is not finite; ignored", material, key));
+          out = fallback;
+          break;
+        }
+      }
+      return out;
+    };
+    if (v.Has("texCoord") && v.Get("texCoord").IsNumber() &&
+        v.Get("texCoord").GetNumberAsDouble() != 0) {
+      mesh_.warnings.push_back(fmt::format(
+          "material '{}': KHR_texture_transform's texCoord is not 0, only TEXCOORD_0 is imported",
+          material));
+    }
+    const std::vector<double> offset = numbers("offset", {0, 0});
+    const double rotation = numbers("rotation", {0})[0];
+    const std::vector<double> scale = numbers("scale", {1, 1});
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    UvTransform t;
+    t.m = {c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1]};
+    if (t.m == UvTransform{}.m) return std::nullopt;
+    return t;
   }
 
   // Points `material` at the texture's image: embedded images (buffer view or data URI) become
@@ -1224,11 +1304,6 @@ class GltfImporter {
     if (info.texCoord != 0) {
       return warn(fmt::format("base colour texture uses TEXCOORD_{}, only TEXCOORD_0 is imported",
                               info.texCoord));
-    }
-    if (info.extensions.count("KHR_texture_transform")) {
-      mesh_.warnings.push_back(fmt::format(
-          "material '{}': KHR_texture_transform is ignored; the texture may be misplaced",
-          material.name));
     }
     if (static_cast<std::size_t>(info.index) >= model_.textures.size()) {
       return warn(fmt::format("texture {} does not exist", info.index));
@@ -1274,7 +1349,8 @@ class GltfImporter {
   std::map<std::pair<int, int>, std::unique_ptr<draco::Mesh>> primitives_;
   std::vector<std::optional<std::uint32_t>> material_slots_;  // per glTF material, once converted
   std::optional<std::uint32_t> default_material_;
-  std::map<int, std::int32_t> image_textures_;  // glTF image → index into mesh_.textures
+  std::map<std::uint32_t, UvTransform> uv_transforms_;  // svokit material → its texture transform
+  std::map<int, std::int32_t> image_textures_;          // glTF image → index into mesh_.textures
 };
 
 }  // namespace

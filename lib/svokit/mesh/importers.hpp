@@ -38,11 +38,15 @@ inline StatusOr<Mesh> ImportGltf(const std::filesystem::path& path) {
 /// `flip_v` (glTF convention).
 Status AppendDracoMesh(const draco::Mesh& in, std::uint32_t material, bool flip_v, Mesh& mesh);
 
+/// What a material uses a texture file for: its colour (sRGB; Material::texture) or its
+/// coverage (linear; Material::alpha_texture, OBJ's map_d).
+enum class TextureUse { kColor, kCoverage };
+
 /// Loads the texture file `reference` names (relative to `folder`, the folder of the file naming
 /// it) into mesh.textures and points `material` at it, if `rule` allows reading it; a file refused
-/// or unreadable leaves the material untextured with a warning.
+/// or unreadable leaves the material without it, with a warning.
 void AttachTextureFile(const SideFileRule& rule, const std::filesystem::path& folder,
                        const std::string& reference, SideFileSyntax syntax, Material& material,
-                       Mesh& mesh);
+                       Mesh& mesh, TextureUse use = TextureUse::kColor);
 
 }  // namespace svokit::detail

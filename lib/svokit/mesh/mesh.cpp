@@ -10,6 +10,18 @@ Box3d Mesh::Bounds() const {
   return box;
 }
 
+bool Mesh::has_alpha() const {
+  for (const Material& m : materials) {
+    if (m.alpha_mode != AlphaMode::kOpaque) return true;
+  }
+  return false;
+}
+
+bool Mesh::ReadsAlpha(std::size_t t) const {
+  const std::uint32_t id = t < material_ids.size() ? material_ids[t] : 0;
+  return id < materials.size() && materials[id].alpha_mode != AlphaMode::kOpaque;
+}
+
 void EnsureDefaultMaterial(Mesh& mesh) {
   if (mesh.materials.empty()) mesh.materials.push_back({.name = "default"});
   mesh.material_ids.resize(mesh.triangles.size(), 0);
@@ -78,9 +90,21 @@ Status ValidateAndSanitize(Mesh& mesh, const std::string& source) {
           fmt::format("material '{}' has a non-finite colour; white is used", m.name));
       m.base_color = {};
     }
-    if (m.texture >= static_cast<std::int32_t>(mesh.textures.size())) {
-      return Status::BadInput("{}: material '{}' refers to texture {}, but there are only {}",
-                              source, m.name, m.texture, mesh.textures.size());
+    for (const std::int32_t t : {m.texture, m.alpha_texture}) {
+      if (t >= static_cast<std::int32_t>(mesh.textures.size())) {
+        return Status::BadInput("{}: material '{}' refers to texture {}, but there are only {}",
+                                source, m.name, t, mesh.textures.size());
+      }
+    }
+    if (m.alpha_mode != AlphaMode::kOpaque && m.alpha_mode != AlphaMode::kMask &&
+        m.alpha_mode != AlphaMode::kBlend) {
+      return Status::BadInput("{}: material '{}' has alpha mode {}, not 0, 1 or 2", source, m.name,
+                              static_cast<std::uint32_t>(m.alpha_mode));
+    }
+    if (!std::isfinite(m.alpha_cutoff)) {
+      mesh.warnings.push_back(
+          fmt::format("material '{}' has a non-finite alpha cutoff; 0.5 is used", m.name));
+      m.alpha_cutoff = 0.5f;
     }
   }
 

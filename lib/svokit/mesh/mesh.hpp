@@ -15,6 +15,13 @@
 
 namespace svokit {
 
+/// How a material's alpha is read (glTF's alphaMode; OBJ's d and map_d map onto it).
+enum class AlphaMode : std::uint32_t {
+  kOpaque = 0,  ///< alpha ignored: the surface is opaque everywhere
+  kMask = 1,    ///< a point is surface where base × texture alpha ≥ alpha_cutoff, else a hole
+  kBlend = 2,   ///< alpha is the surface's opacity: it weights coverage, colour and normal
+};
+
 struct Material {
   std::string name;
   Rgba base_color;            ///< linear RGBA; multiplies the texture and vertex colours
@@ -22,6 +29,11 @@ struct Material {
   /// A texture the source named but that could not be found: the material falls back to its
   /// base colour and the import report says so.
   std::string missing_texture;
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5f;  ///< kMask's threshold
+  /// A coverage map of its own (OBJ's map_d), index into Mesh::textures or -1: its alpha channel
+  /// when the image has one, else the mean of its colour channels, replaces the texture's alpha.
+  std::int32_t alpha_texture = -1;
   bool operator==(const Material&) const = default;
 };
 
@@ -53,6 +65,10 @@ struct Mesh {
   bool has_uvs() const { return !uvs.empty(); }
   bool has_colors() const { return !colors.empty(); }
   Box3d Bounds() const;
+  /// Whether any material reads alpha (kMask or kBlend): voxels may then be holes.
+  bool has_alpha() const;
+  /// Whether triangle t's material reads alpha: its voxels may be holes.
+  bool ReadsAlpha(std::size_t t) const;
 };
 
 /// Checks the invariants above and the input's sanity: non-empty, finite positions, indices in

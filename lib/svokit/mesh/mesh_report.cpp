@@ -126,7 +126,8 @@ MeshReport AnalyzeMesh(const Mesh& mesh, const std::string& source, const Report
   }
 
   for (const Material& m : mesh.materials) {
-    r.materials.push_back({m.name, m.base_color, m.texture, m.missing_texture, 0});
+    r.materials.push_back({m.name, m.base_color, m.texture, m.missing_texture, 0, m.alpha_mode,
+                           m.alpha_cutoff, m.alpha_texture});
   }
   for (std::uint32_t id : mesh.material_ids) {
     if (id < r.materials.size()) ++r.materials[id].triangles;
@@ -181,8 +182,12 @@ std::string FormatReportText(const MeshReport& r) {
     } else if (!m.missing_texture.empty()) {
       tex = fmt::format("texture {} MISSING, base colour used", m.missing_texture);
     }
-    s += fmt::format("  [{}] {:<16} {} triangles, colour {}, {}\n", i, m.name, m.triangles,
-                     FormatColor(m.base_color), tex);
+    std::string alpha;
+    if (m.alpha_mode == AlphaMode::kMask) alpha = fmt::format(", alpha mask {}", m.alpha_cutoff);
+    if (m.alpha_mode == AlphaMode::kBlend) alpha = ", alpha blend";
+    if (m.alpha_texture >= 0) alpha += fmt::format(" by {}", r.textures[m.alpha_texture].name);
+    s += fmt::format("  [{}] {:<16} {} triangles, colour {}, {}{}\n", i, m.name, m.triangles,
+                     FormatColor(m.base_color), tex, alpha);
   }
   line("degenerate tris", fmt::format("{}", r.degenerate_triangles));
   line("edges", fmt::format("{} ({} boundary, {} non-manifold, {} inconsistently oriented)",
@@ -221,6 +226,10 @@ std::string FormatReportJson(const MeshReport& r) {
                {"texture", m.texture >= 0 ? json(m.texture) : json(nullptr)}};
     jm["missing_texture"] =
         m.missing_texture.empty() ? json(nullptr) : json(text(m.missing_texture));
+    static constexpr const char* kModes[] = {"opaque", "mask", "blend"};
+    jm["alpha"] = {{"mode", kModes[static_cast<std::uint32_t>(m.alpha_mode)]},
+                   {"cutoff", m.alpha_cutoff},
+                   {"texture", m.alpha_texture >= 0 ? json(m.alpha_texture) : json(nullptr)}};
     j["materials"].push_back(jm);
   }
   j["textures"] = json::array();

@@ -27,6 +27,9 @@ struct MaterialReport {
   std::int32_t texture = -1;
   std::string missing_texture;
   std::uint64_t triangles = 0;
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5f;
+  std::int32_t alpha_texture = -1;
 };
 
 struct MeshReport {

@@ -1,7 +1,8 @@
 // Wavefront OBJ + MTL. Faces are polygons (triangulated by ear clipping); corners reference
 // positions, texture coordinates and normals independently, so attributes become per-corner.
 // Material colours (Kd) are taken as linear values; map_Kd images and "v x y z r g b" vertex
-// colours as sRGB (the usual conventions, as for PLY colours).
+// colours as sRGB (the usual conventions, as for PLY colours). A map_d makes the material
+// alpha-tested (kMask), a dissolve d < 1 translucent (kBlend).
 
 #include <cstring>
 #include <unordered_map>
@@ -280,11 +281,28 @@ class ObjParser {
         float tr = 0;
         SVOKIT_RETURN_IF_ERROR(mtl.Number(tr, "transparency"));
         m->base_color.a = 1.f - tr;
-      } else if (key == "map_Kd") {
+      } else if (key == "map_Kd" || key == "map_d") {
         const std::string image = TextureFileName(mtl.Rest());
         if (!image.empty()) {
-          AttachTextureFile(rule_, mtl_path.parent_path(), image, SideFileSyntax::kPath, *m, mesh_);
+          AttachTextureFile(rule_, mtl_path.parent_path(), image, SideFileSyntax::kPath, *m, mesh_,
+                            key == "map_d" ? TextureUse::kCoverage : TextureUse::kColor);
         }
+      }
+    }
+    // MTL has no alpha mode: a coverage map cuts the surface out (alpha testing, what map_d is
+    // used for: foliage, fences), unless dissolve also makes it translucent; dissolve alone blends.
+    for (Material& material : mesh_.materials) {
+      if (material.base_color.a <= 0.f && material.alpha_mode == AlphaMode::kOpaque) {
+        // Exporters that write Tr as opacity give "Tr 1": an invisible material is that mistake.
+        mesh_.warnings.push_back(fmt::format(
+            "material '{}': dissolve 0 would leave it invisible; it is opaque", material.name));
+        material.base_color.a = 1.f;
+      }
+      const bool translucent = material.base_color.a < 1.f;
+      if (material.alpha_texture >= 0) {
+        material.alpha_mode = translucent ? AlphaMode::kBlend : AlphaMode::kMask;
+      } else if (translucent) {
+        material.alpha_mode = AlphaMode::kBlend;
       }
     }
     return Status::Ok();

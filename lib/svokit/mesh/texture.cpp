@@ -131,45 +131,48 @@ namespace detail {
 
 void AttachTextureFile(const SideFileRule& rule, const std::filesystem::path& folder,
                        const std::string& reference, SideFileSyntax syntax, Material& material,
-                       Mesh& mesh) {
+                       Mesh& mesh, TextureUse use) {
+  const bool coverage = use == TextureUse::kCoverage;
+  std::int32_t& slot = coverage ? material.alpha_texture : material.texture;
+  const char* fallback = coverage ? "the material is opaque" : "using base colour";
   // glTF names its images by URI: the name kept is the decoded one ("my tex.png").
   const std::string uri = syntax == SideFileSyntax::kUri ? PercentDecode(reference) : reference;
   StatusOr<std::filesystem::path> file = rule.Resolve(reference, syntax, folder);
   if (!file.ok()) {
-    material.missing_texture = uri;
-    mesh.warnings.push_back(
-        fmt::format("material '{}': texture '{}' {}: not read, using base colour", material.name,
-                    uri, file.status().message()));
+    if (!coverage) material.missing_texture = uri;
+    mesh.warnings.push_back(fmt::format("material '{}': texture '{}' {}: not read, {}",
+                                        material.name, uri, file.status().message(), fallback));
     return;
   }
   StatusOr<std::vector<std::uint8_t>> bytes = ReadFileBytes(*file, kSideFileLimit);
   if (!bytes.ok() || bytes->empty()) {
-    material.missing_texture = uri;
+    if (!coverage) material.missing_texture = uri;
     const std::string why = bytes.ok() ? std::string() : UnreadableReason(bytes.status(), *file);
     mesh.warnings.push_back(
-        why.empty() ? fmt::format("material '{}': texture '{}' not found, using base colour",
-                                  material.name, uri)
-                    : fmt::format("material '{}': texture '{}' {}, using base colour",
-                                  material.name, uri, why));
+        why.empty()
+            ? fmt::format("material '{}': texture '{}' not found, {}", material.name, uri, fallback)
+            : fmt::format("material '{}': texture '{}' {}, {}", material.name, uri, why, fallback));
     return;
   }
   mesh.side_files.push_back(*file);
   // Bytes that are not an image svokit reads are never stored (they may be any file at all).
   if (StatusOr<ImageHeader> header = ReadImageHeader(uri, *bytes); !header.ok()) {
-    material.missing_texture = uri;
-    mesh.warnings.push_back(fmt::format("material '{}': {}; using base colour", material.name,
-                                        header.status().message()));
+    if (!coverage) material.missing_texture = uri;
+    mesh.warnings.push_back(
+        fmt::format("material '{}': {}; {}", material.name, header.status().message(), fallback));
     return;
   }
-  // Several materials often share one image: embed it once.
+  // Several materials often share one image: embed it once. A coverage map is linear data.
+  const bool srgb = !coverage;
   for (std::size_t i = 0; i < mesh.textures.size(); ++i) {
-    if (mesh.textures[i].name() == uri && mesh.textures[i].encoded() == *bytes) {
-      material.texture = static_cast<std::int32_t>(i);
+    if (mesh.textures[i].name() == uri && mesh.textures[i].srgb() == srgb &&
+        mesh.textures[i].encoded() == *bytes) {
+      slot = static_cast<std::int32_t>(i);
       return;
     }
   }
-  mesh.textures.emplace_back(uri, std::move(bytes).value());
-  material.texture = static_cast<std::int32_t>(mesh.textures.size() - 1);
+  mesh.textures.emplace_back(uri, std::move(bytes).value(), srgb);
+  slot = static_cast<std::int32_t>(mesh.textures.size() - 1);
 }
 
 }  // namespace detail

@@ -39,6 +39,7 @@ VoxelizeOptions VoxelizeRequest::Options() const {
   o.mode = settings.mode;
   o.colors = settings.colors;
   o.normals = settings.normals;
+  o.alpha = !settings.solid;
   return o;
 }
 

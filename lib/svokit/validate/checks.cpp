@@ -293,6 +293,7 @@ CheckResult CheckContourSurface(const Svo& svo,
   }
   SlabSampleOptions options;
   options.max_violations = r.max_examples;
+  options.holes = !svo.solid;
   return ContourSurfaceResult(
       SampleContourSlabs(mesh, svo.grid, svo.depth, level_keys, NodeContours(svo), options),
       svo.mode);

@@ -93,7 +93,9 @@ std::vector<std::vector<std::uint32_t>> NodeContours(const Svo& svo);
 ///  - thin files: thin ⊆ conservative, so the same bound for extra voxels; a voxel whose centre
 ///    lies within h/(2√3) of the surface must be a leaf (the plane test then holds along any
 ///    dominant axis and the projections meet every inner diamond).
-/// Distances are compared with a tolerance of kDistanceTolerance voxels.
+/// Distances are compared with a tolerance of kDistanceTolerance voxels. Where materials read
+/// alpha (a surface's, not a solid's), their triangles' voxels may be holes: only the opaque
+/// triangles' are required.
 CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& leaf_keys,
                            const Mesh& mesh);
 inline constexpr double kDistanceTolerance = 1e-4;

@@ -66,6 +66,7 @@ SlabSampleResult SampleContourSlabsOf(const Mesh& mesh, const GridTransform& gri
       const std::size_t t = triangles[n];
       // Sampled in voxel space, the voxelizer's frame: world areas of a 1e-300 mesh underflow.
       const Triangle& tri = mesh.triangles[t];
+      const bool may_be_hole = options.holes && mesh.ReadsAlpha(t);
       const Vec3d a = grid.WorldToVoxel(mesh.positions[tri[0]]),
                   b = grid.WorldToVoxel(mesh.positions[tri[1]]),
                   c = grid.WorldToVoxel(mesh.positions[tri[2]]);
@@ -134,7 +135,7 @@ SlabSampleResult SampleContourSlabsOf(const Mesh& mesh, const GridTransform& gri
               }
             }
           }
-          if (!found) ++r.orphans;
+          if (!found && !may_be_hole) ++r.orphans;
         }
       }
     }

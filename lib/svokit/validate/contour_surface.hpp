@@ -22,6 +22,9 @@ struct SlabSampleOptions {
   int interior = 0;
   std::uint64_t seed = 20240601;
   std::size_t max_violations = 10;  ///< kept in `first`
+  /// The file is a surface whose materials' alpha made holes: points of triangles that read
+  /// alpha may lie in no node (no orphans), those in a node must lie in its slab.
+  bool holes = false;
 };
 
 struct SlabViolation {

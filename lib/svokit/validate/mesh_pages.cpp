@@ -115,7 +115,7 @@ struct MeshChecks::Impl {
   VoxelMode mode;
   std::uint32_t depth, page_level;
   std::int64_t side;
-  bool contours;
+  bool contours, solid;
   CubeOccupancy occupancy;
   Bins near, owned;
   // The top chunk's levels for the contour points, looked up by every cube.
@@ -131,7 +131,8 @@ struct MeshChecks::Impl {
         page_level(reader.page_level()),
         side(std::int64_t{1} << (depth - page_level)),
         contours(reader.shape().has_contours),
-        occupancy(m, reader.grid(), reader.mode()) {}
+        solid(reader.shape().solid),
+        occupancy(m, reader.grid(), reader.mode(), solid) {}
 };
 
 MeshChecks::MeshChecks(const Mesh& mesh, const SvoReader& reader, Progress& progress)
@@ -225,6 +226,7 @@ MeshPart MeshChecks::Check(std::uint64_t cube, const LocalOctree& local) const {
     levels.push_back({index.back().get(), local.words[l]});
   }
   SlabSampleOptions options;
+  options.holes = !m.solid;
   out.slabs = SampleContourSlabsOf(m.mesh, m.grid, m.depth, levels, m.owned.Of(cube), owns, options,
                                    &out.slab_order);
   return out;

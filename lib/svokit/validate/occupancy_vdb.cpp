@@ -29,6 +29,9 @@ struct SnappedMesh {
   std::vector<openvdb::Vec3d> points;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::array<openvdb::Vec3d, 2>> segments;  // degenerate triangles (a point: p == q)
+  // Per triangle and segment, when some material reads alpha: 1 where the primitive's material
+  // does, so its voxels may be holes (none is then required). Empty: every primitive is opaque.
+  std::vector<std::uint8_t> triangle_holes, segment_holes;
 
   std::size_t polygonCount() const { return triangles.size(); }
   std::size_t pointCount() const { return points.size(); }
@@ -38,15 +41,17 @@ struct SnappedMesh {
   }
 };
 
-SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid) {
+SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid, bool holes) {
   const std::vector<FixedPoint3> fixed = SnapToVoxelSpace(mesh, grid);
+  auto may_be_hole = [&](std::size_t t) -> std::uint8_t { return mesh.ReadsAlpha(t); };
   SnappedMesh out;
   out.points.reserve(fixed.size());
   for (const FixedPoint3& p : fixed) {
     const Vec3d v = FixedToVoxel(p);
     out.points.emplace_back(v.x - 0.5, v.y - 0.5, v.z - 0.5);
   }
-  for (const Triangle& t : mesh.triangles) {
+  for (std::size_t index = 0; index < mesh.triangles.size(); ++index) {
+    const Triangle& t = mesh.triangles[index];
     const FixedPoint3 &a = fixed[t[0]], &b = fixed[t[1]], &c = fixed[t[2]];
     Int128 e0[3], e1[3];
     for (int ax = 0; ax < 3; ++ax) {
@@ -58,8 +63,10 @@ SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid) {
                             e0[0] * e1[1] - e0[1] * e1[0] == 0;
     if (!degenerate) {
       out.triangles.push_back({t[0], t[1], t[2]});
+      if (holes) out.triangle_holes.push_back(may_be_hole(index));
       continue;
     }
+    if (holes) out.segment_holes.push_back(may_be_hole(index));
     // Collinear corners: the two farthest apart span the others.
     const openvdb::Vec3d &pa = out.points[t[0]], &pb = out.points[t[1]], &pc = out.points[t[2]];
     const double ab = (pb - pa).lengthSqr(), ac = (pc - pa).lengthSqr(), bc = (pc - pb).lengthSqr();
@@ -72,6 +79,19 @@ SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid) {
     }
   }
   return out;
+}
+
+// The primitives whose voxels are required: the opaque ones (all of them when none reads alpha).
+const SnappedMesh& RequiredPart(const SnappedMesh& mesh, SnappedMesh& storage) {
+  if (mesh.triangle_holes.empty() && mesh.segment_holes.empty()) return mesh;
+  storage.points = mesh.points;
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (!mesh.triangle_holes[i]) storage.triangles.push_back(mesh.triangles[i]);
+  }
+  for (std::size_t i = 0; i < mesh.segments.size(); ++i) {
+    if (!mesh.segment_holes[i]) storage.segments.push_back(mesh.segments[i]);
+  }
+  return storage;
 }
 
 // Lowers the distance of every voxel centre within `band` of a segment to its exact distance,
@@ -110,6 +130,34 @@ struct Located {
   double distance;  // voxels
 };
 
+// A band of 2 voxels: OpenVDB's first pass computes the exact distance (double closest point)
+// of every voxel within √3/2 voxel of a triangle, and everything else reads as ≥ 2 h.
+constexpr float kBand = 2.0f;
+
+// The unsigned distance field of `mesh` in voxels, in the voxelizer's own frame: a unit index
+// transform, whatever the world's voxel size (OpenVDB refuses scales near 0, and floats overflow
+// near 1e38).
+openvdb::FloatGrid::Ptr DistanceField(const SnappedMesh& mesh) {
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
+  openvdb::FloatGrid::Ptr distance;
+  if (mesh.triangles.empty()) {
+    distance = openvdb::FloatGrid::create(kBand);
+    distance->setTransform(transform);
+  } else {
+    distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        mesh, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
+  }
+  AddSegmentDistances(mesh, kBand, *distance);
+  return distance;
+}
+
+// The field the required voxels are read from: `all`'s unless some primitive may be a hole.
+openvdb::FloatGrid::Ptr RequiredField(const SnappedMesh& mesh, openvdb::FloatGrid::Ptr all) {
+  SnappedMesh storage;
+  const SnappedMesh& required = RequiredPart(mesh, storage);
+  return &required == &mesh ? all : DistanceField(required);
+}
+
 void InitializeOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
@@ -131,16 +179,10 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
   r.note = fmt::format("{}: leaf required within {:.4f} h, allowed within {:.4f} h (± {} h)",
                        thin ? "thin" : "conservative", required, allowed, tol);
 
-  const SnappedMesh snapped = Snap(mesh, svo.grid);
-  // Distances in voxels, in the voxelizer's own frame: a unit index transform, whatever the
-  // world's voxel size (OpenVDB refuses scales near 0, and floats overflow near 1e38).
-  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
-  // A band of 2 voxels: OpenVDB's first pass computes the exact distance (double closest point)
-  // of every voxel within √3/2 voxel of a triangle, and everything else reads as ≥ 2 h.
-  constexpr float kBand = 2.0f;
-  const openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      snapped, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
-  AddSegmentDistances(snapped, kBand, *distance);
+  // A surface's materials reading alpha may leave holes (a solid's never: alpha is off there).
+  const SnappedMesh snapped = Snap(mesh, svo.grid, mesh.has_alpha() && !svo.solid);
+  const openvdb::FloatGrid::Ptr distance = DistanceField(snapped);
+  const openvdb::FloatGrid::Ptr required_distance = RequiredField(snapped, distance);
 
   // Extra voxels: leaves whose centre is farther than allowed. Chunks in key order, each keeping
   // its first examples, so the reported ones are the first in Morton order for any thread count.
@@ -162,7 +204,7 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
 
   // Missing voxels: distance-grid voxels closer than `required` that are no leaf.
   const KeyIndex leaves(leaf_keys);
-  openvdb::tree::LeafManager<const openvdb::FloatTree> manager(distance->tree());
+  openvdb::tree::LeafManager<const openvdb::FloatTree> manager(required_distance->tree());
   std::mutex mutex;
   std::vector<Located> missing;
   std::uint64_t near = 0;
@@ -237,10 +279,11 @@ struct CubeOccupancy::Impl {
   std::uint32_t depth = 0;
 };
 
-CubeOccupancy::CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelMode mode)
+CubeOccupancy::CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelMode mode,
+                             bool solid)
     : impl_(std::make_unique<Impl>()) {
   InitializeOpenVdb();
-  impl_->snapped = Snap(mesh, grid);
+  impl_->snapped = Snap(mesh, grid, mesh.has_alpha() && !solid);
   impl_->thin = mode == VoxelMode::kThin;
   impl_->required = impl_->thin ? 0.5 / std::sqrt(3.0) : 0.5;
   impl_->allowed = 0.5 * std::sqrt(3.0);
@@ -287,28 +330,23 @@ void CubeOccupancy::Check(const std::array<std::int64_t, 3>& lo, std::int64_t si
   // The cube's primitives alone: the distance at the cube's voxels is the whole mesh's, since
   // every primitive within the band's reach of them is here.
   SnappedMesh part;
+  const SnappedMesh& all = m.snapped;
   for (const std::uint32_t i : near) {
-    if (i < m.snapped.triangles.size()) {
-      const auto& t = m.snapped.triangles[i];
+    if (i < all.triangles.size()) {
+      const auto& t = all.triangles[i];
       const auto base = static_cast<std::uint32_t>(part.points.size());
-      for (int v = 0; v < 3; ++v) part.points.push_back(m.snapped.points[t[v]]);
+      for (int v = 0; v < 3; ++v) part.points.push_back(all.points[t[v]]);
       part.triangles.push_back({base, base + 1, base + 2});
+      if (!all.triangle_holes.empty()) part.triangle_holes.push_back(all.triangle_holes[i]);
     } else {
-      part.segments.push_back(m.snapped.segments[i - m.snapped.triangles.size()]);
+      const std::size_t segment = i - all.triangles.size();
+      part.segments.push_back(all.segments[segment]);
+      if (!all.segment_holes.empty()) part.segment_holes.push_back(all.segment_holes[segment]);
     }
   }
   out.leaves += leaves.size();
-  openvdb::FloatGrid::Ptr distance;
-  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform();
-  constexpr float kBand = 2.0f;
-  if (part.triangles.empty()) {
-    distance = openvdb::FloatGrid::create(kBand);
-    distance->setTransform(transform);
-  } else {
-    distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-        part, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
-  }
-  AddSegmentDistances(part, kBand, *distance);
+  const openvdb::FloatGrid::Ptr distance = DistanceField(part);
+  const openvdb::FloatGrid::Ptr required_distance = RequiredField(part, distance);
   const auto report = [&](const char* kind, std::uint64_t key, double d, const char* what) {
     const MortonCoord c = MortonDecode(key);
     return Finding{kind,
@@ -329,7 +367,7 @@ void CubeOccupancy::Check(const std::array<std::int64_t, 3>& lo, std::int64_t si
     }
   }
   std::vector<Located> missing;
-  for (auto it = distance->tree().cbeginValueOn(); it; ++it) {
+  for (auto it = required_distance->tree().cbeginValueOn(); it; ++it) {
     const double d = static_cast<double>(*it);
     if (d > m.required - tol) continue;
     const openvdb::Coord ijk = it.getCoord();

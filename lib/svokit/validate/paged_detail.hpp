@@ -91,7 +91,8 @@ struct MeshTotals {
 /// that includes OpenVDB: occupancy_vdb.cpp).
 class CubeOccupancy {
  public:
-  CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelMode mode);
+  /// `solid`: the file's interior is filled, so its materials' alpha made no holes.
+  CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelMode mode, bool solid);
   ~CubeOccupancy();
   /// Triangles and segments (degenerate triangles) the check measures, and each one's bounding
   /// box in voxels.

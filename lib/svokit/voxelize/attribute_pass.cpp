@@ -248,11 +248,17 @@ class BrickOutput {
 
 // One pass brick's voxels (a bit set) and their area-weighted sums, indexed by local Morton code.
 // Colours are summed only when they differ between voxels (else the set holds the shared one),
-// in an array of their own that is otherwise never touched.
+// in an array of their own that is otherwise never touched. A sample's opacity (its colour's
+// alpha: 1 unless its material reads alpha) weights its colour, normal and coverage; with
+// `holes`, a voxel whose samples all have opacity 0 is left out.
 class BrickAccumulator {
  public:
-  BrickAccumulator(bool colors, bool normals, bool sums)
-      : color_sums_(colors ? kVoxels : 0), colors_(colors), normals_(normals), sums_on_(sums) {}
+  BrickAccumulator(bool colors, bool normals, bool sums, bool holes)
+      : color_sums_(colors ? kVoxels : 0),
+        colors_(colors),
+        normals_(normals),
+        sums_on_(sums),
+        holes_(holes) {}
   static constexpr std::size_t kVoxels = PassBrick::kVoxels;
   // Zero-area contacts (a triangle grazing a voxel's edge) get a tiny weight, so a voxel touched
   // only that way still averages its contacts.
@@ -261,33 +267,55 @@ class BrickAccumulator {
   // A voxel without sums (a walk for the voxels alone).
   void Mark(std::uint32_t local) { bits_[local >> 6] |= std::uint64_t{1} << (local & 63); }
   void Add(std::uint32_t local, double area, const Rgba& color, const Vec3f& normal) {
-    bits_[local >> 6] |= std::uint64_t{1} << (local & 63);
+    const std::uint64_t bit = std::uint64_t{1} << (local & 63);
+    bits_[local >> 6] |= bit;
+    const double opacity = color.a;
+    if (opacity > 0) surface_[local >> 6] |= bit;
     Sum& sum = sums_[local];
-    const double w = area + kMinWeight;
-    sum.area += area;
+    const double w = area + kMinWeight, wo = w * opacity;
+    sum.area += area * opacity;
     if (colors_) {
       ColorSum& c = color_sums_[local];
       c.weight += w;
-      c.r += color.r * w, c.g += color.g * w, c.b += color.b * w, c.a += color.a * w;
+      c.opaque += wo;
+      c.r += color.r * wo, c.g += color.g * wo, c.b += color.b * wo;
     }
-    sum.nx += normal.x * w, sum.ny += normal.y * w, sum.nz += normal.z * w;
+    sum.nx += normal.x * wo, sum.ny += normal.y * wo, sum.nz += normal.z * wo;
   }
   // Appends the brick's voxels (bits set in local Morton order = key order) to `out`, and
   // clears the brick.
   void Finish(std::uint64_t brick, VoxelRun& out) {
     std::uint16_t* locals = locals_.data();
-    std::size_t n = 0;
+    std::size_t n = 0, marked = 0;
     for (std::size_t word = 0; word < bits_.size(); ++word) {
       for (std::uint64_t bits = bits_[word]; bits != 0; bits &= bits - 1) {
-        locals[n++] = static_cast<std::uint16_t>(word * 64 + std::countr_zero(bits));
+        locals[marked++] = static_cast<std::uint16_t>(word * 64 + std::countr_zero(bits));
       }
-      bits_[word] = 0;
     }
+    if (holes_) {
+      for (std::size_t i = 0; i < marked; ++i) {
+        const std::uint16_t local = locals[i];
+        if (surface_[local >> 6] >> (local & 63) & 1) {
+          locals[n++] = local;
+        } else {
+          sums_[local] = {};
+          if (colors_) color_sums_[local] = {};
+        }
+      }
+      surface_ = {};
+    } else {
+      n = marked;
+    }
+    bits_ = {};
     const std::size_t at = out.keys.size();
     const std::uint64_t base = brick << PassBrick::kCodeBits;
     out.keys.resize(at + n);
     if (!sums_on_) {
       for (std::size_t i = 0; i < n; ++i) out.keys[at + i] = base | locals[i];
+      // Sums taken for the holes alone.
+      if (holes_) {
+        for (std::size_t i = 0; i < n; ++i) sums_[locals[i]] = {};
+      }
       return;
     }
     out.coverage.resize(at + n);
@@ -300,9 +328,11 @@ class BrickAccumulator {
       out.colors.resize(at + n);
       for (std::size_t i = 0; i < n; ++i) {
         ColorSum& c = color_sums_[locals[i]];
-        const double inv = 1.0 / c.weight;  // ≥ kMinWeight
+        const double inv = c.opaque > 0 ? 1.0 / c.opaque : 0.0;
+        // Opacity: the opaque part of the voxel's surface (exactly 1 when all of it is).
+        const double alpha = c.opaque == c.weight ? 1.0 : c.opaque / c.weight;
         out.colors[at + i] = Rgba{static_cast<float>(c.r * inv), static_cast<float>(c.g * inv),
-                                  static_cast<float>(c.b * inv), static_cast<float>(c.a * inv)};
+                                  static_cast<float>(c.b * inv), static_cast<float>(alpha)};
         c = {};
       }
     }
@@ -331,13 +361,14 @@ class BrickAccumulator {
     double area = 0, nx = 0, ny = 0, nz = 0;
   };
   struct ColorSum {
-    double weight = 0, r = 0, g = 0, b = 0, a = 0;
+    double weight = 0, opaque = 0, r = 0, g = 0, b = 0;
   };
   std::array<std::uint64_t, kVoxels / 64> bits_{};
+  std::array<std::uint64_t, kVoxels / 64> surface_{};  // voxels with an opacity above 0
   std::array<std::uint16_t, kVoxels> locals_;
   std::array<Sum, kVoxels> sums_{};
   std::vector<ColorSum> color_sums_;
-  bool colors_, normals_, sums_on_;
+  bool colors_, normals_, sums_on_, holes_;
 };
 
 // Voxels with attributes, brick by brick: every triangle of a brick's bin, in index order, walks
@@ -347,8 +378,13 @@ class BrickAccumulator {
 class BrickPass {
  public:
   BrickPass(const MeshVoxelizer& voxelizer, const AttributeSampler& sampler, bool colors,
-            bool normals, bool sums)
-      : voxelizer_(voxelizer), sampler_(sampler), colors_(colors), normals_(normals), sums_(sums) {}
+            bool normals, bool sums, bool holes)
+      : voxelizer_(voxelizer),
+        sampler_(sampler),
+        colors_(colors),
+        normals_(normals),
+        sums_(sums),
+        holes_(holes) {}
 
   /// `bins`: the (brick, triangle) pairs BinToCells listed, per chunk of triangles in index
   /// order (each brick of a triangle once); `reserve`: room for the voxels to reserve up front
@@ -374,7 +410,7 @@ class BrickPass {
     SVOKIT_RETURN_IF_ERROR(output.Reserve(reserve, bricks));
     Progress::Stage stage(progress, "attributes", bricks);
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator>> accumulators(
-        [&] { return std::make_unique<BrickAccumulator>(colors_, normals_, sums_); });
+        [&] { return std::make_unique<BrickAccumulator>(colors_, normals_, sums_, holes_); });
     tbb::enumerable_thread_specific<std::unique_ptr<TriangleCache>> caches(
         [] { return std::make_unique<TriangleCache>(); });
     // Groups of kGroupBricks bricks: numbered in order, filled in parallel into a free buffer,
@@ -452,7 +488,7 @@ class BrickPass {
         voxelizer_.Prefetch(pairs[i + 1].triangle, MeshVoxelizer::kVertices);
       const TriangleCache::Entry& entry = cache.Get(pairs[i].triangle, voxelizer_, sampler_);
       const TriangleVoxelizer& tv = *entry.tv;
-      if (!sums_) {
+      if (!sums_ && !holes_) {
         const int w = tv.dominant_axis(), u = (w + 1) % 3, v = (w + 2) % 3;
         tv.RunsAlongAxis(
             lo[u], lo[u] + kPassSide, lo[v], lo[v] + kPassSide, lo[w], lo[w] + kPassSide,
@@ -495,7 +531,27 @@ class BrickPass {
 
   const MeshVoxelizer& voxelizer_;
   const AttributeSampler& sampler_;
-  bool colors_, normals_, sums_;
+  bool colors_, normals_, sums_, holes_;
+};
+
+// Passes everything on to `inner`, keeping the voxel count.
+class CountingOutput : public VoxelOutput {
+ public:
+  explicit CountingOutput(VoxelOutput& inner) : inner_(inner) {}
+  bool packed() const override { return inner_.packed(); }
+  StatusOr<OutputArrays> Reserve(const PackedVoxelContents& contents, std::size_t voxels,
+                                 std::size_t key_bytes) override {
+    return inner_.Reserve(contents, voxels, key_bytes);
+  }
+  void Finish(VoxelAttributes attributes, const PackedVoxelContents& contents, std::uint64_t voxels,
+              std::size_t key_bytes) override {
+    count = voxels;
+    inner_.Finish(std::move(attributes), contents, voxels, key_bytes);
+  }
+  std::uint64_t count = 0;
+
+ private:
+  VoxelOutput& inner_;
 };
 
 }  // namespace
@@ -524,7 +580,7 @@ Status VoxelizeWithSampler(const MeshVoxelizer& voxelizer, const AttributeSample
   const bool colors = options.colors && !shared_color;
   const PackedVoxelContents contents{colors, options.normals, sums,
                                      sums && shared_color.has_value()};
-  BrickPass pass(voxelizer, sampler, colors, options.normals, sums);
+  BrickPass pass(voxelizer, sampler, colors, options.normals, sums, sampler.reads_alpha());
   BrickOutput brick_output(output, contents);
   SVOKIT_RETURN_IF_ERROR(pass.Run(bins, reserve, brick_output, progress));
   output.Finish(std::move(attributes), contents, brick_output.count(), brick_output.bytes());
@@ -535,12 +591,20 @@ Status VoxelizeWithAttributes(const MeshVoxelizer& voxelizer, const VoxelizeOpti
                               double projected_area, VoxelAttributes attributes,
                               VoxelOutput& output, Progress& progress) {
   const AttributeSampler sampler(voxelizer.mesh(), voxelizer.vertices(), options.colors,
-                                 options.normals);
+                                 options.normals, options.alpha);
   attributes.warnings = sampler.warnings();
   // Curved surfaces fill ~1.75 voxels per voxel² of projected area, flat ones ~1.
-  return VoxelizeWithSampler(voxelizer, sampler, sampler.SharedColor(), options,
-                             static_cast<std::size_t>(2.0 * projected_area) + voxelizer.size(),
-                             std::move(attributes), output, progress);
+  CountingOutput counted(output);
+  SVOKIT_RETURN_IF_ERROR(
+      VoxelizeWithSampler(voxelizer, sampler, sampler.SharedColor(), options,
+                          static_cast<std::size_t>(2.0 * projected_area) + voxelizer.size(),
+                          std::move(attributes), counted, progress));
+  if (counted.count == 0 && sampler.reads_alpha()) {
+    return Status::BadInput(
+        "every surface is transparent (alpha 0, or below the mask's cutoff, everywhere): no "
+        "voxels");
+  }
+  return Status::Ok();
 }
 
 }  // namespace svokit::voxelize_detail

@@ -102,57 +102,155 @@ ClipVertex NearestPoint(const Frame& f) {
 
 }  // namespace
 
+namespace {
+
+// The RGBA image a material's lookups read when it reads alpha: the colour texture's texels (white
+// without one) premultiplied by the coverage (the colour texture's alpha, or the coverage map's),
+// which a mask first tests against its cutoff: so the pyramid's box filter averages surface only,
+// and a texel's coverage is 0 or 1 before filtering (alpha testing, then filtering: no leaf
+// thins out with distance).
+Image SurfaceImage(const Image* color, const Image* coverage, bool coverage_has_alpha,
+                   const Material& material) {
+  const Image& shape = color ? *color : *coverage;
+  Image out;
+  out.width = shape.width;
+  out.height = shape.height;
+  out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
+  const bool mask = material.alpha_mode == AlphaMode::kMask;
+  ParallelChunks(static_cast<std::size_t>(out.height), 16, [&](std::size_t y0, std::size_t y1) {
+    for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
+      for (int x = 0; x < out.width; ++x) {
+        Rgba t = color ? color->Texel(x, y) : Rgba{};
+        if (coverage) {
+          // A coverage map of another size (the texture budget may shrink either): its texel
+          // under this one's centre.
+          const int cx = static_cast<int>((x + 0.5) * coverage->width / out.width);
+          const int cy = static_cast<int>((y + 0.5) * coverage->height / out.height);
+          const Rgba c = coverage->Texel(std::min(cx, coverage->width - 1),
+                                         std::min(cy, coverage->height - 1));
+          t.a = coverage_has_alpha ? c.a : (c.r + c.g + c.b) / 3.f;
+        }
+        float a = std::clamp(t.a, 0.f, 1.f);
+        if (mask) a = material.base_color.a * a >= material.alpha_cutoff ? 1.f : 0.f;
+        float* q = &out.rgba[(static_cast<std::size_t>(y) * out.width + x) * 4];
+        q[0] = t.r * a, q[1] = t.g * a, q[2] = t.b * a, q[3] = a;
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
 AttributeSampler::AttributeSampler(const Mesh& mesh, const std::vector<FixedPoint3>& vertices,
-                                   bool want_color, bool want_normal)
+                                   bool want_color, bool want_normal, bool want_alpha)
     : mesh_(mesh), vertices_(vertices), want_color_(want_color), want_normal_(want_normal) {
   materials_.resize(mesh.materials.size());
   for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
     materials_[m].base_color = mesh.materials[m].base_color;
+    if (want_alpha) {
+      materials_[m].mode = mesh.materials[m].alpha_mode;
+      materials_[m].cutoff = mesh.materials[m].alpha_cutoff;
+    }
   }
-  if (!want_color || !mesh.has_uvs() || mesh.textures.empty()) return;
+  if (!mesh.has_uvs() || mesh.textures.empty()) return;
 
-  // Decode (and build the pyramids of) only the textures some triangle's material uses.
+  // The images some triangle's material reads: its colour texture when colours are wanted, and
+  // its coverage when it reads alpha. One surface image per material that reads alpha.
+  auto valid = [&](std::int32_t t) {
+    return t >= 0 && static_cast<std::size_t>(t) < mesh.textures.size();
+  };
   std::vector<std::uint8_t> material_used(mesh.materials.size(), 0);
   for (std::uint32_t id : mesh.material_ids) {
     if (id < material_used.size()) material_used[id] = 1;
   }
   std::vector<std::uint8_t> texture_used(mesh.textures.size(), 0);
   for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
-    const std::int32_t t = mesh.materials[m].texture;
-    if (material_used[m] && t >= 0 && static_cast<std::size_t>(t) < mesh.textures.size()) {
-      texture_used[t] = 1;
-    }
+    if (!material_used[m]) continue;
+    const Material& material = mesh.materials[m];
+    const bool alpha = materials_[m].mode != AlphaMode::kOpaque;
+    if ((want_color || alpha) && valid(material.texture)) texture_used[material.texture] = 1;
+    if (alpha && valid(material.alpha_texture)) texture_used[material.alpha_texture] = 1;
   }
   std::vector<std::size_t> used;
   for (std::size_t t = 0; t < texture_used.size(); ++t) {
     if (texture_used[t]) used.push_back(t);
   }
+  if (used.empty()) return;
   // All the textures within one memory budget, decided in texture order (mesh/texture_budget.hpp).
   BudgetedTextures decoded = DecodeTexturesWithinBudget(mesh.textures, used);
   images_ = std::move(decoded.images);
   std::vector<Status>& errors = decoded.errors;
   warnings_.insert(warnings_.end(), decoded.warnings.begin(), decoded.warnings.end());
-  textures_.resize(mesh.textures.size());
-  ParallelChunks(used.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t t = used[i];
-      if (errors[t].ok()) textures_[t] = TextureSampler(images_[t]);
-    }
-  });
   for (std::size_t t : used) {
     // A texture that cannot be decoded is the input's fault; memory running out is not.
     if (errors[t].code() == StatusCode::kOutOfMemory) throw OutOfMemoryError(errors[t].message());
     if (!errors[t].ok()) {
       warnings_.push_back(errors[t].message() + "; its materials use their base colour");
-    } else if (!textures_[t].valid()) {
+    } else if (images_[t].width == 0 || images_[t].height == 0) {
       warnings_.push_back("texture '" + mesh.textures[t].name() +
                           "' is empty; its materials use their base colour");
+      errors[t] = Status::BadInput("empty");
     }
   }
+  auto image = [&](std::int32_t t) -> const Image* {
+    return valid(t) && texture_used[t] && errors[t].ok() ? &images_[t] : nullptr;
+  };
+
+  // Samplers: one per texture read as decoded (opaque materials' colour), one per material
+  // reading alpha. Their images are all made before any sampler refers to one.
+  std::vector<std::int32_t> sampler_of_texture(mesh.textures.size(), -1);
+  std::vector<std::int32_t> sampler_of_material(mesh.materials.size(), -1);
+  std::vector<const Image*> sampler_images;
+  std::vector<std::uint8_t> texture_read_as_is(mesh.textures.size(), 0);
+  std::vector<std::size_t> alpha_materials;
   for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
-    const std::int32_t t = mesh.materials[m].texture;
-    if (t >= 0 && static_cast<std::size_t>(t) < textures_.size() && textures_[t].valid()) {
-      materials_[m].texture = &textures_[t];
+    if (!material_used[m]) continue;
+    const Material& material = mesh.materials[m];
+    if (materials_[m].mode != AlphaMode::kOpaque) {
+      if (image(material.texture) || image(material.alpha_texture)) alpha_materials.push_back(m);
+    } else if (want_color && image(material.texture)) {
+      texture_read_as_is[material.texture] = 1;
+    }
+  }
+  surface_images_.resize(alpha_materials.size());
+  ParallelChunks(alpha_materials.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Material& material = mesh.materials[alpha_materials[i]];
+      const Image* coverage = image(material.alpha_texture);
+      bool coverage_has_alpha = false;
+      if (coverage) {
+        const StatusOr<Texture::Info> info = mesh.textures[material.alpha_texture].ReadInfo();
+        coverage_has_alpha = info.ok() && (info->channels == 2 || info->channels == 4);
+      }
+      surface_images_[i] =
+          SurfaceImage(image(material.texture), coverage, coverage_has_alpha, material);
+    }
+  });
+  for (std::size_t i = 0; i < alpha_materials.size(); ++i) {
+    sampler_of_material[alpha_materials[i]] = static_cast<std::int32_t>(sampler_images.size());
+    sampler_images.push_back(&surface_images_[i]);
+  }
+  for (std::size_t t = 0; t < texture_read_as_is.size(); ++t) {
+    if (texture_read_as_is[t]) {
+      sampler_of_texture[t] = static_cast<std::int32_t>(sampler_images.size());
+      sampler_images.push_back(&images_[t]);
+    } else {
+      images_[t] = Image{};  // only surface images read it: its memory goes back
+    }
+  }
+  textures_.resize(sampler_images.size());
+  ParallelChunks(sampler_images.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) textures_[i] = TextureSampler(*sampler_images[i]);
+  });
+  for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
+    const std::int32_t s = sampler_of_material[m] >= 0 ? sampler_of_material[m]
+                           : valid(mesh.materials[m].texture)
+                               ? sampler_of_texture[mesh.materials[m].texture]
+                               : -1;
+    if (s >= 0) {
+      materials_[m].texture = &textures_[s];
+      materials_[m].premultiplied = sampler_of_material[m] >= 0;
     }
   }
 }
@@ -169,11 +267,36 @@ std::optional<Rgba> AttributeSampler::SharedColor() const {
   for (std::size_t m = 0; m < used.size(); ++m) {
     if (!used[m]) continue;
     if (m < materials_.size() && materials_[m].texture && mesh_.has_uvs()) return std::nullopt;
-    const Rgba color = m < materials_.size() ? materials_[m].base_color : Rgba{};
+    // A material reading alpha may make holes: its voxels are not all alike.
+    if (m < materials_.size() && materials_[m].mode != AlphaMode::kOpaque) return std::nullopt;
+    Rgba color = m < materials_.size() ? materials_[m].base_color : Rgba{};
+    color.a = 1.f;  // opaque: alpha is ignored
     if (shared && !(*shared == color)) return std::nullopt;
     shared = color;
   }
   return shared;
+}
+
+bool AttributeSampler::reads_alpha() const {
+  for (const MaterialInfo& m : materials_) {
+    if (m.mode != AlphaMode::kOpaque) return true;
+  }
+  return false;
+}
+
+float AttributeSampler::Opacity(const MaterialInfo* material, double vertex_alpha,
+                                double texture_alpha) {
+  if (!material) return 1.f;
+  switch (material->mode) {
+    case AlphaMode::kBlend:
+      return static_cast<float>(material->base_color.a * vertex_alpha * texture_alpha);
+    case AlphaMode::kMask:
+      // The surface image tested base × texture alpha per texel; without one, the base alone.
+      if (material->texture) return static_cast<float>(texture_alpha);
+      return material->base_color.a >= material->cutoff ? 1.f : 0.f;
+    default:
+      return 1.f;
+  }
 }
 
 AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const {
@@ -196,11 +319,16 @@ AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const
 
   const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
   const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  // Textures are sampled only for what is wanted (MaterialInfo::texture is null otherwise); vertex
+  // colours vary the colour, and a blend's opacity.
   const bool textured = material && material->texture && mesh_.has_uvs();
-  p.uniform = p.normal_length > 0 && !(want_color_ && (textured || mesh_.has_colors())) &&
-              !(want_normal_ && mesh_.has_normals());
+  const bool varying_colors =
+      mesh_.has_colors() && (want_color_ || (material && material->mode == AlphaMode::kBlend));
+  p.uniform =
+      p.normal_length > 0 && !textured && !varying_colors && !(want_normal_ && mesh_.has_normals());
   if (p.uniform) {
     if (want_color_ && material) p.color = material->base_color;
+    p.color.a = Opacity(material, 1.0, 1.0);
     if (want_normal_) {
       const Vec3d g = p.normal / p.normal_length;
       p.unit_normal = {static_cast<float>(g.x), static_cast<float>(g.y), static_cast<float>(g.z)};
@@ -335,14 +463,14 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
   const double bary[3] = {1.0 - b1 - b2, b1, b2};
   const std::size_t corner = 3 * triangle;
 
-  if (want_color_) {
-    const std::uint32_t id =
-        triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
-    const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
+  const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  if (want_color_ || (material && material->mode != AlphaMode::kOpaque)) {
+    // Colour straight, alpha the opacity (Opacity()): each factor's mean, multiplied.
     double c[4] = {1, 1, 1, 1};
-    if (material) {
+    if (material && want_color_) {
       c[0] = material->base_color.r, c[1] = material->base_color.g;
-      c[2] = material->base_color.b, c[3] = material->base_color.a;
+      c[2] = material->base_color.b;
     }
     if (mesh_.has_colors()) {
       // Linear over the triangle: its mean over the polygon is its value at the centroid.
@@ -354,6 +482,7 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
       }
       for (int i = 0; i < 4; ++i) c[i] *= v[i];
     }
+    double texture_alpha = 1;
     if (material && material->texture && mesh_.has_uvs()) {
       const Vec2f& t0 = mesh_.uvs[corner];
       const Vec2f& t1 = mesh_.uvs[corner + 1];
@@ -371,10 +500,16 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
       } else {
         tex = material->texture->Bilinear(t0.u + b1 * du1 + b2 * du2, t0.v + b1 * dv1 + b2 * dv2);
       }
-      c[0] *= tex.r, c[1] *= tex.g, c[2] *= tex.b, c[3] *= tex.a;
+      if (material->premultiplied) {
+        // A surface image: its colour is weighted by coverage, so the mean's straight colour is
+        // that of the surface alone.
+        const float inv = tex.a > 0 ? 1.f / tex.a : 0.f;
+        tex.r *= inv, tex.g *= inv, tex.b *= inv;
+      }
+      c[0] *= tex.r, c[1] *= tex.g, c[2] *= tex.b, texture_alpha = tex.a;
     }
     out.color = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]),
-                 static_cast<float>(c[3])};
+                 Opacity(material, c[3], texture_alpha)};
   }
 
   if (want_normal_) {

@@ -47,10 +47,11 @@ struct AttributeSample {
   /// degenerate. A triangle lying exactly in a face shared by two voxels counts fully in both.
   double area = 0;
   /// Mean over the clipped polygon of material base colour × texture × vertex colour (linear light,
-  /// straight alpha; each factor's mean, multiplied). With zero area: the value at the contact
-  /// (midpoint of the contact segment or the contact point); where the triangle misses the box,
-  /// or rounding clipped a contact away, at its point nearest the voxel's centre. Opaque white
-  /// unless want_color.
+  /// straight; each factor's mean, multiplied), and in alpha the surface's opacity there: 1 for an
+  /// opaque material, the covered fraction for a mask, the mean alpha for a blend (Material). With
+  /// zero area: the value at the contact (midpoint of the contact segment or the contact point);
+  /// where the triangle misses the box, or rounding clipped a contact away, at its point nearest
+  /// the voxel's centre. White unless want_color; opacity 1 unless want_alpha.
   Rgba color;
   /// Mean shading normal over the clipped polygon (per-corner normals interpolated; unnormalized),
   /// or the unit geometric normal (voxel space, counter-clockwise winding = front) when the mesh
@@ -63,11 +64,12 @@ class AttributeSampler {
  public:
   /// `vertices`: the snapped voxel-space vertices the voxelizer uses (same indexing as
   /// mesh.positions). Both are referenced, not copied: they must outlive the sampler. Decodes the
-  /// textures the colour needs and builds their mip pyramids (in parallel), so Sample() never
-  /// waits; a texture that cannot be decoded leaves its materials at their base colour (see
-  /// warnings()), and so does a mesh without UVs.
+  /// textures the colour and the opacity need and builds their mip pyramids (in parallel), so
+  /// Sample() never waits; a texture that cannot be decoded leaves its materials at their base
+  /// colour (see warnings()), and so does a mesh without UVs. Without `want_alpha` every material
+  /// is opaque.
   AttributeSampler(const Mesh& mesh, const std::vector<FixedPoint3>& vertices, bool want_color,
-                   bool want_normal);
+                   bool want_normal, bool want_alpha = true);
 
   /// What triangle `triangle` contributes to voxel (x, y, z). Thread-safe (const, no shared
   /// mutable state) and allocation-free.
@@ -163,6 +165,9 @@ class AttributeSampler {
   /// materials the triangles use are untextured and share one base colour): every voxel's mean.
   std::optional<Rgba> SharedColor() const;
 
+  /// Whether some material reads alpha: a voxel whose surface has opacity 0 is then a hole.
+  bool reads_alpha() const;
+
   /// Textures that could not be decoded, one message each (their materials use the base colour).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -175,15 +180,23 @@ class AttributeSampler {
 
   struct MaterialInfo {
     Rgba base_color;
-    const TextureSampler* texture = nullptr;  // null: untextured, or the texture failed
+    // The colour texture, or the surface image of a material reading alpha (premultiplied by its
+    // coverage); null: untextured, not wanted, or the texture failed.
+    const TextureSampler* texture = nullptr;
+    bool premultiplied = false;
+    AlphaMode mode = AlphaMode::kOpaque;
+    float cutoff = 0.5f;
   };
+  // A sample's opacity from the means of the vertex colours' and the texture's alpha.
+  static float Opacity(const MaterialInfo* material, double vertex_alpha, double texture_alpha);
 
   const Mesh& mesh_;
   const std::vector<FixedPoint3>& vertices_;
   bool want_color_;
   bool want_normal_;
   std::vector<Image> images_;             // per Mesh::textures entry, as the budget decoded them
-  std::vector<TextureSampler> textures_;  // per Mesh::textures entry; invalid when unused/failed
+  std::vector<Image> surface_images_;     // per material reading alpha from a texture
+  std::vector<TextureSampler> textures_;  // over images_ read as decoded, then surface_images_
   std::vector<MaterialInfo> materials_;   // per Mesh::materials entry
   std::vector<std::string> warnings_;
 };

@@ -318,7 +318,7 @@ Status VoxelizeInto(const Mesh& mesh, const GridTransform& grid, const VoxelizeO
   VoxelAttributes attributes;
   attributes.grid = grid;
   attributes.mode = options.mode;
-  if (options.colors || options.normals) {
+  if (options.colors || options.normals || (options.alpha && mesh.has_alpha())) {
     return voxelize_detail::VoxelizeWithAttributes(voxelizer, options, projected_area,
                                                    std::move(attributes), output, progress);
   }
@@ -390,8 +390,8 @@ StatusOr<std::unique_ptr<RegionVoxelizer>> RegionVoxelizer::Create(const Mesh& m
   }
   std::unique_ptr<RegionVoxelizer> r(new RegionVoxelizer(mesh, grid, options));
   r->vertices_ = std::move(*snapped);
-  r->sampler_ =
-      std::make_unique<AttributeSampler>(mesh, r->vertices_, options.colors, options.normals);
+  r->sampler_ = std::make_unique<AttributeSampler>(mesh, r->vertices_, options.colors,
+                                                   options.normals, options.alpha);
   r->shared_color_ = r->sampler_->SharedColor();
   return r;
 }

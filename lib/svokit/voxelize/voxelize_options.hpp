@@ -20,6 +20,10 @@ struct VoxelizeOptions {
   /// Per-voxel attributes (VoxelSet::colors / normals, and coverage with either).
   bool colors = false;
   bool normals = false;
+  /// Materials' alpha (Material::alpha_mode): a mask's cut-out parts and a blend's transparent
+  /// ones are holes, and opacity weights the attributes. Off: every material is opaque (solids,
+  /// whose boundary is their closed surface).
+  bool alpha = true;
 };
 
 }  // namespace svokit

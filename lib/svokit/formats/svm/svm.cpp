@@ -1,5 +1,7 @@
 #include "svokit/formats/svm/svm.hpp"
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "svokit/core/bytes.hpp"
@@ -20,6 +22,7 @@ constexpr container::Tag kColors = MakeTag("COLR");
 constexpr container::Tag kMaterials = MakeTag("MATL");
 constexpr container::Tag kTextures = MakeTag("TEXS");
 constexpr container::Tag kWarnings = MakeTag("WARN");
+constexpr container::Tag kAlpha = MakeTag("ALPH");
 constexpr container::Tag kMetadata = MakeTag("META");
 
 template <class T>
@@ -61,6 +64,18 @@ std::vector<std::uint8_t> EncodeSvm(const Mesh& mesh, const std::string& source)
     materials.PutString(m.missing_texture);
   }
   file.AddSection(kMaterials, std::move(materials.bytes()));
+  // Only meshes that read alpha have the section: an opaque mesh's bytes are those of version 1.
+  if (mesh.has_alpha() || std::any_of(mesh.materials.begin(), mesh.materials.end(),
+                                      [](const Material& m) { return m.alpha_texture >= 0; })) {
+    ByteWriter alpha;
+    alpha.Put(static_cast<std::uint32_t>(mesh.materials.size()));
+    for (const Material& m : mesh.materials) {
+      alpha.Put(static_cast<std::uint32_t>(m.alpha_mode));
+      alpha.Put(m.alpha_cutoff);
+      alpha.Put(m.alpha_texture);
+    }
+    file.AddSection(kAlpha, std::move(alpha.bytes()));
+  }
 
   ByteWriter textures;
   textures.Put(static_cast<std::uint32_t>(mesh.textures.size()));
@@ -132,6 +147,21 @@ StatusOr<Mesh> DecodeSections(const StatusOr<container::Reader>& file) {
     SVOKIT_RETURN_IF_ERROR(mr.GetString(m.name));
     SVOKIT_RETURN_IF_ERROR(mr.GetString(m.missing_texture));
     mesh.materials.push_back(std::move(m));
+  }
+  if (auto s = file->Find(kAlpha)) {
+    ByteReader ar(*s, name + ": ALPH section");
+    SVOKIT_RETURN_IF_ERROR(ar.Get(count));
+    if (count != mesh.materials.size()) {
+      return Status::BadInput("{}: ALPH section has {} materials, MATL {}", name, count,
+                              mesh.materials.size());
+    }
+    for (Material& m : mesh.materials) {
+      std::uint32_t mode = 0;
+      SVOKIT_RETURN_IF_ERROR(ar.Get(mode));
+      SVOKIT_RETURN_IF_ERROR(ar.Get(m.alpha_cutoff));
+      SVOKIT_RETURN_IF_ERROR(ar.Get(m.alpha_texture));
+      m.alpha_mode = static_cast<AlphaMode>(mode);  // ValidateAndSanitize refuses other values
+    }
   }
   ByteReader tr(*textures, name + ": TEXS section");
   SVOKIT_RETURN_IF_ERROR(tr.Get(count));
