@@ -36,7 +36,8 @@ void PrintSummary(const MeshToSvoRequest& request, const MeshToSvoReport& report
     return;
   }
   const OctreeReport& octree = report.octree;
-  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.grid, true);
+  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.orientation,
+                      report.grid, true);
   if (octree.memory.by_pages()) {
     out.Line("build", {{"by_pages", true}, {"within", octree.memory.WithinText()}},
              fmt::format("by pages {}", octree.memory.WithinText()));

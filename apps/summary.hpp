@@ -18,6 +18,7 @@
 #include "svokit/formats/svo/section_key.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/mesh/orientation.hpp"
 #include "svokit/pipeline/chain.hpp"
 
 namespace svokit::app {
@@ -124,12 +125,18 @@ inline void AddInterior(Report& report, const InteriorSummary& interior) {
               text);
 }
 
-/// The report's lines of the mesh and the grid it was voxelized in (`depth`: the octree's).
+/// The report's lines of the mesh (with the orientation it was turned by, if any) and the grid it
+/// was voxelized in (`depth`: the octree's).
 inline void AddMeshAndGrid(Report& report, const std::string& mesh, std::uint64_t triangles,
-                           const GridTransform& grid, bool depth) {
+                           const Orientation& orientation, const GridTransform& grid, bool depth) {
   const auto& d = grid.dims();
-  report.Line("mesh", {{"path", mesh}, {"triangles", triangles}},
-              fmt::format("{} ({} triangles)", mesh, triangles));
+  Json m = {{"path", mesh}, {"triangles", triangles}};
+  std::string turned;
+  if (!orientation.IsIdentity()) {
+    m["orientation"] = Matrix(orientation);
+    turned = ", " + Describe(orientation);
+  }
+  report.Line("mesh", m, fmt::format("{} ({} triangles{})", mesh, triangles, turned));
   Json g = {{"dims", {d[0], d[1], d[2]}},
             {"voxel_size", grid.voxel_size()},
             {"origin", {grid.origin().x, grid.origin().y, grid.origin().z}}};

@@ -14,6 +14,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/thread_limit.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/validate/validate.hpp"
@@ -60,11 +61,16 @@ int main(int argc, char** argv) {
                                       : (paged->reader ? &paged->reader->grid() : nullptr);
     std::optional<Mesh> mesh;
     if (!mesh_path.empty()) {
+      // The mesh turned as the octree's META records, unless --up or --rotate say otherwise.
+      const std::string metadata = whole           ? whole->svo.metadata
+                                   : paged->reader ? paged->reader->metadata()
+                                                   : std::string();
+      const ImportOptions options =
+          WithRecordedOrientation(import.options, ParseProvenance(metadata).orientation);
       // A damaged grid cannot vouch for or against the mesh: the checks will say what they can.
-      StatusOr<Mesh> m = grid != nullptr
-                             ? ImportSourceMesh(progress, mesh_path, *grid, input,
-                                                "the octree was built from", import.options)
-                             : ImportStage(progress, mesh_path, import.options);
+      StatusOr<Mesh> m = grid != nullptr ? ImportSourceMesh(progress, mesh_path, *grid, input,
+                                                            "the octree was built from", options)
+                                         : ImportStage(progress, mesh_path, options);
       if (!m.ok()) return app::Fail(tool, m.status());
       const auto warn = import.Sink(tool);
       for (const std::string& w : m->warnings) warn(fmt::format("{}: {}", mesh_path.string(), w));

@@ -19,7 +19,8 @@ using namespace svokit;
 void PrintSummary(const MeshToVoxelsRequest& request, const MeshToVoxelsReport& report,
                   const std::string& mode, std::size_t warnings, const app::CommonOptions& common) {
   app::Report out(common);
-  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.grid, false);
+  app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.orientation,
+                      report.grid, false);
   if (report.memory.by_pages()) {
     out.Line("voxelize", {{"by_cubes", true}, {"within", report.memory.WithinText()}},
              fmt::format("by cubes {}", report.memory.WithinText()));

@@ -359,7 +359,8 @@ Status CheckMeshMatchesOctree(const Mesh& mesh, const GridTransform& grid,
       Length(fitted->origin() - g.origin()) > tolerance) {
     return Status::BadInput(
         "{}: the mesh's bounds [{:.9g}, {:.9g}, {:.9g}] .. [{:.9g}, {:.9g}, {:.9g}] do not give "
-        "the octree's grid: not the mesh it was voxelized from",
+        "the octree's grid: not the mesh it was voxelized from (or not turned as it was: "
+        "--up, --rotate)",
         mesh_name, bounds.lo.x, bounds.lo.y, bounds.lo.z, bounds.hi.x, bounds.hi.y, bounds.hi.z);
   }
   return Status::Ok();

@@ -8,6 +8,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/held_bytes.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/mesh/image_codec.hpp"
@@ -52,7 +53,8 @@ Status CheckOutputs(const AoBakeRequest& r, const std::vector<std::filesystem::p
 // and its side files checked against the outputs before anything is written.
 StatusOr<Mesh> ImportBakedMesh(const AoBakeRequest& r, const SvoReader& octree,
                                Progress& progress) {
-  StatusOr<Mesh> mesh = ImportStage(progress, r.mesh, r.import);
+  const Orientation recorded = ParseProvenance(octree.metadata()).orientation;
+  StatusOr<Mesh> mesh = ImportStage(progress, r.mesh, WithRecordedOrientation(r.import, recorded));
   if (!mesh.ok()) return mesh.status();
   if (r.warn) {
     for (const std::string& w : mesh->warnings) r.warn(fmt::format("{}: {}", r.mesh.string(), w));

@@ -67,6 +67,11 @@ StatusOr<Mesh> ImportMesh(const std::filesystem::path& path, const ImportOptions
     if (mesh.ok()) WarnMissingTextures(*mesh);
   }
   if (!mesh.ok()) return mesh;
+  // The orientation is the source file's: a .svm already turned by its recorded one is turned
+  // only by the difference, so that its positions end as the source's would.
+  const Orientation target = options.orientation.value_or(mesh->orientation);
+  Orient(*mesh, mesh->orientation.Inverse().Then(target));
+  mesh->orientation = target;
   SVOKIT_RETURN_IF_ERROR(ValidateAndSanitize(*mesh, name));
   return mesh;
 }
@@ -80,13 +85,19 @@ StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path
       });
 }
 
+ImportOptions WithRecordedOrientation(ImportOptions options, const Orientation& recorded) {
+  if (!options.orientation) options.orientation = recorded;
+  return options;
+}
+
 StatusOr<Mesh> ImportSourceMesh(Progress& progress, const std::filesystem::path& mesh_path,
                                 const GridTransform& grid, const std::filesystem::path& input,
                                 std::string_view made, const ImportOptions& options) {
   StatusOr<Mesh> mesh = ImportStage(progress, mesh_path, options);
   if (mesh.ok() && !grid.Encloses(mesh->Bounds())) {
-    return Status::BadInput("{}: the mesh lies outside {}'s grid: not the mesh {}",
-                            mesh_path.string(), input.string(), made);
+    return Status::BadInput("{}: the mesh lies outside {}'s grid: not the mesh {}{}",
+                            mesh_path.string(), input.string(), made,
+                            options.orientation ? " (or not as --up/--rotate turned it)" : "");
   }
   return mesh;
 }

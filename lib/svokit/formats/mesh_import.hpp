@@ -21,14 +21,20 @@ namespace svokit {
 /// Extensions ImportMesh accepts, lower case without the dot.
 const std::vector<std::string>& SupportedMeshExtensions();
 
-/// Reads, triangulates and validates a mesh; its side files (textures, material libraries,
-/// buffers) are read as `options` allow (side_files.hpp). Every error message starts with the
-/// file name. A .svm's materials whose texture was missing when it was made warn again.
+/// Reads, triangulates, orients and validates a mesh; its side files (textures, material
+/// libraries, buffers) are read as `options` allow (side_files.hpp). `options.orientation` turns
+/// the source file's axes (a .svm recording one is turned by the difference); the mesh's
+/// `orientation` is then the one applied. Every error message starts with the file name. A .svm's
+/// materials whose texture was missing when it was made warn again.
 StatusOr<Mesh> ImportMesh(const std::filesystem::path& path, const ImportOptions& options = {});
 
 /// ImportMesh as the "import" stage of `progress`, its line giving the triangle count.
 StatusOr<Mesh> ImportStage(Progress& progress, const std::filesystem::path& path,
                            const ImportOptions& options = {});
+
+/// `options`, oriented as `recorded` (the Provenance of the voxels or octree the mesh is read
+/// for) unless they name an orientation: a later stage turns the mesh as the first one did.
+ImportOptions WithRecordedOrientation(ImportOptions options, const Orientation& recorded);
 
 /// The same for the mesh `input` was made from (`made` says how, for the message): a mesh
 /// reaching outside `grid` cannot be that mesh and is bad input.

@@ -54,6 +54,27 @@ Json BakeJson(const BakeSettings& b) {
   return j;
 }
 
+// Three rows of three finite numbers forming a rotation (orthonormal, determinant +1, to
+// rounding); anything else reads as absent.
+std::optional<Orientation> ParseOrientation(const Json& j) {
+  if (!j.is_array() || j.size() != 3) return std::nullopt;
+  Orientation o;
+  for (std::size_t r = 0; r < 3; ++r) {
+    if (!j[r].is_array() || j[r].size() != 3) return std::nullopt;
+    for (std::size_t c = 0; c < 3; ++c) {
+      if (!j[r][c].is_number()) return std::nullopt;
+      o.rows[r][static_cast<int>(c)] = j[r][c].get<double>();
+      if (!std::isfinite(o.rows[r][static_cast<int>(c)])) return std::nullopt;
+    }
+  }
+  const Orientation product = o.Then(o.Inverse());
+  for (int r = 0; r < 3; ++r) {
+    if (Length(product.rows[r] - Orientation{}.rows[r]) > 1e-9) return std::nullopt;
+  }
+  if (!(o.Determinant() > 0)) return std::nullopt;
+  return o;
+}
+
 // Typed members, read leniently: a member of another type is as good as absent.
 template <class T>
 std::optional<T> Member(const Json& j, const char* key) {
@@ -208,6 +229,7 @@ std::string ProvenanceJson(const Provenance& p) {
   if (p.voxelize) j["voxelize"] = VoxelJson(*p.voxelize);
   if (p.build) j["build"] = BuildJson(*p.build);
   if (p.bake) j["bake"] = BakeJson(*p.bake);
+  if (!p.orientation.IsIdentity()) j["orientation"] = Matrix(p.orientation);
   return j.dump();
 }
 
@@ -218,6 +240,9 @@ Provenance ParseProvenance(std::string_view text) {
   p.source = Member<std::string>(j, "source").value_or("");
   p.generator = Member<std::string>(j, "generator").value_or("");
   p.triangles = Member<std::uint64_t>(j, "triangles").value_or(0);
+  if (const auto it = j.find("orientation"); it != j.end()) {
+    p.orientation = ParseOrientation(*it).value_or(Orientation{});
+  }
   if (const auto grid = j.find("grid"); grid != j.end() && grid->is_object()) {
     p.grid = GridFrom(JsonFields{*grid});
     // Six finite numbers, min before max; anything else reads as absent.

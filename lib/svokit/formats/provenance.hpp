@@ -11,6 +11,7 @@
 
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
+#include "svokit/mesh/orientation.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -48,12 +49,16 @@ struct Provenance {
   std::optional<BuildSettings> build;  ///< an octree's
   std::optional<BakeSettings> bake;    ///< an octree's, once baked
   std::string generator;               ///< the tool that wrote the file, as read
+  /// The rotation applied to the mesh on import (--up, --rotate; identity: none, not written).
+  /// A stage that reads the mesh again applies it unless told otherwise.
+  Orientation orientation;
 };
 
 /// The META section's JSON (its generator: this version of svokit).
 std::string ProvenanceJson(const Provenance& provenance);
 /// META's JSON as written by any version; what is absent, malformed or of another type is left
-/// unset (metadata never makes a file unreadable).
+/// unset (metadata never makes a file unreadable), an orientation that is not a rotation too.
+/// A .svm's META (source, generator, orientation) reads alike.
 Provenance ParseProvenance(std::string_view json);
 
 }  // namespace svokit

@@ -154,6 +154,7 @@ void MetadataLines(std::string& out, const SvoStats& st) {
                          : fmt::format("voxels of {:.9g}", p.grid->voxel_size),
                      p.grid->pad));
   }
+  if (!p.orientation.IsIdentity()) Line(out, "orientation", Describe(p.orientation));
   if (p.voxelize) {
     const VoxelSettings& v = *p.voxelize;
     Line(out, "voxelize",

@@ -11,6 +11,7 @@
 #include "svokit/core/box.hpp"
 #include "svokit/core/status.hpp"
 #include "svokit/core/vec.hpp"
+#include "svokit/mesh/orientation.hpp"
 #include "svokit/mesh/texture.hpp"
 
 namespace svokit {
@@ -58,6 +59,9 @@ struct Mesh {
   /// The side files the import read (textures, material libraries, buffers), canonical: what
   /// an output must not overwrite. Not stored in a .svm.
   std::vector<std::filesystem::path> side_files;
+  /// The rotation that took the file's axes to these positions (identity: none); recorded in a
+  /// .svm's META, so that importing the .svm again does not turn it twice.
+  Orientation orientation;
 
   std::size_t triangle_count() const { return triangles.size(); }
   std::size_t vertex_count() const { return positions.size(); }

@@ -7,18 +7,23 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "svokit/core/status.hpp"
+#include "svokit/mesh/orientation.hpp"
 
 namespace svokit {
 
-/// What an import may read besides the mesh file itself.
+/// What an import may read besides the mesh file itself, and how it turns the file's axes.
 struct ImportOptions {
   /// Folders (and their subfolders) side files may lie in besides the model's own (--asset-path).
   std::vector<std::filesystem::path> asset_paths;
+  /// The rotation from the source file's axes to svokit's (--up, --rotate); unset: the one the
+  /// file records (a .svm's), else none. ImportMesh applies it (mesh_import.hpp).
+  std::optional<Orientation> orientation;
 };
 
 /// How a format writes a reference to a side file.

@@ -73,6 +73,7 @@ struct MeshToVoxelsRequest {
 };
 struct MeshToVoxelsReport {
   std::uint64_t triangles = 0;
+  Orientation orientation;  ///< the one the mesh was turned by on import
   GridTransform grid;
   std::uint64_t voxels = 0;
   MemoryPlan memory;  ///< by cubes when memory.by_pages()
@@ -117,6 +118,7 @@ struct MeshToSvoRequest {
 };
 struct MeshToSvoReport {
   std::uint64_t triangles = 0;
+  Orientation orientation;  ///< the one the mesh was turned by on import
   GridTransform grid;
   OctreeReport octree;
   std::optional<SvoPartStats> part;  ///< a part was built

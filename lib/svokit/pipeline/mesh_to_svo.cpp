@@ -102,9 +102,11 @@ StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progres
   const GridTransform* grid = &fitted->grid;
   MeshToSvoReport report;
   report.triangles = mesh->triangle_count();
+  report.orientation = mesh->orientation;
   report.grid = *grid;
-  const Provenance provenance{r.input.filename().string(), mesh->triangle_count(), r.voxelize.grid,
-                              r.voxelize.settings, r.build};
+  Provenance provenance{r.input.filename().string(), mesh->triangle_count(), r.voxelize.grid,
+                        r.voxelize.settings, r.build};
+  provenance.orientation = mesh->orientation;
   Build build{r, *mesh, *grid, ProvenanceJson(provenance), {}, report, progress};
   build.options.brick_side = r.build.brick_side;
   build.options.contours = r.build.contours;

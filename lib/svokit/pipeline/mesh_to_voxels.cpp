@@ -65,9 +65,11 @@ StatusOr<MeshToVoxelsReport> MeshToVoxels(const MeshToVoxelsRequest& r, Progress
   const GridTransform* grid = &fitted->grid;
   MeshToVoxelsReport report;
   report.triangles = mesh->triangle_count();
+  report.orientation = mesh->orientation;
   report.grid = *grid;
-  const Provenance meta{r.input.filename().string(), mesh->triangle_count(), r.voxelize.grid,
-                        r.voxelize.settings};
+  Provenance meta{r.input.filename().string(), mesh->triangle_count(), r.voxelize.grid,
+                  r.voxelize.settings};
+  meta.orientation = mesh->orientation;
   const bool vfrag = LowerExtension(r.output) == "vfrag";
   // Only a .vfrag is written cube by cube, of ~8 B a voxel held whole (~16 with attributes).
   if (vfrag) {

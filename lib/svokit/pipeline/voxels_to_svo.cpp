@@ -33,11 +33,12 @@ MemoryPlan PlanOf(const VoxelsToSvoRequest& r, const std::optional<InteriorCubes
   return ChooseMemoryPlan(std::nullopt, per_voxel * static_cast<double>(*count), can_split);
 }
 
+// The mesh for the contours, turned as the voxels' META records unless the user says otherwise.
 StatusOr<std::optional<Mesh>> ImportMeshOf(const VoxelsToSvoRequest& r, const GridTransform& grid,
-                                           Progress& progress) {
+                                           const Provenance& provenance, Progress& progress) {
   if (r.mesh.empty()) return std::optional<Mesh>();
-  StatusOr<Mesh> mesh =
-      ImportSourceMesh(progress, r.mesh, grid, r.input, "that was voxelized", r.import);
+  StatusOr<Mesh> mesh = ImportSourceMesh(progress, r.mesh, grid, r.input, "that was voxelized",
+                                         WithRecordedOrientation(r.import, provenance.orientation));
   if (!mesh.ok()) return mesh.status();
   SVOKIT_RETURN_IF_ERROR(Warn(r.warn, mesh->warnings, r.strict, r.mesh));
   SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, mesh->side_files));
@@ -47,7 +48,7 @@ StatusOr<std::optional<Mesh>> ImportMeshOf(const VoxelsToSvoRequest& r, const Gr
 StatusOr<OctreeReport> BuildByPages(const VoxelsToSvoRequest& r, const VfragCubes& vfrag,
                                     Provenance provenance, const BuildOptions& options,
                                     const MemoryPlan& plan, Progress& progress) {
-  StatusOr<std::optional<Mesh>> mesh = ImportMeshOf(r, vfrag.grid(), progress);
+  StatusOr<std::optional<Mesh>> mesh = ImportMeshOf(r, vfrag.grid(), provenance, progress);
   if (!mesh.ok()) return mesh.status();
   provenance.build = r.build;
   const BoxVoxels paged{vfrag.grid(),
@@ -77,7 +78,7 @@ StatusOr<OctreeReport> BuildWhole(const VoxelsToSvoRequest& r, BuildOptions opti
   StatusOr<VoxelSet> voxels =
       RunStage(progress, "read", [&] { return ReadVfrag(r.input, &provenance); });
   if (!voxels.ok()) return voxels.status();
-  StatusOr<std::optional<Mesh>> mesh = ImportMeshOf(r, voxels->grid, progress);
+  StatusOr<std::optional<Mesh>> mesh = ImportMeshOf(r, voxels->grid, provenance, progress);
   if (!mesh.ok()) return mesh.status();
   provenance.build = r.build;
   if (interior) options.interior = &*interior;

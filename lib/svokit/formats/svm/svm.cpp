@@ -6,7 +6,7 @@
 
 #include "svokit/core/bytes.hpp"
 #include "svokit/core/file_io.hpp"
-#include "svokit/core/utf8.hpp"
+#include "svokit/formats/provenance.hpp"
 
 namespace svokit {
 
@@ -92,9 +92,10 @@ std::vector<std::uint8_t> EncodeSvm(const Mesh& mesh, const std::string& source)
   for (const std::string& w : mesh.warnings) warnings.PutString(w);
   file.AddSection(kWarnings, std::move(warnings.bytes()));
 
-  const nlohmann::json meta = {{"source", EscapeInvalidUtf8(source)},
-                               {"generator", "svokit " SVOKIT_VERSION}};
-  const std::string meta_text = meta.dump();
+  Provenance meta;
+  meta.source = source;
+  meta.orientation = mesh.orientation;
+  const std::string meta_text = ProvenanceJson(meta);
   file.AddSection(kMetadata, std::vector<std::uint8_t>(meta_text.begin(), meta_text.end()));
   return file.Serialize();
 }
@@ -182,6 +183,10 @@ StatusOr<Mesh> DecodeSections(const StatusOr<container::Reader>& file) {
     mesh.warnings.resize(count > s->size() / 4 ? 0 : count);
     if (mesh.warnings.size() != count) return Status::BadInput("{}: WARN section is corrupt", name);
     for (std::string& w : mesh.warnings) SVOKIT_RETURN_IF_ERROR(wr.GetString(w));
+  }
+  if (auto s = file->Find(kMetadata)) {
+    mesh.orientation =
+        ParseProvenance({reinterpret_cast<const char*>(s->data()), s->size()}).orientation;
   }
   // Checksums vouch for the bytes, not for what they say: a file written by another program may
   // still name a vertex or material that does not exist.
