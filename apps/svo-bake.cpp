@@ -173,14 +173,15 @@ void PrintSummary(const BakeCli& cli, const AoBakeReport& report, const Progress
   }
   if (!r.vertex_out.empty()) out.Line("vertex-out", r.vertex_out.string(), r.vertex_out.string());
   if (report.texels) {
-    out.Line(
-        "texture-out",
-        {{"path", r.texture_out.string()},
-         {"size", r.texture_size},
-         {"texels", report.texels->count},
-         {"mean_ao", report.texels->mean_ao}},
-        fmt::format("{} ({}x{}, {} texels covered, mean AO {:.4f})", r.texture_out.string(),
-                    r.texture_size, r.texture_size, report.texels->count, report.texels->mean_ao));
+    out.Line("texture-out",
+             {{"path", r.texture_out.string()},
+              {"size", r.texture_size},
+              {"texels", report.texels->count},
+              {"overlapped", report.texels->overlapped},
+              {"mean_ao", report.texels->mean_ao}},
+             fmt::format("{} ({}x{}, {} texels covered, {} in overlapping charts, mean AO {:.4f})",
+                         r.texture_out.string(), r.texture_size, r.texture_size,
+                         report.texels->count, report.texels->overlapped, report.texels->mean_ao));
   }
   app::AddTimes(out, progress);
   if (!r.mesh.empty()) out.Line("warnings", warnings, fmt::format("{}", warnings));

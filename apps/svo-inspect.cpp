@@ -17,6 +17,7 @@ using namespace svokit;
 struct InspectCli {
   InspectRequest request;
   std::string view = "front", size = "512x512", shade = "color";
+  std::optional<std::string> background;
   bool no_contours = false;
   std::vector<std::string> slice;
   app::MemoryLimitOption memory_limit;
@@ -36,6 +37,10 @@ struct InspectCli {
     cli.add_option("--shade", shade, "What the render's pixels show")
         ->option_text("color|normal|depth|ao")
         ->capture_default_str();
+    cli.add_option("--background", background,
+                   "Where no ray hits: an opaque colour, or none for transparent (default: none; "
+                   "334d66 with --shade ao)")
+        ->option_text("none|RRGGBB");
     cli.add_flag("--no-contours", no_contours, "Render leaves as full cubes, ignoring contours");
     cli.add_option("--slice", slice, "Write slice K across axis x, y or z of the grid as PNG")
         ->option_text("AXIS=K FILE")
@@ -62,6 +67,12 @@ struct InspectCli {
     request.render.height = (*wh)[1];
     request.render.shade = *s;
     request.render.contours = !no_contours;
+    if (*s == Shade::kAo) request.render.background = kAoBackground;
+    if (background) {
+      StatusOr<std::optional<Background>> b = ParseBackground(*background);
+      if (!b.ok()) return Status::BadInput("--{}", b.status().message());
+      request.render.background = *b;
+    }
     StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
     if (!limit.ok()) return limit.status();
     request.memory_limit = limit->value_or(0);

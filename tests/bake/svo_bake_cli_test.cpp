@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
@@ -69,9 +72,47 @@ TEST(SvoBakeCli, BakesIntoTheOctreeTheSameBytesForAnyThreadCount) {
   ImageHeader header;
   StatusOr<std::vector<float>> pixels = DecodeImagePixels(png, bytes, header);
   ASSERT_TRUE(pixels.ok());
-  auto grey = [&](int x, int y) { return (*pixels)[static_cast<std::size_t>(4 * (y * 64 + x))]; };
-  // Top view: the ring's inner edge (towards the hole) at x ≈ 20 faces the far side of the ring.
-  EXPECT_LT(grey(21, 32), grey(4, 32));
+  auto rgba = [&](const std::vector<float>& p, int x, int y) {
+    const float* q = &p[static_cast<std::size_t>(4 * (y * 64 + x))];
+    return std::array<int, 4>{
+        static_cast<int>(std::lround(q[0] * 255)), static_cast<int>(std::lround(q[1] * 255)),
+        static_cast<int>(std::lround(q[2] * 255)), static_cast<int>(std::lround(q[3] * 255))};
+  };
+  // Hits are grey; misses opaque slate blue, a colour no AO term takes.
+  auto hit = [&](int x, int y) {
+    const std::array<int, 4> c = rgba(*pixels, x, y);
+    return c[0] == c[1] && c[1] == c[2];
+  };
+  // Top view, row 32 through the hole: the ring's inner edge faces the far side of the ring, its
+  // outer edge open space.
+  int outer = 0, inner = 32;
+  while (outer < 32 && !hit(outer, 32)) ++outer;
+  while (inner > 0 && !hit(inner, 32)) --inner;
+  ASSERT_LT(outer + 4, inner);
+  EXPECT_LT(rgba(*pixels, inner, 32)[0], rgba(*pixels, outer, 32)[0]);
+  EXPECT_EQ(rgba(*pixels, 0, 0), (std::array<int, 4>{0x33, 0x4d, 0x66, 255}));
+  EXPECT_EQ(rgba(*pixels, 32, 32), (std::array<int, 4>{0x33, 0x4d, 0x66, 255}));  // the hole
+  for (const auto& [background, want] :
+       {std::pair{"none", std::array<int, 4>{0, 0, 0, 0}},
+        std::pair{"ff8000", std::array<int, 4>{255, 128, 0, 255}}}) {
+    const std::string other = (dir / (std::string(background) + ".png")).string();
+    const ToolResult r =
+        RunTool("svo-inspect", {one, "--render", other, "--shade", "ao", "--view", "top", "--size",
+                                "64x64", "--background", background, "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::vector<std::uint8_t> b = ReadBytes(other);
+    ImageHeader h;
+    StatusOr<std::vector<float>> p = DecodeImagePixels(other, b, h);
+    ASSERT_TRUE(p.ok());
+    EXPECT_EQ(rgba(*p, 32, 32), want) << background;
+    EXPECT_EQ(rgba(*p, inner, 32), rgba(*pixels, inner, 32)) << background;  // hits alike
+  }
+  const ToolResult bad = RunTool(
+      "svo-inspect", {one, "--render", (dir / "x.png").string(), "--background", "slate", "-q"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--background 'slate': expected none or RRGGBB"), std::string::npos)
+      << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
   const ToolResult no_ao =
       RunTool("svo-inspect", {TorusSvo(), "--render", png + "2.png", "--shade", "ao", "-q"});
   EXPECT_EQ(no_ao.exit_code, 2);
@@ -101,6 +142,57 @@ TEST(SvoBakeCli, BakesOntoTheVerticesAndTheUvs) {
   const auto [lo, hi] = std::minmax_element(pixels->begin(), pixels->end());
   EXPECT_LT(*lo, 0.95f);  // some texels occluded
   EXPECT_GT(*hi, 0.99f);  // some open
+}
+
+// Charts written over each other (here: the torus's UVs, one triangle in four given its
+// neighbour's, so those pairs share UV space) are a warning with the fraction of texels covered
+// twice, and under --strict an error before any output.
+TEST(SvoBakeCli, OverlappingUvChartsAreReported) {
+  TempDir dir;
+  StatusOr<Mesh> torus = ImportMesh(kTorus);
+  ASSERT_TRUE(torus.ok());
+  // The torus's OBJ with every fourth triangle's UVs replaced by the next one's.
+  std::string obj = "mtllib uv-torus.mtl\nusemtl torus\n";
+  for (const Vec3d& p : torus->positions) obj += fmt::format("v {} {} {}\n", p.x, p.y, p.z);
+  for (std::size_t t = 0; t < torus->triangles.size(); ++t) {
+    const std::size_t from = t % 4 == 0 && t + 1 < torus->triangles.size() ? t + 1 : t;
+    for (int c = 0; c < 3; ++c) {
+      const Vec2f uv = torus->uvs[3 * from + static_cast<std::size_t>(c)];
+      obj += fmt::format("vt {} {}\n", uv.u, uv.v);
+    }
+  }
+  for (std::size_t t = 0; t < torus->triangles.size(); ++t) {
+    const Triangle& tri = torus->triangles[t];
+    obj += fmt::format("f {}/{} {}/{} {}/{}\n", tri[0] + 1, 3 * t + 1, tri[1] + 1, 3 * t + 2,
+                       tri[2] + 1, 3 * t + 3);
+  }
+  const std::filesystem::path mesh = dir.Write("torus.obj", obj);
+  std::filesystem::copy_file(DataDir() / "uv-torus.mtl", dir / "uv-torus.mtl");
+  std::filesystem::copy_file(DataDir() / "uv-torus.png", dir / "uv-torus.png");
+  const std::string svo = (dir / "t.svo").string(), png = (dir / "ao.png").string();
+  ASSERT_EQ(RunTool("mesh2svo", {mesh.string(), "-r", "32", "-o", svo, "-q"}).exit_code, 0);
+  ToolResult r = RunTool("svo-bake", {svo, "--mesh", mesh.string(), "--texture-out", png, "--size",
+                                      "64", "--json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("UV charts overlap"), std::string::npos) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  const std::uint64_t covered = report["texture-out"]["texels"];
+  const std::uint64_t twice = report["texture-out"]["overlapped"];
+  // Three charts in four remain, one of them covered twice: about a third of the covered texels.
+  EXPECT_GT(twice, covered / 4);
+  EXPECT_LT(twice, covered * 2 / 5);
+  std::filesystem::remove(png);
+  r = RunTool("svo-bake", {svo, "--mesh", mesh.string(), "--texture-out", png, "--size", "64",
+                           "--strict", "-o", (dir / "baked.svo").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--strict: nothing written"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+  EXPECT_FALSE(std::filesystem::exists(dir / "baked.svo"));
+  // The torus's own charts do not overlap: shared edges are not overlaps.
+  r = RunTool("svo-bake", {TorusSvo(), "--mesh", kTorus, "--texture-out", png, "--size", "64",
+                           "--json", "-q", "--strict"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["texture-out"]["overlapped"], 0u);
 }
 
 TEST(SvoBakeCli, BadInputIsOneLineExitTwoAndNoOutput) {

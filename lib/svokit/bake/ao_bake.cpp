@@ -204,6 +204,10 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
   // The triangle that owns each texel (the first to cover it), 4 bytes a texel.
   constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<std::uint32_t> owner(side * side, kNone);
+  std::vector<std::uint8_t> twice(side * side, 0);
+  // Strictly inside, by more than rounding: a texel centre on an edge two triangles share is not
+  // an overlap.
+  constexpr double kInside = 1e-9;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const UvTriangle uv = uv_triangle(t);
     if (uv.area == 0 || !std::isfinite(uv.area)) continue;
@@ -221,12 +225,18 @@ StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size) {
         if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
         const std::size_t texel =
             static_cast<std::size_t>(py) * side + static_cast<std::size_t>(px);
-        if (owner[texel] == kNone) owner[texel] = static_cast<std::uint32_t>(t);
+        if (owner[texel] == kNone) {
+          owner[texel] = static_cast<std::uint32_t>(t);
+        } else if (w[0] > kInside && w[1] > kInside && w[2] > kInside) {
+          const std::array<double, 3> first = uv_triangle(owner[texel]).Weights(px, py);
+          twice[texel] |= first[0] > kInside && first[1] > kInside && first[2] > kInside;
+        }
       }
     }
   }
   TexelPoints out;
   out.size = size;
+  out.overlapped = static_cast<std::size_t>(std::count(twice.begin(), twice.end(), 1));
   for (std::size_t texel = 0; texel < owner.size(); ++texel) {
     if (owner[texel] == kNone) continue;
     const Triangle& tri = mesh.triangles[owner[texel]];

@@ -61,6 +61,9 @@ struct TexelPoints {
   int size = 0;
   std::vector<std::uint32_t> texels;  ///< y·size + x, ascending
   std::vector<AoPoint> points;
+  /// Covered texels whose centre lies strictly inside a second triangle too (overlapping UV
+  /// charts: mirrored halves, materials sharing UV space); edges two triangles share do not count.
+  std::size_t overlapped = 0;
 };
 /// Bad input: a mesh without UVs, a size outside 1..16384.
 StatusOr<TexelPoints> RasterizeUvs(const Mesh& mesh, int size);

@@ -111,6 +111,8 @@ class Baker {
 
   Status Run(const Mesh* mesh) {
     mesh_ = mesh;
+    // The texture's texels first: charts written over each other are found before any output.
+    if (!r_.texture_out.empty()) SVOKIT_RETURN_IF_ERROR(Rasterize());
     if (r_.rays || r_.reference) {
       StatusOr<RayAoReference> made =
           RunStage(progress_, "embree scene", [&] { return RayAoReference::Make(*mesh_); });
@@ -222,20 +224,36 @@ class Baker {
                     [&] { return WriteAoPly(*mesh_, points, vertex_ao, r_.vertex_out); });
   }
 
-  Status Texture() {
+  Status Rasterize() {
     StatusOr<TexelPoints> texels = RasterizeUvs(*mesh_, r_.texture_size);
     if (!texels.ok()) {
       return Status::BadInput("{}: {}", r_.mesh.string(), texels.status().message());
     }
+    texels_ = std::move(*texels);
+    if (texels_.overlapped == 0) return Status::Ok();
+    // Overlapping charts (mirrored or shared UV space) hold one triangle's AO for all of them.
+    const std::string what = fmt::format(
+        "{}: UV charts overlap: {} of the {} covered texels ({:.2f}%) lie in two or more "
+        "triangles; the texture holds the first one's AO there",
+        r_.mesh.string(), texels_.overlapped, texels_.texels.size(),
+        100.0 * static_cast<double>(texels_.overlapped) /
+            static_cast<double>(texels_.texels.size()));
+    if (r_.strict) return Status::BadInput("{} (--strict: nothing written)", what);
+    if (r_.warn) r_.warn(what);
+    return Status::Ok();
+  }
+
+  Status Texture() {
     const StatusOr<std::vector<float>> traced =
-        RunStage(progress_, "texels", [&] { return AtPoints(texels->points); });
+        RunStage(progress_, "texels", [&] { return AtPoints(texels_.points); });
     if (!traced.ok()) return traced.status();
     const std::vector<float>& texel_ao = *traced;
-    const std::vector<std::uint8_t> pixels = AoTexture(*texels, texel_ao);
+    const std::vector<std::uint8_t> pixels = AoTexture(texels_, texel_ao);
     SVOKIT_RETURN_IF_ERROR(RunStage(progress_, "write texture", [&] {
       return WriteImage(r_.texture_out, r_.texture_size, r_.texture_size, 1, pixels);
     }));
-    report_.texels = AoBakeReport::Points{texels->texels.size(), MeanAo(texel_ao)};
+    report_.texels =
+        AoBakeReport::Texels{{texels_.texels.size(), MeanAo(texel_ao)}, texels_.overlapped};
     return Status::Ok();
   }
 
@@ -247,6 +265,7 @@ class Baker {
   const Mesh* mesh_ = nullptr;
   std::optional<RayAoReference> rays_;
   MaskTree page_tree_;
+  TexelPoints texels_;
 };
 
 }  // namespace

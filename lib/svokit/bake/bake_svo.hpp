@@ -32,7 +32,8 @@ struct AoBakeRequest {
   std::optional<std::uint32_t> rays;
   std::optional<std::uint32_t> reference;  ///< also the vertices' error against this many rays
   ImportOptions import;                    ///< where the mesh's side files may be read from
-  /// Receives each of the mesh's import warnings, as "MESH: warning".
+  /// Receives each of the mesh's import warnings, as "MESH: warning", and the texture's
+  /// overlapping UV charts.
   std::function<void(const std::string&)> warn;
   bool strict = false;  ///< any warning is an error: nothing is written
 };
@@ -59,8 +60,11 @@ struct AoBakeReport {
   std::uint64_t output_bytes = 0;  ///< the output octree's size
   std::optional<Points> vertices;  ///< traced for the vertex output or the reference
   std::optional<double> reference_mean_ao;
-  AoErrors reference_errors;                         ///< the vertices' against the reference
-  std::optional<Points> texels;                      ///< covered texels of the texture
+  AoErrors reference_errors;  ///< the vertices' against the reference
+  struct Texels : Points {
+    std::uint64_t overlapped = 0;  ///< covered texels inside a second triangle too
+  };
+  std::optional<Texels> texels;                      ///< covered texels of the texture
   std::uint64_t cache_capacity = 0, cache_peak = 0;  ///< the pages' cache, in bytes
   std::uint64_t pages_decoded = 0;                   ///< by the cones (again after eviction)
 };

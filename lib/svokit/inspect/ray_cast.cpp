@@ -513,9 +513,15 @@ StatusOr<RenderResult> Draw(const Svo& svo, const SvoPageSource* pages,
       for (int x = x0; x < x1; ++x) {
         const RayHit& hit = rays[static_cast<std::size_t>((y - y0) * (x1 - x0) + (x - x0))].hit();
         tile_visits[t] += hit.visits;
-        if (!hit.hit) continue;
-        ++tile_hits[t];
         std::uint8_t* px = result.image.at(x, y);
+        if (!hit.hit) {
+          if (options.background) {
+            std::copy(options.background->begin(), options.background->end(), px);
+            px[3] = 255;
+          }
+          continue;
+        }
+        ++tile_hits[t];
         px[3] = 255;
         switch (options.shade) {
           case Shade::kColor: {

@@ -27,6 +27,22 @@ StatusOr<Shade> ParseShade(std::string_view name) {
   return Status::BadInput("shade '{}' is not color, normal, depth or ao", name);
 }
 
+StatusOr<std::optional<Background>> ParseBackground(std::string_view text) {
+  if (text == "none") return std::optional<Background>();
+  Background rgb{};
+  bool ok = text.size() == 6;
+  for (std::size_t i = 0; ok && i < 3; ++i) {
+    const char* begin = text.data() + 2 * i;
+    const auto [ptr, ec] = std::from_chars(begin, begin + 2, rgb[i], 16);
+    ok = ec == std::errc() && ptr == begin + 2;
+  }
+  if (!ok) {
+    return Status::BadInput("background '{}': expected none or RRGGBB in hexadecimal, e.g. 334d66",
+                            text);
+  }
+  return std::optional<Background>(rgb);
+}
+
 StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {
   const auto bad = [&] {
     return Status::BadInput("size '{}': expected WxH with each side 1 to {}", text, kMaxImageSide);

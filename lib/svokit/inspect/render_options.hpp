@@ -30,6 +30,14 @@ std::string_view ViewName(View view);
 StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text);
 std::string_view ShadeName(Shade shade);
 
+/// An opaque background colour, sRGB bytes.
+using Background = std::array<std::uint8_t, 3>;
+/// "none" (transparent: nullopt) or "RRGGBB" in hexadecimal (e.g. "334d66"); else bad input.
+StatusOr<std::optional<Background>> ParseBackground(std::string_view text);
+/// What `--shade ao` draws behind the octree unless told otherwise: a dark slate blue, apart from
+/// every grey an AO term can take (white open, black occluded).
+inline constexpr Background kAoBackground = {0x33, 0x4d, 0x66};
+
 struct RenderOptions {
   View view = View::kFront;
   int width = 512, height = 512;
@@ -38,6 +46,8 @@ struct RenderOptions {
   Shade shade = Shade::kColor;
   /// Intersect contour slabs; off, leaves are their full cubes (what contours save is visible).
   bool contours = true;
+  /// Where no ray hits: this colour, opaque; nullopt: transparent (alpha 0).
+  std::optional<Background> background;
 };
 
 }  // namespace svokit
