@@ -5,7 +5,8 @@
 // --reference rays per point (seed 0). The cone options are svo-bake's defaults: distance 0.25 ×
 // the grid's diagonal, falloff 1, aperture 1, offset 1.
 //
-//   ao_bench [--reference RAYS] [--images DIR] MESH [MESH OPTIONS] [MESH [MESH OPTIONS]]...
+//   ao_bench [--reference RAYS] [--images DIR] [--cones N] MESH [MESH OPTIONS] [MESH ...]...
+// --cones N measures the constellation of N cones alone (default: 3, 5, 8 and 16).
 // MESH OPTIONS (for the mesh before them):
 //   --depths A-B      octree depths A..B (resolution 2^depth; default 8-10)
 //   --surface N       N surface points (SurfacePoints, seed 1) instead of the vertices
@@ -278,6 +279,7 @@ std::uint32_t ParseDepth(const std::string& s) {
 int main(int argc, char** argv) {
   std::uint32_t reference_rays = 1024;
   std::filesystem::path images = ".";
+  std::uint32_t only_cones = 0;
   std::vector<MeshSpec> specs;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -292,6 +294,8 @@ int main(int argc, char** argv) {
       };
       if (a == "--reference") {
         reference_rays = static_cast<std::uint32_t>(std::stoul(next()));
+      } else if (a == "--cones") {
+        only_cones = static_cast<std::uint32_t>(std::stoul(next()));
       } else if (a == "--images") {
         images = next();
       } else if (a == "--depths") {
@@ -333,7 +337,7 @@ int main(int argc, char** argv) {
   if (specs.empty()) {
     Fail(
         "usage: ao_bench [--reference RAYS] [--images DIR] MESH [--depths A-B] [--surface N] "
-        "[--speed D] [--image NAME D] [--per-pixel] [--view X,Y,Z] [--cull] ...");
+        "[--speed D] [--image NAME D] [--per-pixel] [--view X,Y,Z] [--cull] ... [--cones N]");
   }
 
   std::vector<Loaded> meshes;
@@ -355,9 +359,9 @@ int main(int argc, char** argv) {
   }
 
   std::vector<std::string> speed_rows, equal_rows, notes;
-  fmt::print("{:<18} {:>5} {:>5} {:>5} {:>9} {:>8} {:>8} {:>8} {:>7} {:>7} {:>13}\n", "mesh",
+  fmt::print("{:<18} {:>5} {:>5} {:>5} {:>9} {:>8} {:>8} {:>8} {:>7} {:>7} {:>13} {:>12}\n", "mesh",
              "depth", "cones", "res", "voxels", "mean_err", "p95_err", "max_err", "cone_ao",
-             "ref_ao", "cone_points/s");
+             "ref_ao", "cone_points/s", "steps_per_cone");
   std::fflush(stdout);
   for (const Loaded& l : meshes) {
     auto embree = RayAoReference::Make(l.mesh);
@@ -371,14 +375,19 @@ int main(int argc, char** argv) {
       const std::vector<float> truth = embree->Occlusion(points, truth_options);
       std::vector<float> cones8;
       for (const std::uint32_t count : kConeCounts) {
+        if (only_cones != 0 && count != only_cones) continue;
         const ConeTracer tracer = MakeTracer(svo, DefaultCones(svo, count));
         auto [ao, t] = Timed(3, [&] { return tracer.Occlusion(points); });
+        ConeStats stats;
+        tracer.Occlusion(points, &stats);
         const AoErrors e = CompareAo(ao, truth);
         fmt::print(
             "{:<18} {:>5} {:>5} {:>5} {:>9} {:>8.4f} {:>8.4f} {:>8.4f} {:>7.4f} {:>7.4f} "
-            "{:>13.0f}\n",
+            "{:>13.0f} {:>12.1f}\n",
             l.spec.name, depth, count, 1u << depth, svo.voxels, e.mean, e.p95, e.max, MeanAo(ao),
-            MeanAo(truth), static_cast<double>(points.size()) / t);
+            MeanAo(truth), static_cast<double>(points.size()) / t,
+            static_cast<double>(stats.samples) /
+                static_cast<double>(std::max<std::uint64_t>(stats.cones, 1)));
         std::fflush(stdout);
         if (count == 8) cones8 = std::move(ao);
       }

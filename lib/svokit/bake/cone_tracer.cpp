@@ -1,6 +1,7 @@
 #include "svokit/bake/cone_tracer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <numbers>
@@ -244,7 +245,7 @@ double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int l
 }
 
 float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta,
-                            double tan_half, Cursor& cursor) const {
+                            double tan_half, Cursor& cursor, std::uint64_t& samples) const {
   const std::uint32_t depth = octree_->depth();
   const double lambda = options_.falloff / distance_voxels_;
   const double o = offset_voxels_;
@@ -253,15 +254,31 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
   float occlusion = 0, transmittance = 1;
   cursor.valid = 0;
   const Vec3d inverse_axis{1 / axis.x, 1 / axis.y, 1 / axis.z};
-  for (double t = 1;;) {
+  double t = 1;
+  // The last sample before the cone leaves the octree's cube is taken on its face: a wall there
+  // is read from inside only, and the step past the face would skip it.
+  bool at_face = false;
+  auto advance = [&](const Vec3d& p, double next) {
+    if (!at_face) {
+      const double face = t + ExitDistance(p, inverse_axis, 0) - 2e-6 * root_side_;
+      if (next > face) {
+        at_face = true;
+        if (face > t) next = face;
+      }
+    }
+    t = next;
+  };
+  for (;;) {
     // Distance from the surface point (the origin sits `o` above it along the normal).
     const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
     if (r > distance_voxels_) break;
+    ++samples;
     const double diameter = std::max(1.0, 2 * t * tan_half);
     // The sample's footprint (about a node size plus the shell's half-thickness around it) stays
     // off the point's own tangent plane: near it, the cone reads finer levels than its diameter.
     const double height = o + t * cos_theta;
     const double footprint = std::clamp((height - kShellReach) / kFootprint, 1.0, diameter);
+    const double step = kStep * footprint;
     const float lod =
         std::clamp(static_cast<float>(depth) - FastLog2(static_cast<float>(footprint)), 0.f,
                    static_cast<float>(depth));
@@ -274,12 +291,16 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
     const int reached = Descend(p, deepest, cursor);
     if (reached < 0) break;  // out of the octree's cube, which the axis does not enter again
     if (reached < static_cast<int>(coarse)) {
-      // Inside an empty node: nothing to read there until the cone leaves it or grows to its
-      // size (then a coarser level's brick may hold its neighbours' surface).
+      // Inside an empty node: nothing to read there until the cone leaves it or its footprint
+      // outgrows it, which needs both the diameter and the tangent-plane limit above its size.
       const int empty = reached + 1;
-      t = std::max(t + kStep * footprint,
-                   std::min(t + ExitDistance(p, inverse_axis, empty),
-                            node_size_[static_cast<std::size_t>(empty)] / (2 * tan_half)));
+      const double size = node_size_[static_cast<std::size_t>(empty)];
+      const double grown =
+          std::max(size / (2 * tan_half), (size * kFootprint + kShellReach - o) / cos_theta);
+      const double exit = t + ExitDistance(p, inverse_axis, empty);
+      // The next node is entered half a step past its face: samples on the faces of the nodes
+      // entered would all read grid-aligned walls at the same phase.
+      advance(p, exit < grown ? std::max(t + step, exit + 0.5 * step) : std::max(t + step, grown));
       continue;
     }
     float coverage = Coverage(p, coarse, cursor);
@@ -296,12 +317,17 @@ float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_t
       transmittance *= 1 - alpha;
       if (transmittance <= kClear) break;
     }
-    t += kStep * footprint;
+    advance(p, t + step);
   }
   return occlusion;
 }
 
 float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
+  ConeStats stats;
+  return Occlusion(point, index, stats);
+}
+
+float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index, ConeStats& stats) const {
   // A point without a normal (a voxel whose brick holds none) has no hemisphere to trace.
   if (!(Dot(point.normal, point.normal) > 0.25)) return 0;
   const Vec3d n = point.normal;
@@ -319,12 +345,13 @@ float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
   for (std::size_t i = 0; i < cones_.size(); ++i) {
     const Vec3d& local = cones_[i].axis;
     const Vec3d axis = t * local.x + b * local.y + n * local.z;
-    sum += TraceCone(origin, axis, local.z, tan_half_[i], cursor);
+    sum += TraceCone(origin, axis, local.z, tan_half_[i], cursor, stats.samples);
   }
+  stats.cones += cones_.size();
   return sum / static_cast<float>(cones_.size());
 }
 
-std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points) const {
+std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points, ConeStats* stats) const {
   // By the Morton key of each point's voxel (clamped into the grid's cube), ties by index.
   const double most = root_side_ - 1;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> order(points.size());
@@ -339,12 +366,20 @@ std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points) const 
   });
   std::sort(order.begin(), order.end());
   std::vector<float> ao(points.size());
+  std::atomic<std::uint64_t> cones{0}, samples{0};
   ParallelChunks(points.size(), 256, [&](std::size_t begin, std::size_t end) {
+    ConeStats local;
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = order[k].second;
-      ao[i] = Occlusion(points[i], i);
+      ao[i] = Occlusion(points[i], i, local);
     }
+    cones += local.cones;
+    samples += local.samples;
   });
+  if (stats) {
+    stats->cones += cones.load();
+    stats->samples += samples.load();
+  }
   return ao;
 }
 

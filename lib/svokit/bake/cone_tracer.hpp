@@ -57,6 +57,12 @@ struct AoPoint {
 /// offset < 0, non-finite values).
 Status CheckConeOptions(const ConeOptions& options);
 
+/// What a trace cost: cones traced and the samples they read.
+struct ConeStats {
+  std::uint64_t cones = 0;
+  std::uint64_t samples = 0;
+};
+
 class ConeTracer {
  public:
   /// Bad input: options out of range (CheckConeOptions).
@@ -65,9 +71,12 @@ class ConeTracer {
   /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal);
   /// `index` numbers the point for the jitter. Thread-safe.
   float Occlusion(const AoPoint& point, std::uint64_t index) const;
+  /// The same, adding the cones traced and the samples they read to `stats`.
+  float Occlusion(const AoPoint& point, std::uint64_t index, ConeStats& stats) const;
   /// Occlusion of every point, in parallel, traced in the order of their voxels' keys (cones from
   /// nearby points read the same pages); the result depends on neither order nor thread count.
-  std::vector<float> Occlusion(std::span<const AoPoint> points) const;
+  /// `stats`, when given, gets the cones traced and the samples they read added.
+  std::vector<float> Occlusion(std::span<const AoPoint> points, ConeStats* stats = nullptr) const;
 
   const ConeOptions& options() const { return options_; }
 
@@ -93,7 +102,7 @@ class ConeTracer {
   float Coverage(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   double ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const;
   float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half,
-                  Cursor& cursor) const;
+                  Cursor& cursor, std::uint64_t& samples) const;
 
   const TraceOctree* octree_;
   GridTransform grid_;
