@@ -41,9 +41,10 @@ struct SnappedMesh {
   }
 };
 
-SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid, bool holes) {
+// `solid`: the file's interior is filled, so alpha made no holes (it is off for solids).
+SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid, bool solid) {
   const std::vector<FixedPoint3> fixed = SnapToVoxelSpace(mesh, grid);
-  auto may_be_hole = [&](std::size_t t) -> std::uint8_t { return mesh.ReadsAlpha(t); };
+  const bool holes = mesh.has_alpha() && !solid;
   SnappedMesh out;
   out.points.reserve(fixed.size());
   for (const FixedPoint3& p : fixed) {
@@ -63,10 +64,10 @@ SnappedMesh Snap(const Mesh& mesh, const GridTransform& grid, bool holes) {
                             e0[0] * e1[1] - e0[1] * e1[0] == 0;
     if (!degenerate) {
       out.triangles.push_back({t[0], t[1], t[2]});
-      if (holes) out.triangle_holes.push_back(may_be_hole(index));
+      if (holes) out.triangle_holes.push_back(mesh.ReadsAlpha(index));
       continue;
     }
-    if (holes) out.segment_holes.push_back(may_be_hole(index));
+    if (holes) out.segment_holes.push_back(mesh.ReadsAlpha(index));
     // Collinear corners: the two farthest apart span the others.
     const openvdb::Vec3d &pa = out.points[t[0]], &pb = out.points[t[1]], &pc = out.points[t[2]];
     const double ab = (pb - pa).lengthSqr(), ac = (pc - pa).lengthSqr(), bc = (pc - pb).lengthSqr();
@@ -179,8 +180,7 @@ CheckResult CheckOccupancy(const Svo& svo, const std::vector<std::uint64_t>& lea
   r.note = fmt::format("{}: leaf required within {:.4f} h, allowed within {:.4f} h (± {} h)",
                        thin ? "thin" : "conservative", required, allowed, tol);
 
-  // A surface's materials reading alpha may leave holes (a solid's never: alpha is off there).
-  const SnappedMesh snapped = Snap(mesh, svo.grid, mesh.has_alpha() && !svo.solid);
+  const SnappedMesh snapped = Snap(mesh, svo.grid, svo.solid);
   const openvdb::FloatGrid::Ptr distance = DistanceField(snapped);
   const openvdb::FloatGrid::Ptr required_distance = RequiredField(snapped, distance);
 
@@ -283,7 +283,7 @@ CubeOccupancy::CubeOccupancy(const Mesh& mesh, const GridTransform& grid, VoxelM
                              bool solid)
     : impl_(std::make_unique<Impl>()) {
   InitializeOpenVdb();
-  impl_->snapped = Snap(mesh, grid, mesh.has_alpha() && !solid);
+  impl_->snapped = Snap(mesh, grid, solid);
   impl_->thin = mode == VoxelMode::kThin;
   impl_->required = impl_->thin ? 0.5 / std::sqrt(3.0) : 0.5;
   impl_->allowed = 0.5 * std::sqrt(3.0);

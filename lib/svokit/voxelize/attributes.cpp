@@ -100,10 +100,6 @@ ClipVertex NearestPoint(const Frame& f) {
   return {vb / sum, vc / sum};
 }
 
-}  // namespace
-
-namespace {
-
 // The RGBA image a material's lookups read when it reads alpha: the colour texture's texels (white
 // without one) premultiplied by the coverage (the colour texture's alpha, or the coverage map's),
 // which a mask first tests against its cutoff: so the pyramid's box filter averages surface only,
@@ -277,6 +273,11 @@ std::optional<Rgba> AttributeSampler::SharedColor() const {
   return shared;
 }
 
+const AttributeSampler::MaterialInfo* AttributeSampler::MaterialOf(std::size_t triangle) const {
+  const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
+  return id < materials_.size() ? &materials_[id] : nullptr;
+}
+
 bool AttributeSampler::reads_alpha() const {
   for (const MaterialInfo& m : materials_) {
     if (m.mode != AlphaMode::kOpaque) return true;
@@ -317,8 +318,7 @@ AttributeSampler::Prepared AttributeSampler::Prepare(std::size_t triangle) const
   const double nx = std::abs(p.normal.x), ny = std::abs(p.normal.y), nz = std::abs(p.normal.z);
   p.axis = nx > ny && nx > nz ? 0 : (ny > nz ? 1 : 2);
 
-  const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
-  const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  const MaterialInfo* material = MaterialOf(triangle);
   // Textures are sampled only for what is wanted (MaterialInfo::texture is null otherwise); vertex
   // colours vary the colour, and a blend's opacity.
   const bool textured = material && material->texture && mesh_.has_uvs();
@@ -463,8 +463,7 @@ AttributeSample AttributeSampler::Finish(const Prepared& p, const ClipVertex* po
   const double bary[3] = {1.0 - b1 - b2, b1, b2};
   const std::size_t corner = 3 * triangle;
 
-  const std::uint32_t id = triangle < mesh_.material_ids.size() ? mesh_.material_ids[triangle] : 0;
-  const MaterialInfo* material = id < materials_.size() ? &materials_[id] : nullptr;
+  const MaterialInfo* material = MaterialOf(triangle);
   if (want_color_ || (material && material->mode != AlphaMode::kOpaque)) {
     // Colour straight, alpha the opacity (Opacity()): each factor's mean, multiplied.
     double c[4] = {1, 1, 1, 1};

@@ -187,6 +187,8 @@ class AttributeSampler {
     AlphaMode mode = AlphaMode::kOpaque;
     float cutoff = 0.5f;
   };
+  // Triangle t's material (null for an index past the materials).
+  const MaterialInfo* MaterialOf(std::size_t triangle) const;
   // A sample's opacity from the means of the vertex colours' and the texture's alpha.
   static float Opacity(const MaterialInfo* material, double vertex_alpha, double texture_alpha);
 
