@@ -12,7 +12,6 @@
 #include "svokit/svo/sample_codec.hpp"
 
 namespace svokit {
-
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -29,7 +28,11 @@ constexpr float kClear = 0.002f;
 // Near the point's own surface a sample's footprint is kept off its tangent plane: the shell
 // reaches kShellReach voxels above the plane, and a sample of node size s reads about
 // s·kFootprint / 2 around it (tent cascade plus trilinear tails).
-constexpr double kShellReach = 1.5, kFootprint = 3.0;
+constexpr double kShellReach = 1.5, kFootprint = 3.5;
+// The cones over-estimate partial occlusion (circular cones overlap where they tile the hemisphere,
+// and the filter spreads a wall over more than its thickness), never none or full: a point's AO a
+// reads as a·(1 − kCalibration·(1 − a)), fitted to Embree's rays (docs/design.md).
+constexpr float kCalibration = 0.25f;
 
 // One ring of a constellation: `count` cones over the band sin²θ ∈ [u0, u1] (equal cosine-weighted
 // shares), azimuths rotated by `phase` of a cone's spacing.
@@ -53,15 +56,11 @@ std::vector<Ring> Rings(std::uint32_t cones) {
   }
 }
 
-// log2 of x ≥ 1 to about 1e-4: the exponent plus a quartic for ln of the mantissa (a level of
-// detail needs no more, and libm's log2f was a sixth of the tracer's time).
-float FastLog2(float x) {
-  const std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
-  const float exponent = static_cast<float>(static_cast<int>(bits >> 23) - 127);
-  const float m = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u);  // [1, 2)
-  const float ln_m =
-      -1.7417939f + (2.8212026f + (-1.4699568f + (0.44717955f - 0.056570851f * m) * m) * m) * m;
-  return exponent + 1.44269504f * ln_m;
+// The footprint of a sample of a cone of radius `radius` at `height` above the point's tangent
+// plane: about a node size plus the shell's half-thickness around it stays off that plane, so near
+// it the cone reads finer levels than its diameter.
+double Footprint(double height, double radius) {
+  return std::clamp((height - kShellReach) / kFootprint, 1.0, std::max(1.0, 2 * radius));
 }
 
 }  // namespace
@@ -133,6 +132,32 @@ ConeTracer::ConeTracer(const TraceOctree& octree, const ConeOptions& options)
   distance_voxels_ = options.distance / grid_.voxel_size();
   offset_voxels_ = options.offset * std::sqrt(3.0);
   root_side_ = std::ldexp(1.0, static_cast<int>(depth));
+  for (std::size_t i = 0; i < cones_.size(); ++i) {
+    std::vector<ConeSample> samples;
+    for (double t = 1;;) {
+      const double cos_theta = cones_[i].axis.z;
+      const double r =
+          std::sqrt(offset_voxels_ * offset_voxels_ + t * t + 2 * offset_voxels_ * t * cos_theta);
+      if (r > distance_voxels_) break;
+      samples.push_back(SampleAt(i, t));
+      t += kStep * Footprint(offset_voxels_ + t * cos_theta, t * tan_half_[i]);
+    }
+    schedule_.push_back(std::move(samples));
+  }
+}
+
+ConeTracer::ConeSample ConeTracer::SampleAt(std::size_t cone, double t) const {
+  const double cos_theta = cones_[cone].axis.z, o = offset_voxels_;
+  const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
+  const double footprint = Footprint(o + t * cos_theta, t * tan_half_[cone]);
+  const auto depth = static_cast<float>(octree_->depth());
+  const float lod = std::clamp(depth - static_cast<float>(std::log2(footprint)), 0.f, depth);
+  ConeSample s;
+  s.t = t;
+  s.coarse = static_cast<std::uint32_t>(lod);
+  s.fine_weight = s.coarse < octree_->depth() ? lod - static_cast<float>(s.coarse) : 0;
+  s.falloff = static_cast<float>(1 / (1 + options_.falloff / distance_voxels_ * r));
+  return s;
 }
 
 int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
@@ -143,6 +168,7 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
   const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
   const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
              z = static_cast<std::uint32_t>(v.z);
+  cursor.full = false;
   // The levels whose node holds both this point and the last one keep their indices.
   const std::uint32_t differ =
       static_cast<std::uint32_t>(std::bit_width((x ^ cursor.x) | (y ^ cursor.y) | (z ^ cursor.z)));
@@ -167,6 +193,7 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
     const std::uint8_t mask = k < tree.masks.size() ? tree.masks[k][i] : 0;
     if (((mask >> c) & 1u) == 0) {
       cursor.valid = l;
+      cursor.full = k < tree.full.size() && (tree.full[k][i] >> c & 1u);
       return static_cast<int>(l);
     }
     cursor.index[l + 1] = tree.first_child[k][i] + RankInByte(mask, c);
@@ -177,6 +204,46 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
     }
   }
   cursor.valid = level;
+  return static_cast<int>(level);
+}
+
+int ConeTracer::Probe(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
+  const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
+  if (level <= page_level || octree_->solid()) return Descend(v, level, cursor);
+  if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
+        v.z < root_side_)) {
+    return -1;
+  }
+  const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
+             z = static_cast<std::uint32_t>(v.z);
+  // The cursor's page, unless the point lies in another one.
+  const std::uint32_t page_shift = depth - page_level;
+  if (cursor.valid < page_level || cursor.page_index == ~std::uint64_t{0} ||
+      ((x ^ cursor.x) | (y ^ cursor.y) | (z ^ cursor.z)) >> page_shift) {
+    const int top = Descend(v, page_level, cursor);
+    if (top < static_cast<int>(page_level)) return top;
+  }
+  const NodeBits& bits = cursor.page->nodes;
+  const std::uint32_t local = (1u << page_shift) - 1;
+  const std::uint32_t lx = x & local, ly = y & local, lz = z & local;
+  const std::uint32_t above_voxels = std::min(level, depth - 1);
+  // The levels whose node holds both this point and the last one probed are known to exist.
+  const std::uint32_t differ = static_cast<std::uint32_t>(
+      std::bit_width((x ^ cursor.probe_x) | (y ^ cursor.probe_y) | (z ^ cursor.probe_z)));
+  std::uint32_t l = std::max(page_level, std::min(cursor.probed, depth - differ)) + 1;
+  cursor.probe_x = x;
+  cursor.probe_y = y;
+  cursor.probe_z = z;
+  for (; l <= above_voxels; ++l) {
+    const std::uint32_t k = l - page_level - 1;
+    // A page that did not decode holds no bits, and reads as empty.
+    if (k >= bits.levels() || !bits.At(k, depth - l, lx, ly, lz)) {
+      cursor.probed = l - 1;
+      return static_cast<int>(l) - 1;
+    }
+  }
+  cursor.probed = above_voxels;
+  if (level == depth && !cursor.page->voxels.At(x, y, z)) return static_cast<int>(depth) - 1;
   return static_cast<int>(level);
 }
 
@@ -244,82 +311,77 @@ double ConeTracer::ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int l
   return exit + 1e-6 * size;
 }
 
-float ConeTracer::TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta,
-                            double tan_half, Cursor& cursor, std::uint64_t& samples) const {
-  const std::uint32_t depth = octree_->depth();
-  const double lambda = options_.falloff / distance_voxels_;
-  const double o = offset_voxels_;
-  // Occlusion as the rays define it: the mean falloff at the first hit, E[f(r)]. Each sample
-  // occludes its share of what the samples before it let through (the transmittance).
-  float occlusion = 0, transmittance = 1;
-  cursor.valid = 0;
-  const Vec3d inverse_axis{1 / axis.x, 1 / axis.y, 1 / axis.z};
-  double t = 1;
+struct ConeTracer::ConeMarch {
+  Vec3d origin, axis, inverse_axis;
+  const ConeSample* next = nullptr;
+  const ConeSample* end = nullptr;
   // The last sample before the cone leaves the octree's cube is taken on its face: a wall there
   // is read from inside only, and the step past the face would skip it.
-  bool at_face = false;
-  auto advance = [&](const Vec3d& p, double next) {
-    if (!at_face) {
-      const double face = t + ExitDistance(p, inverse_axis, 0) - 2e-6 * root_side_;
-      if (next > face) {
-        at_face = true;
-        if (face > t) next = face;
-      }
-    }
-    t = next;
-  };
-  for (;;) {
-    // Distance from the surface point (the origin sits `o` above it along the normal).
-    const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
-    if (r > distance_voxels_) break;
-    ++samples;
-    const double diameter = std::max(1.0, 2 * t * tan_half);
-    // The sample's footprint (about a node size plus the shell's half-thickness around it) stays
-    // off the point's own tangent plane: near it, the cone reads finer levels than its diameter.
-    const double height = o + t * cos_theta;
-    const double footprint = std::clamp((height - kShellReach) / kFootprint, 1.0, diameter);
-    const double step = kStep * footprint;
-    const float lod =
-        std::clamp(static_cast<float>(depth) - FastLog2(static_cast<float>(footprint)), 0.f,
-                   static_cast<float>(depth));
-    const auto coarse = static_cast<std::uint32_t>(lod);
-    const float fine_weight = lod - static_cast<float>(coarse);
-    const Vec3d p = origin + axis * t;
-    // One descent serves both levels: to the finer one, the coarser on its way.
-    const bool fine = fine_weight > 0 && coarse < depth;
-    const std::uint32_t deepest = fine ? coarse + 1 : coarse;
-    const int reached = Descend(p, deepest, cursor);
-    if (reached < 0) break;  // out of the octree's cube, which the axis does not enter again
-    if (reached < static_cast<int>(coarse)) {
-      // Inside an empty node: nothing to read there until the cone leaves it or its footprint
-      // outgrows it, which needs both the diameter and the tangent-plane limit above its size.
-      const int empty = reached + 1;
-      const double size = node_size_[static_cast<std::size_t>(empty)];
-      const double grown =
-          std::max(size / (2 * tan_half), (size * kFootprint + kShellReach - o) / cos_theta);
-      const double exit = t + ExitDistance(p, inverse_axis, empty);
-      // The next node is entered half a step past its face: samples on the faces of the nodes
-      // entered would all read grid-aligned walls at the same phase.
-      advance(p, exit < grown ? std::max(t + step, exit + 0.5 * step) : std::max(t + step, grown));
-      continue;
-    }
-    float coverage = Coverage(p, coarse, cursor);
-    if (fine) {
-      // An absent finer node covers nothing.
-      const float finer = reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor) : 0;
-      coverage += fine_weight * (finer - coverage);
-    }
-    if (coverage > 0) {
-      // Corrected for the step: a wall is seen by 1/kStep samples, (1 − α)^(1/kStep) = 1 −
-      // coverage.
-      const float alpha = 1.f - std::sqrt(1.f - coverage);
-      occlusion += transmittance * alpha * static_cast<float>(1 / (1 + lambda * r));
-      transmittance *= 1 - alpha;
-      if (transmittance <= kClear) break;
-    }
-    advance(p, t + step);
+  double face = 0, last_t = 0;
+  std::size_t cone = 0;
+  float occlusion = 0, transmittance = 1;
+};
+
+bool ConeTracer::Step(ConeMarch& m, Cursor& cursor, std::uint64_t& samples) const {
+  if (m.next == m.end) return false;
+  ConeSample sample;
+  if (m.next->t <= m.face) {
+    sample = *m.next++;
+  } else if (m.face > m.last_t) {
+    sample = SampleAt(m.cone, m.face);  // the last one
+    m.next = m.end;
+  } else {
+    m.next = m.end;
+    return false;
   }
-  return occlusion;
+  m.last_t = sample.t;
+  ++samples;
+  const Vec3d p = m.origin + m.axis * sample.t;
+  const std::uint32_t coarse = sample.coarse;
+  const bool fine = sample.fine_weight > 0;
+  const std::uint32_t deepest = fine ? coarse + 1 : coarse;
+  const int reached = Probe(p, deepest, cursor);
+  if (reached < 0) {
+    m.next = m.end;  // out of the octree's cube, which the axis does not enter again
+    return false;
+  }
+  // Inside a full leaf when the node of level reached + 1 is one.
+  const bool full = cursor.full;
+  if (reached < static_cast<int>(coarse) && !full) {
+    // Inside an empty node: the samples still in it that read its level or a finer one read
+    // nothing.
+    const int empty = reached + 1;
+    const double exit = sample.t + ExitDistance(p, m.inverse_axis, empty);
+    while (m.next != m.end && m.next->t < exit &&
+           m.next->coarse >= static_cast<std::uint32_t>(empty)) {
+      ++m.next;
+    }
+    return true;
+  }
+  float coverage = 1;
+  if (reached >= static_cast<int>(coarse)) {
+    if (!octree_->solid()) Descend(p, deepest, cursor);  // Probe left it at the page
+    coverage = Coverage(p, coarse, cursor);
+    if (fine) {
+      // An absent finer node covers nothing, a full leaf everything.
+      const float finer = reached == static_cast<int>(deepest) ? Coverage(p, deepest, cursor)
+                          : full                               ? 1.f
+                                                               : 0.f;
+      coverage += sample.fine_weight * (finer - coverage);
+    }
+  }
+  if (coverage > 0) {
+    // Corrected for the step: a wall is seen by 1/kStep samples, (1 − α)^(1/kStep) = 1 −
+    // coverage.
+    const float alpha = 1.f - std::sqrt(1.f - coverage);
+    m.occlusion += m.transmittance * alpha * sample.falloff;
+    m.transmittance *= 1 - alpha;
+    if (m.transmittance <= kClear) {
+      m.next = m.end;
+      return false;
+    }
+  }
+  return true;
 }
 
 float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
@@ -328,6 +390,12 @@ float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
 }
 
 float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index, ConeStats& stats) const {
+  Cursor cursor;
+  return Trace(point, index, cursor, stats);
+}
+
+float ConeTracer::Trace(const AoPoint& point, std::uint64_t index, Cursor& cursor,
+                        ConeStats& stats) const {
   // A point without a normal (a voxel whose brick holds none) has no hemisphere to trace.
   if (!(Dot(point.normal, point.normal) > 0.25)) return 0;
   const Vec3d n = point.normal;
@@ -340,15 +408,26 @@ float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index, ConeStats
     t = t2;
   }
   const Vec3d origin = grid_.WorldToVoxel(point.position) + n * offset_voxels_;
-  Cursor cursor;
   float sum = 0;
   for (std::size_t i = 0; i < cones_.size(); ++i) {
+    ConeMarch m;
     const Vec3d& local = cones_[i].axis;
-    const Vec3d axis = t * local.x + b * local.y + n * local.z;
-    sum += TraceCone(origin, axis, local.z, tan_half_[i], cursor, stats.samples);
+    m.origin = origin;
+    m.axis = t * local.x + b * local.y + n * local.z;
+    m.inverse_axis = {1 / m.axis.x, 1 / m.axis.y, 1 / m.axis.z};
+    m.cone = i;
+    m.next = schedule_[i].data();
+    m.end = m.next + schedule_[i].size();
+    const bool inside = origin.x >= 0 && origin.y >= 0 && origin.z >= 0 && origin.x < root_side_ &&
+                        origin.y < root_side_ && origin.z < root_side_;
+    m.face = inside ? ExitDistance(origin, m.inverse_axis, 0) - 2e-6 * root_side_ : 0;
+    while (Step(m, cursor, stats.samples)) {
+    }
+    sum += m.occlusion;
   }
   stats.cones += cones_.size();
-  return sum / static_cast<float>(cones_.size());
+  const float a = sum / static_cast<float>(cones_.size());
+  return a * (1 - kCalibration * (1 - a));
 }
 
 std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points, ConeStats* stats) const {
@@ -369,9 +448,11 @@ std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points, ConeSt
   std::atomic<std::uint64_t> cones{0}, samples{0};
   ParallelChunks(points.size(), 256, [&](std::size_t begin, std::size_t end) {
     ConeStats local;
+    // Points in key order share most of their paths and pages.
+    Cursor cursor;
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = order[k].second;
-      ao[i] = Occlusion(points[i], i, local);
+      ao[i] = Trace(points[i], i, cursor, local);
     }
     cones += local.cones;
     samples += local.samples;

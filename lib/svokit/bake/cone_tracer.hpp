@@ -84,7 +84,7 @@ class ConeTracer {
   ConeTracer(const TraceOctree& octree, const ConeOptions& options);
   // The path of the last lookup: node indices at levels 0 .. valid of the nodes holding the voxel
   // (x, y, z), and the page they lie in. A cone's samples move little, so most of the path is
-  // reused; a point's cones start in one page.
+  // reused.
   struct Cursor {
     std::uint32_t x = 0, y = 0, z = 0;
     std::uint32_t valid = 0;
@@ -94,23 +94,47 @@ class ConeTracer {
     // The occupancy around the last voxel read at the voxel level.
     std::int64_t voxel[3] = {-1, -1, -1};
     std::uint32_t around = 0;
+    // Probe's last point and the deepest level known to exist there (within the cursor's page).
+    std::uint32_t probe_x = 0, probe_y = 0, probe_z = 0;
+    std::uint32_t probed = 0;
+    // Whether the last descent stopped at a full leaf (a solid's interior), not at empty space.
+    bool full = false;
   };
+  // A sample of a cone, at `t` voxels along its axis from the origin: what it reads (levels
+  // `coarse` and, weighted `fine_weight`, coarse + 1) and the falloff there. Its position along
+  // the axis depends on the cone alone, so a constellation's samples are computed once.
+  struct ConeSample {
+    double t = 0;
+    float falloff = 1, fine_weight = 0;
+    std::uint32_t coarse = 0;
+  };
+  // One cone of one point as it marches: where it stands in its schedule and what it has seen.
+  struct ConeMarch;
+
+  ConeSample SampleAt(std::size_t cone, double t) const;
   // Walks `cursor` towards the node of `level` holding voxel-space point `v`: the deepest level
-  // reached (`level` when that node exists), or −1 outside the octree's cube.
+  // reached (`level` when that node exists), or −1 outside the octree's cube. cursor.full says
+  // whether the child it stopped at is a full leaf.
   int Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
+  // Descend's result by the pages' node bits, walking the masks only above the page level (and
+  // everywhere in a solid, whose full leaves have no bits): the cursor is left in the page holding
+  // `v` (when one does), not at `level`.
+  int Probe(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   // Coverage at `v` in the node of `level` the cursor holds (trilinear in its brick).
   float Coverage(const Vec3d& v, std::uint32_t level, Cursor& cursor) const;
   double ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const;
-  float TraceCone(const Vec3d& origin, const Vec3d& axis, double cos_theta, double tan_half,
-                  Cursor& cursor, std::uint64_t& samples) const;
+  // One sample (or one skip over empty space) of `march`; false once the cone is done.
+  bool Step(ConeMarch& march, Cursor& cursor, std::uint64_t& samples) const;
+  float Trace(const AoPoint& point, std::uint64_t index, Cursor& cursor, ConeStats& stats) const;
 
   const TraceOctree* octree_;
   GridTransform grid_;
   ConeOptions options_;
   std::vector<Cone> cones_;
-  std::vector<double> tan_half_;   // per cone: tan of its half-angle
-  std::vector<double> node_size_;  // per level, in voxels
-  std::vector<float> level_gain_;  // per level: coverage per unit of opacity
+  std::vector<double> tan_half_;                   // per cone: tan of its half-angle
+  std::vector<std::vector<ConeSample>> schedule_;  // per cone, by t
+  std::vector<double> node_size_;                  // per level, in voxels
+  std::vector<float> level_gain_;                  // per level: coverage per unit of opacity
   double distance_voxels_ = 0;
   double offset_voxels_ = 0;
   double root_side_ = 0;

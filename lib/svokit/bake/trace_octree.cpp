@@ -30,7 +30,8 @@ StatusOr<std::uint64_t> PageBound(const SvoReader& reader, std::size_t i, std::u
   }
   const std::uint32_t side = 1u << (reader.depth() - reader.page_level());
   const auto tiles = static_cast<std::uint64_t>(TilesFor(side));
-  return sizeof(TracePage) + nodes * (samples + 1 + 8) + tiles * tiles * tiles * (4 + 64);
+  return sizeof(TracePage) + nodes * (samples + 1 + 8) + tiles * tiles * tiles * (4 + 64) +
+         NodeBits::BytesFor(reader.depth() - reader.page_level() - 1);
 }
 
 // The opacity bricks of the levels of `chunk` above the voxels, assembled from its samples.
@@ -68,6 +69,33 @@ VoxelOccupancy::VoxelOccupancy(const std::array<std::int64_t, 3>& lo, std::uint3
     words_[d - 1 + static_cast<std::size_t>(z % kTile)] |= std::uint64_t{1}
                                                            << ((x % kTile) + kTile * (y % kTile));
   }
+}
+
+NodeBits::NodeBits(std::span<const std::vector<std::uint64_t>> keys, std::uint32_t levels) {
+  bits_.reserve(levels);
+  for (std::uint32_t k = 0; k < levels && k + 1 < keys.size(); ++k) {
+    const std::uint32_t side_bits = k + 1;
+    std::vector<std::uint64_t>& bits =
+        bits_.emplace_back(((std::uint64_t{1} << (3 * side_bits)) + 63) / 64, 0);
+    const std::uint32_t local = (1u << side_bits) - 1;
+    for (const std::uint64_t key : keys[k + 1]) {
+      const MortonCoord c = MortonDecode(key);
+      const std::uint64_t i = (c.x & local) | (std::uint64_t{c.y & local} << side_bits) |
+                              (std::uint64_t{c.z & local} << (2 * side_bits));
+      bits[i >> 6] |= std::uint64_t{1} << (i & 63);
+    }
+  }
+}
+
+std::uint64_t NodeBits::bytes() const {
+  return NestedHeldBytes(bits_);
+}
+
+std::uint64_t NodeBits::BytesFor(std::uint32_t levels) {
+  std::uint64_t words = 0;
+  for (std::uint32_t k = 0; k < levels; ++k)
+    words += ((std::uint64_t{1} << (3 * (k + 1))) + 63) / 64;
+  return 8 * words + 24 * levels;
 }
 
 bool VoxelOccupancy::At(std::int64_t x, std::int64_t y, std::int64_t z) const {
@@ -180,9 +208,10 @@ StatusOr<std::shared_ptr<const TracePage>> TraceOctree::Decode(std::size_t i) co
       keys);
   page->levels.tree = std::move(chunk->tree);
   const MaskTree& t = page->levels.tree;
+  page->nodes = NodeBits(TreeLevelKeys(t, chunk->root_key, depth_ - 1), depth_ - page_level_ - 1);
   page->bytes = sizeof(TracePage) + NestedHeldBytes(t.masks) + NestedHeldBytes(t.full) +
                 NestedHeldBytes(t.first_child) + NestedHeldBytes(page->levels.opacity) +
-                page->voxels.bytes();
+                page->nodes.bytes() + page->voxels.bytes();
   return std::shared_ptr<const TracePage>(std::move(page));
 }
 

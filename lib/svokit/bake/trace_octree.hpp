@@ -52,9 +52,38 @@ struct TraceLevels {
   std::vector<DefaultInitVector<std::uint8_t>> opacity;
 };
 
-/// A page: its levels (page level .. depth; bricks above the voxels) and its voxels' occupancy.
+/// Which nodes of the levels strictly between a page's root and its voxels exist: per level, a bit
+/// per cell of the page's cube at that level (x fastest). Cones find empty space with a bit test
+/// each level instead of a walk through the masks.
+class NodeBits {
+ public:
+  NodeBits() = default;
+  /// `keys[k]`: the Morton keys of level root_level + k (TreeLevelKeys); `levels`: how many levels
+  /// below the root get bits (those above the voxels).
+  NodeBits(std::span<const std::vector<std::uint64_t>> keys, std::uint32_t levels);
+  /// Whether the node of level root + 1 + k holding page-local voxel (x, y, z) exists, with
+  /// `shift` = depth − that level.
+  bool At(std::uint32_t k, std::uint32_t shift, std::uint32_t x, std::uint32_t y,
+          std::uint32_t z) const {
+    const std::uint32_t side_bits = k + 1;
+    const std::uint64_t i = (x >> shift) | (std::uint64_t{y >> shift} << side_bits) |
+                            (std::uint64_t{z >> shift} << (2 * side_bits));
+    return bits_[k][i >> 6] >> (i & 63) & 1u;
+  }
+  std::uint32_t levels() const { return static_cast<std::uint32_t>(bits_.size()); }
+  std::uint64_t bytes() const;
+  /// What NodeBits of `levels` levels hold.
+  static std::uint64_t BytesFor(std::uint32_t levels);
+
+ private:
+  std::vector<std::vector<std::uint64_t>> bits_;
+};
+
+/// A page: its levels (page level .. depth; bricks above the voxels), which of their nodes exist
+/// by position, and its voxels' occupancy.
 struct TracePage {
   TraceLevels levels;
+  NodeBits nodes;
   VoxelOccupancy voxels;
   std::uint64_t bytes = 0;  ///< what it holds
 };
@@ -74,6 +103,8 @@ class TraceOctree {
   std::uint32_t depth() const { return depth_; }
   std::uint32_t page_level() const { return page_level_; }
   std::uint32_t brick_side() const { return brick_side_; }
+  /// Whether nodes may have full leaves (a solid's interior).
+  bool solid() const { return reader_.shape().solid; }
   const TraceLevels& top() const { return top_; }
 
   /// Page i, from the cache or decoded. A page that does not decode reads as empty (no voxels) and
