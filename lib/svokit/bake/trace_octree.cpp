@@ -216,7 +216,6 @@ StatusOr<std::shared_ptr<const TracePage>> TraceOctree::Decode(std::size_t i) co
 }
 
 std::shared_ptr<const TracePage> TraceOctree::Page(std::size_t i) const {
-  std::promise<std::shared_ptr<const TracePage>> made;
   std::unique_lock<std::mutex> lock(mutex_);
   if (auto found = entries_.find(i); found != entries_.end()) {
     uses_.splice(uses_.begin(), uses_, found->second.use);
@@ -224,6 +223,7 @@ std::shared_ptr<const TracePage> TraceOctree::Page(std::size_t i) const {
     lock.unlock();
     return page.get();
   }
+  std::promise<std::shared_ptr<const TracePage>> made;
   uses_.push_front(i);
   entries_.emplace(i, Entry{made.get_future().share(), 0, uses_.begin()});
   lock.unlock();
