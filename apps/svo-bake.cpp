@@ -64,8 +64,13 @@ struct BakeCli {
         ->option_text("X")
         ->capture_default_str();
     cli.add_option("--jitter", cones.jitter_seed,
-                   "Rotate each point's cones about its normal by an angle from this seed")
+                   "Rotate each point's cones about its normal by an angle hashed from this seed "
+                   "and the point's position (default 0)")
         ->option_text("SEED");
+    cli.add_flag_callback(
+           "--no-jitter", [&cones] { cones.jitter_seed.reset(); },
+           "Align every point's cones alike (the voxel grid's steps show as bands)")
+        ->excludes("--jitter");
     cli.add_option("--method", method,
                    "What --vertex-out and --texture-out hold: cones (through the octree) or rays "
                    "(Embree on the mesh: the reference)")

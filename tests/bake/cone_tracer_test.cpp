@@ -28,7 +28,7 @@ ConeOptions Options(std::uint32_t cones, double distance, double falloff) {
 float Cones(const TraceOctree& octree, const ConeOptions& options, const AoPoint& point) {
   StatusOr<ConeTracer> tracer = ConeTracer::Make(octree, options);
   EXPECT_TRUE(tracer.ok()) << tracer.status().message();
-  return tracer.ok() ? tracer->Occlusion(point, 0) : -1.f;
+  return tracer.ok() ? tracer->Occlusion(point) : -1.f;
 }
 
 float Rays(const Mesh& mesh, double distance, double falloff, const AoPoint& point) {
@@ -56,14 +56,14 @@ TEST(ConeTracer, APlaneOccludesNothingAboveIt) {
   for (const std::uint32_t cones : kConstellations) {
     for (const bool jitter : {false, true}) {
       ConeOptions options = Options(cones, 0.5, 0);
-      if (jitter) options.jitter_seed = 3;
+      options.jitter_seed = jitter ? std::optional<std::uint64_t>(3) : std::nullopt;
       const StatusOr<ConeTracer> tracer = ConeTracer::Make(Plane256(), options);
       ASSERT_TRUE(tracer.ok());
       float worst = 0;
       for (int i = 0; i <= 10; ++i) {
         for (int j = 0; j <= 10; ++j) {
           const AoPoint p{{-0.5 + 0.1 * i, -0.5 + 0.1 * j, 0}, {0, 0, 1}};
-          worst = std::max(worst, tracer->Occlusion(p, static_cast<std::uint64_t>(11 * i + j)));
+          worst = std::max(worst, tracer->Occlusion(p));
         }
       }
       EXPECT_LE(worst, 0.01f) << cones << " cones, jitter " << jitter;

@@ -3,7 +3,7 @@
 // depth asked for; the cones' AO at the mesh's points (its vertices, or area-stratified surface
 // points) is compared with Embree's at the same points, the same distance and falloff, with
 // --reference rays per point (seed 0). The cone options are svo-bake's defaults: distance 0.25 ×
-// the grid's diagonal, falloff 1, aperture 1, offset 1.
+// the grid's diagonal, falloff 1, aperture 1, offset 1, jitter seed 0.
 //
 //   ao_bench [--reference RAYS] [--images DIR] [--cones N] MESH [MESH OPTIONS] [MESH ...]...
 // --cones N measures the constellation of N cones alone (default: 3, 5, 8 and 16).
@@ -343,7 +343,7 @@ int main(int argc, char** argv) {
   std::vector<Loaded> meshes;
   fmt::print(
       "# ambient occlusion: cones (default options: aperture 1, offset 1, distance 0.25 x\n"
-      "# the grid's diagonal, falloff 1) against Embree with {} cosine-weighted rays per\n"
+      "# the grid's diagonal, falloff 1, jitter seed 0) against Embree with {} cosine-weighted rays per\n"
       "# point at the same points, distance and falloff; absolute AO error per point\n",
       reference_rays);
   for (const MeshSpec& spec : specs) {

@@ -384,25 +384,29 @@ bool ConeTracer::Step(ConeMarch& m, Cursor& cursor, std::uint64_t& samples) cons
   return true;
 }
 
-float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index) const {
+float ConeTracer::Occlusion(const AoPoint& point) const {
   ConeStats stats;
-  return Occlusion(point, index, stats);
+  return Occlusion(point, stats);
 }
 
-float ConeTracer::Occlusion(const AoPoint& point, std::uint64_t index, ConeStats& stats) const {
+float ConeTracer::Occlusion(const AoPoint& point, ConeStats& stats) const {
   Cursor cursor;
-  return Trace(point, index, cursor, stats);
+  return Trace(point, cursor, stats);
 }
 
-float ConeTracer::Trace(const AoPoint& point, std::uint64_t index, Cursor& cursor,
-                        ConeStats& stats) const {
+float ConeTracer::Trace(const AoPoint& point, Cursor& cursor, ConeStats& stats) const {
   // A point without a normal (a voxel whose brick holds none) has no hemisphere to trace.
   if (!(Dot(point.normal, point.normal) > 0.25)) return 0;
   const Vec3d n = point.normal;
   Vec3d t, b;
   TangentFrame(n, t, b);
   if (options_.jitter_seed) {
-    const double phi = 2 * kPi * UnitInterval(HashIndex(*options_.jitter_seed, index));
+    // From the position, not the point's number: a point gets the same cones in any batch or order.
+    std::uint64_t hash = *options_.jitter_seed;
+    for (const double c : {point.position.x, point.position.y, point.position.z}) {
+      hash = HashIndex(hash, std::bit_cast<std::uint64_t>(c));
+    }
+    const double phi = 2 * kPi * UnitInterval(hash);
     const Vec3d t2 = t * std::cos(phi) + b * std::sin(phi);
     b = Cross(n, t2);
     t = t2;
@@ -452,7 +456,7 @@ std::vector<float> ConeTracer::Occlusion(std::span<const AoPoint> points, ConeSt
     Cursor cursor;
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = order[k].second;
-      ao[i] = Trace(points[i], i, cursor, local);
+      ao[i] = Trace(points[i], cursor, local);
     }
     cones += local.cones;
     samples += local.samples;

@@ -31,8 +31,9 @@ struct ConeOptions {
   double falloff = 0;       ///< λ ≥ 0 of f(r) = 1/(1 + λ·r/distance)
   double offset = 1;        ///< cone origins' offset along the normal, in finest voxel diagonals
   /// Rotates each point's constellation about its normal by an angle hashed from the seed and
-  /// the point's number (adjacent points stop sharing cone directions).
-  std::optional<std::uint64_t> jitter_seed;
+  /// the point's position, so adjacent points stop sharing cone directions (and the voxel grid's
+  /// steps show as noise, not bands). Empty: every point's constellation is aligned alike.
+  std::optional<std::uint64_t> jitter_seed = 0;
 };
 
 /// One cone: its axis in the point's frame (z along the normal) and its half-angle.
@@ -68,11 +69,11 @@ class ConeTracer {
   /// Bad input: options out of range (CheckConeOptions).
   static StatusOr<ConeTracer> Make(const TraceOctree& octree, const ConeOptions& options);
 
-  /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal);
-  /// `index` numbers the point for the jitter. Thread-safe.
-  float Occlusion(const AoPoint& point, std::uint64_t index) const;
+  /// AO ∈ [0, 1] at `point` (0: nothing in reach, 1: fully occluded; 0 for a zero normal).
+  /// Thread-safe.
+  float Occlusion(const AoPoint& point) const;
   /// The same, adding the cones traced and the samples they read to `stats`.
-  float Occlusion(const AoPoint& point, std::uint64_t index, ConeStats& stats) const;
+  float Occlusion(const AoPoint& point, ConeStats& stats) const;
   /// Occlusion of every point, in parallel, traced in the order of their voxels' keys (cones from
   /// nearby points read the same pages); the result depends on neither order nor thread count.
   /// `stats`, when given, gets the cones traced and the samples they read added.
@@ -125,7 +126,7 @@ class ConeTracer {
   double ExitDistance(const Vec3d& p, const Vec3d& inverse_axis, int level) const;
   // One sample (or one skip over empty space) of `march`; false once the cone is done.
   bool Step(ConeMarch& march, Cursor& cursor, std::uint64_t& samples) const;
-  float Trace(const AoPoint& point, std::uint64_t index, Cursor& cursor, ConeStats& stats) const;
+  float Trace(const AoPoint& point, Cursor& cursor, ConeStats& stats) const;
 
   const TraceOctree* octree_;
   GridTransform grid_;
