@@ -6,6 +6,7 @@
 
 #include <map>
 #include <regex>
+#include <set>
 
 #include "svokit/bake/ao_bake.hpp"
 #include "svokit/bake/bake_svo.hpp"
@@ -53,6 +54,46 @@ TEST(TraceOctree, VoxelBricksFollowFromTheOccupancy) {
   ExpectVoxelOpacityOfTheFile(*BakeScene(sphere, 256));
   ExpectVoxelOpacityOfTheFile(*BakeScene(sphere, 200, 0, {.brick_side = 2, .contours = false}));
   ExpectVoxelOpacityOfTheFile(*BakeScene(sphere, 160, 0, {.contours = false}, /*solid=*/true));
+}
+
+// Every cell of every level between a page's root and its voxels: its node bit is set exactly where
+// a voxel of the page lies in the cell (the voxels' keys, not the masks the bits come from).
+TEST(TraceOctree, NodeBitsMarkTheCellsThatHoldVoxels) {
+  const auto scene = BakeScene(Icosphere(4), 256);
+  const SvoReader& reader = *scene->reader;
+  const std::uint32_t depth = reader.depth(), page_level = reader.page_level();
+  ASSERT_GT(reader.page_count(), 1u);
+  std::uint64_t set = 0, clear = 0;
+  for (std::size_t i = 0; i < reader.page_count(); ++i) {
+    StatusOr<SvoChunk> page = reader.Page(i);
+    ASSERT_TRUE(page.ok()) << page.status().message();
+    const std::shared_ptr<const TracePage> traced = scene->octree->Page(i);
+    ASSERT_EQ(traced->nodes.levels(), depth - page_level - 1);
+    for (std::uint32_t l = page_level + 1; l < depth; ++l) {
+      const std::uint32_t shift = depth - l, side = 1u << (l - page_level);
+      std::set<std::uint64_t> cells;
+      for (const std::uint64_t key : ChunkVoxelKeys(*page)) {
+        const MortonCoord c = MortonDecode(key);
+        const std::uint32_t local = (1u << (depth - page_level)) - 1;
+        cells.insert(
+            MortonEncode((c.x & local) >> shift, (c.y & local) >> shift, (c.z & local) >> shift));
+      }
+      for (std::uint32_t z = 0; z < side; ++z) {
+        for (std::uint32_t y = 0; y < side; ++y) {
+          for (std::uint32_t x = 0; x < side; ++x) {
+            const bool expected = cells.count(MortonEncode(x, y, z)) > 0;
+            ASSERT_EQ(
+                traced->nodes.At(l - page_level - 1, shift, x << shift, y << shift, z << shift),
+                expected)
+                << "page " << i << " level " << l << " cell " << x << " " << y << " " << z;
+            (expected ? set : clear)++;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(set, 1000u);
+  EXPECT_GT(clear, set);
 }
 
 // The least memory limit that works, read from the refusal of a smaller one.

@@ -179,7 +179,13 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
   // The page a cursor enters at the page level (the only one, when that is level 0).
   auto enter = [&](std::uint64_t page) {
     if (cursor.page_index == page) return;
-    cursor.page = octree_->Page(page);
+    auto& held = cursor.held;
+    std::size_t k = 0;
+    while (k + 1 < held.size() && held[k].second && held[k].first != page) ++k;
+    if (!held[k].second || held[k].first != page) held[k] = {page, octree_->Page(page)};
+    std::rotate(held.begin(), held.begin() + static_cast<std::ptrdiff_t>(k),
+                held.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+    cursor.page = held[0].second.get();
     cursor.page_index = page;
   };
   if (page_level == 0) enter(0);
@@ -236,8 +242,12 @@ int ConeTracer::Probe(const Vec3d& v, std::uint32_t level, Cursor& cursor) const
   cursor.probe_z = z;
   for (; l <= above_voxels; ++l) {
     const std::uint32_t k = l - page_level - 1;
-    // A page that did not decode holds no bits, and reads as empty.
-    if (k >= bits.levels() || !bits.At(k, depth - l, lx, ly, lz)) {
+    // Levels without bits (a page that did not decode has none) take the masks' walk.
+    if (k >= bits.levels()) {
+      cursor.probed = page_level;
+      return Descend(v, level, cursor);
+    }
+    if (!bits.At(k, depth - l, lx, ly, lz)) {
       cursor.probed = l - 1;
       return static_cast<int>(l) - 1;
     }

@@ -90,8 +90,11 @@ class ConeTracer {
     std::uint32_t x = 0, y = 0, z = 0;
     std::uint32_t valid = 0;
     std::array<std::uint64_t, 32> index{};
-    std::shared_ptr<const TracePage> page;
+    const TracePage* page = nullptr;
     std::uint64_t page_index = ~std::uint64_t{0};
+    // The pages entered last, most recent first (page is held[0]'s).
+    std::array<std::pair<std::uint64_t, std::shared_ptr<const TracePage>>, TraceOctree::kPagesInUse>
+        held;
     // The occupancy around the last voxel read at the voxel level.
     std::int64_t voxel[3] = {-1, -1, -1};
     std::uint32_t around = 0;

@@ -72,16 +72,15 @@ VoxelOccupancy::VoxelOccupancy(const std::array<std::int64_t, 3>& lo, std::uint3
 }
 
 NodeBits::NodeBits(std::span<const std::vector<std::uint64_t>> keys, std::uint32_t levels) {
+  levels = std::min(levels, kMaxLevels);
   bits_.reserve(levels);
   for (std::uint32_t k = 0; k < levels && k + 1 < keys.size(); ++k) {
-    const std::uint32_t side_bits = k + 1;
+    // A key's low 3(k + 1) bits are its Morton code within the page.
+    const std::uint32_t code_bits = 3 * (k + 1);
     std::vector<std::uint64_t>& bits =
-        bits_.emplace_back(((std::uint64_t{1} << (3 * side_bits)) + 63) / 64, 0);
-    const std::uint32_t local = (1u << side_bits) - 1;
+        bits_.emplace_back(((std::uint64_t{1} << code_bits) + 63) / 64, 0);
     for (const std::uint64_t key : keys[k + 1]) {
-      const MortonCoord c = MortonDecode(key);
-      const std::uint64_t i = (c.x & local) | (std::uint64_t{c.y & local} << side_bits) |
-                              (std::uint64_t{c.z & local} << (2 * side_bits));
+      const std::uint64_t i = key & ((std::uint64_t{1} << code_bits) - 1);
       bits[i >> 6] |= std::uint64_t{1} << (i & 63);
     }
   }
@@ -92,6 +91,7 @@ std::uint64_t NodeBits::bytes() const {
 }
 
 std::uint64_t NodeBits::BytesFor(std::uint32_t levels) {
+  levels = std::min(levels, kMaxLevels);
   std::uint64_t words = 0;
   for (std::uint32_t k = 0; k < levels; ++k)
     words += ((std::uint64_t{1} << (3 * (k + 1))) + 63) / 64;
@@ -179,13 +179,13 @@ StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader
       largest = std::max(largest, *bound);
     }
     const TraceLevels& top = octree->top_;
-    const std::uint64_t fixed = held_besides + NestedHeldBytes(top.tree.masks) +
-                                NestedHeldBytes(top.tree.full) +
-                                NestedHeldBytes(top.tree.first_child) +
-                                NestedHeldBytes(top.opacity) + Concurrency() * largest;
+    const std::uint64_t fixed =
+        held_besides + NestedHeldBytes(top.tree.masks) + NestedHeldBytes(top.tree.full) +
+        NestedHeldBytes(top.tree.first_child) + NestedHeldBytes(top.opacity) +
+        Concurrency() * kPagesInUse * largest;
     StatusOr<std::size_t> fits =
         InFlightWithin(memory_limit, fixed, largest, largest, "this file",
-                       "the top levels, cone tracing's pages (one a thread, and one more kept) "
+                       "the top levels, cone tracing's pages (a few a thread, and one more kept) "
                        "and what is baked");
     if (!fits.ok()) return fits.status().WithContext(reader.name());
     // An eighth stays free for what the allocator holds of pages already let go.

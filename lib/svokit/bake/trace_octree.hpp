@@ -53,10 +53,12 @@ struct TraceLevels {
 };
 
 /// Which nodes of the levels strictly between a page's root and its voxels exist: per level, a bit
-/// per cell of the page's cube at that level (x fastest). Cones find empty space with a bit test
-/// each level instead of a walk through the masks.
+/// per cell of the page's cube at that level, in Morton order (a cache line holds 8³ cells). Cones
+/// find empty space with a bit test each level instead of a walk through the masks.
 class NodeBits {
  public:
+  /// The most levels a page has between its root and its voxels (pages of 128³ voxels).
+  static constexpr std::uint32_t kMaxLevels = 6;
   NodeBits() = default;
   /// `keys[k]`: the Morton keys of level root_level + k (TreeLevelKeys); `levels`: how many levels
   /// below the root get bits (those above the voxels).
@@ -65,9 +67,8 @@ class NodeBits {
   /// `shift` = depth − that level.
   bool At(std::uint32_t k, std::uint32_t shift, std::uint32_t x, std::uint32_t y,
           std::uint32_t z) const {
-    const std::uint32_t side_bits = k + 1;
-    const std::uint64_t i = (x >> shift) | (std::uint64_t{y >> shift} << side_bits) |
-                            (std::uint64_t{z >> shift} << (2 * side_bits));
+    const std::uint32_t i =
+        kSpread[x >> shift] | kSpread[y >> shift] << 1 | kSpread[z >> shift] << 2;
     return bits_[k][i >> 6] >> (i & 63) & 1u;
   }
   std::uint32_t levels() const { return static_cast<std::uint32_t>(bits_.size()); }
@@ -76,6 +77,14 @@ class NodeBits {
   static std::uint64_t BytesFor(std::uint32_t levels);
 
  private:
+  // v's bits spread to every third bit (a Morton key's x), for v < 2^kMaxLevels.
+  static constexpr std::array<std::uint32_t, 1u << kMaxLevels> kSpread = [] {
+    std::array<std::uint32_t, 1u << kMaxLevels> spread{};
+    for (std::uint32_t v = 0; v < spread.size(); ++v) {
+      for (std::uint32_t b = 0; b < kMaxLevels; ++b) spread[v] |= (v >> b & 1u) << (3 * b);
+    }
+    return spread;
+  }();
   std::vector<std::vector<std::uint64_t>> bits_;
 };
 
@@ -90,11 +99,16 @@ struct TracePage {
 
 class TraceOctree {
  public:
+  /// The pages a tracing thread holds at once: the cones of a point cross a few pages, and
+  /// going back to one still held takes no lock.
+  static constexpr std::uint32_t kPagesInUse = 4;
+
   /// The top levels of `reader`'s file read, pages to come through a cache: the top levels,
-  /// `held_besides` (what the caller holds meanwhile), the pages in use by the threads (one each)
+  /// `held_besides` (what the caller holds meanwhile), the pages in use by the threads
+  /// (kPagesInUse each)
   /// and those kept for later within `memory_limit` bytes (0: every page may be kept). A limit
-  /// that cannot hold one page a thread and one more is bad input naming the least that can. Bad
-  /// input as well: an octree without bricks.
+  /// that cannot hold kPagesInUse pages a thread and one more is bad input naming the least that
+  /// can. Bad input as well: an octree without bricks.
   static StatusOr<std::unique_ptr<TraceOctree>> Open(const SvoReader& reader,
                                                      std::uint64_t memory_limit,
                                                      std::uint64_t held_besides = 0);
