@@ -29,11 +29,14 @@ struct Solid {
   Svo surface_svo;  ///< the same surface without its interior
 };
 
-Solid BuildSolid(const Mesh& mesh, std::uint32_t resolution, std::uint32_t side) {
+Solid BuildSolid(const Mesh& mesh, std::uint32_t resolution, std::uint32_t side,
+                 VoxelMode mode = VoxelMode::kConservative) {
   Solid s;
   auto grid = GridTransform::FitResolution(mesh.Bounds(), resolution);
   EXPECT_TRUE(grid.ok());
-  auto voxels = Voxelize(mesh, *grid, VoxelizeOptions{});
+  VoxelizeOptions vo;
+  vo.mode = mode;
+  auto voxels = Voxelize(mesh, *grid, vo);
   EXPECT_TRUE(voxels.ok()) << voxels.status().message();
   s.surface = std::move(*voxels);
   auto interior = FillInterior(mesh, *grid, s.surface.keys);
@@ -124,6 +127,20 @@ std::uint64_t ExpectOpacityOfSurfaceAndInterior(const Solid& s, const char* name
   return differ_from_surface;
 }
 
+// The icosphere with the triangles around a few vertices removed: open, so its interior is
+// decided by winding numbers, whose split cubes are nodes holding full leaves only.
+Mesh HoledBall() {
+  Mesh m = test::Icosphere(3, false);
+  std::vector<Triangle> kept;
+  for (const Triangle& t : m.triangles) {
+    if (t[0] % 97 == 5 || t[1] % 97 == 5 || t[2] % 97 == 5) continue;
+    kept.push_back(t);
+  }
+  m.triangles = std::move(kept);
+  m.material_ids.assign(m.triangles.size(), 0);
+  return m;
+}
+
 TEST(SolidBricks, OpacityIsTheFilterOfSurfaceAndInteriorAtEveryLevel) {
   const Mesh box = test::BoxMesh({0.1, 0.2, 0.05}, {0.93, 0.81, 0.97});
   const Mesh ball = test::Icosphere(3, false);
@@ -131,6 +148,12 @@ TEST(SolidBricks, OpacityIsTheFilterOfSurfaceAndInteriorAtEveryLevel) {
     EXPECT_GT(ExpectOpacityOfSurfaceAndInterior(BuildSolid(box, 40, side), "box"), 1000u) << side;
     EXPECT_GT(ExpectOpacityOfSurfaceAndInterior(BuildSolid(ball, 48, side), "ball"), 1000u) << side;
   }
+  // A thin (6-separating) surface lets the interior touch the outside diagonally.
+  EXPECT_GT(ExpectOpacityOfSurfaceAndInterior(BuildSolid(ball, 48, 3, VoxelMode::kThin), "thin"),
+            1000u);
+  const Solid open = BuildSolid(HoledBall(), 48, 3);
+  EXPECT_EQ(open.interior.method, FillMethod::kWindingNumber);
+  EXPECT_GT(ExpectOpacityOfSurfaceAndInterior(open, "open ball"), 1000u);
 }
 
 TEST(SolidBricks, ArmadilloOpacityIsTheFilterOfSurfaceAndInterior) {
