@@ -259,34 +259,42 @@ class VoxelsAround {
   std::unordered_map<std::uint64_t, Voxel> at_;
 };
 
-// A solid page's ShellInterior: its full leaves, and its voxels within two of its faces.
+// A solid page's ShellInterior: its voxels within two voxels of its faces and its full leaves
+// within one of their own size, all the face samples read of it (a tap lies within one step of a
+// face, and with side 2 its reach spans two cells of its level on each side).
 void PutInterior(ByteWriter& out, const SvoChunk& page, const SvoShape& shape,
                  const PageFrame& frame, const std::vector<std::vector<std::uint64_t>>& keys) {
+  const std::int64_t edge = std::int64_t{1} << (shape.depth - page.root_level);
+  // Whether the cube of `size` voxels at c (in its level's units) comes within 2·size of a face.
+  const auto near_faces = [&](const MortonCoord& c, std::int64_t size) {
+    const std::int64_t v[3] = {c.x, c.y, c.z};
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t r = v[a] * size - frame.cell[a] * edge;
+      if (r < 2 * size || r + size > edge - 2 * size) return true;
+    }
+    return false;
+  };
   for (std::uint32_t l = page.root_level + 1; l <= shape.depth; ++l) {
     std::vector<std::uint64_t> leaves;
     const std::size_t k = l - 1 - page.root_level;
+    const std::int64_t size = std::int64_t{1} << (shape.depth - l);
     for (std::size_t i = 0; i < keys[k].size(); ++i) {
       for (unsigned c = 0; c < 8; ++c) {
-        if (page.tree.full[k][i] >> c & 1u) leaves.push_back(keys[k][i] << 3 | c);
+        const std::uint64_t leaf = keys[k][i] << 3 | c;
+        if ((page.tree.full[k][i] >> c & 1u) && near_faces(MortonDecode(leaf), size)) {
+          leaves.push_back(leaf);
+        }
       }
     }
     out.Put(static_cast<std::uint64_t>(leaves.size()));
     out.PutArray(std::span<const std::uint64_t>(leaves));
   }
   const std::vector<std::uint64_t> voxels = ChunkVoxelKeys(page);
-  const std::int64_t edge = std::int64_t{1} << (shape.depth - page.root_level);
   std::vector<std::uint64_t> near;
   std::vector<HalfRgba> colors;
   std::vector<OctNormal> normals;
   for (std::size_t i = 0; i < voxels.size(); ++i) {
-    const MortonCoord c = MortonDecode(voxels[i]);
-    const std::int64_t v[3] = {c.x, c.y, c.z};
-    bool is_near = false;
-    for (int a = 0; a < 3; ++a) {
-      const std::int64_t r = v[a] - frame.cell[a] * edge;
-      is_near = is_near || r < 2 || r >= edge - 2;
-    }
-    if (!is_near) continue;
+    if (!near_faces(MortonDecode(voxels[i]), 1)) continue;
     near.push_back(voxels[i]);
     if (!page.colors.empty()) colors.push_back(page.colors[i]);
     if (shape.has_normal) normals.push_back(page.normals[i]);
