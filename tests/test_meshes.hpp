@@ -60,3 +60,24 @@ inline Mesh Icosphere(int subdivisions, bool corner_normals = true) {
 }
 
 }  // namespace svokit::test
+
+namespace svokit::test {
+
+/// The closed box [lo, hi] with outward faces, two triangles a face.
+inline Mesh BoxMesh(const Vec3d& lo, const Vec3d& hi) {
+  Mesh m;
+  for (int c = 0; c < 8; ++c) {
+    m.positions.push_back({c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z});
+  }
+  // Corners c = x + 2y + 4z; each face's quad counter-clockwise seen from outside.
+  const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) {
+    m.triangles.push_back({q[0], q[1], q[2]});
+    m.triangles.push_back({q[0], q[2], q[3]});
+  }
+  EnsureDefaultMaterial(m);
+  return m;
+}
+
+}  // namespace svokit::test

@@ -18,11 +18,14 @@
 
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/container/container.hpp"
+#include "svokit/formats/mesh_import.hpp"
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/formats/vfrag/vfrag.hpp"
+#include "svokit/svo/compact_build.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
+#include "svokit/voxelize/voxelize.hpp"
 #include "tests/cli/run_tool.hpp"
 #include "tests/test_meshes.hpp"
 
@@ -185,6 +188,41 @@ TEST(SolidCli, MemoryLimitWritesTheWholeBuildsFile) {
     EXPECT_TRUE(reader->shape().solid);
     ExpectValidSvo((dir / "paged.svo").string(), c.mesh);
   }
+}
+
+// svo-validate recomputes a solid's bricks with its interior: mesh2svo's solid passes; the same
+// tree with the bricks its surface alone gives (the interior's opacity zeroed) exits 1, each
+// finding one line saying what the filter gives.
+TEST(SolidCli, ValidateRecomputesTheInteriorsOpacity) {
+  TempDir dir;
+  const std::string solid = (dir / "solid.svo").string();
+  RunOk("mesh2svo", {Torus(), "-r", "96", "--fill", "solid", "-o", solid, "-q"});
+  ExpectValidSvo(solid, Torus());
+
+  auto mesh = ImportMesh(Torus());
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  auto grid = GridTransform::FitResolution(mesh->Bounds(), 96);
+  ASSERT_TRUE(grid.ok());
+  auto voxels = Voxelize(*mesh, *grid, {});
+  ASSERT_TRUE(voxels.ok());
+  auto interior = FillInterior(*mesh, *grid, voxels->keys);
+  ASSERT_TRUE(interior.ok());
+  BuildOptions bo;
+  bo.contours = false;
+  auto surface = BuildCompactSvo(*voxels, nullptr, bo);
+  bo.interior = &*interior;
+  auto zeroed = BuildCompactSvo(*voxels, nullptr, bo);
+  ASSERT_TRUE(surface.ok() && zeroed.ok());
+  zeroed->whole.samples = surface->whole.samples;
+  const std::string bad = (dir / "zeroed.svo").string();
+  ASSERT_TRUE(WriteSvo(*zeroed, bad).ok());
+  const ToolResult r = RunTool("svo-validate", {bad});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  const std::size_t at = r.out.find("    brick_filter: level ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+  EXPECT_NE(line.find(" where the filter gives "), std::string::npos) << line;
+  EXPECT_NE(r.out.find("result          INVALID"), std::string::npos) << r.out;
 }
 
 // Thread counts change nothing, whole and by pages, on closed and open surfaces.

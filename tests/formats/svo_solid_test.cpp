@@ -358,9 +358,13 @@ TEST(SvoSolid, SurfaceFilesCarryNoFullLeaves) {
   for (const SvoLevel& level : back->levels) {
     for (const SvoNode& n : level.nodes) EXPECT_EQ(n.full_mask, 0);
   }
-  // The solid of the same voxels differs from it only by the flag, the masks and their counts.
-  const Solid s = MakeSolid(test::Icosphere(4), 64, 3, false, false);
-  EXPECT_GT(EncodeSvo(s.svo).size(), bytes.size());
+  // Without bricks (whose opacities a solid's interior changes), the solid of the same voxels
+  // differs from the surface only by the flag, the masks and their counts.
+  bo.brick_side = 0;
+  auto plain = BuildCompactSvo(*voxels, &sphere, bo);
+  ASSERT_TRUE(plain.ok());
+  const Solid s = MakeSolid(test::Icosphere(4), 64, 0, false, false);
+  EXPECT_GT(EncodeSvo(s.svo).size(), EncodeSvo(*plain).size());
 }
 
 // Open surfaces: winding numbers split the cubes they cannot decide whole; the split cube is a
@@ -413,8 +417,8 @@ TEST(SvoSolid, OpenSurfacesKeepTheirSplitCubesAsNodes) {
 }
 
 // A solid over several pages: the interior's largest cubes (a whole page) are full leaves of the
-// top chunk; the build by pages, whatever its limit and thread count, writes the whole build's
-// bytes.
+// top chunk; the build by pages, whatever its limit, thread count and bricks, writes the whole
+// build's bytes.
 TEST(SvoSolid, PagedSolidsHaveFullLeavesInTheTopChunkAndBuildByPagesAlike) {
   const Mesh sphere = test::Icosphere(4, false);
   const std::uint32_t resolution = 400;  // depth 9, pages below level 2; one page cube is inside
@@ -445,24 +449,30 @@ TEST(SvoSolid, PagedSolidsHaveFullLeavesInTheTopChunkAndBuildByPagesAlike) {
   ExpectSolidOctree(*back, s);
 
   test::TempDir dir;
-  ASSERT_TRUE(WriteSvo(s.svo, dir / "whole.svo").ok());
-  const std::string want = test::ReadText(dir / "whole.svo");
   auto finder = InteriorFinder::Create(s.mesh, s.voxels.grid);
   ASSERT_TRUE(finder.ok()) << finder.status().message();
   auto regions = RegionVoxelizer::Create(s.mesh, s.voxels.grid, VoxelizeOptions{});
   ASSERT_TRUE(regions.ok()) << regions.status().message();
   BuildOptions bo;
-  bo.brick_side = 0;
   bo.contours = false;
   bo.interior_finder = finder->get();
-  for (const std::uint64_t limit : {std::uint64_t{0}, std::uint64_t{16} << 20}) {
-    for (const std::size_t threads : {1, 2}) {
-      ThreadLimit limit_threads(threads);
-      auto stats = BuildSvoByPages(**regions, bo, R"({"source":"solid test"})", dir / "paged.svo",
-                                   {}, limit);
-      ASSERT_TRUE(stats.ok()) << stats.status().message();
-      EXPECT_TRUE(test::ReadText(dir / "paged.svo") == want)
-          << "limit " << limit << ", threads " << threads;
+  // With bricks the pages' faces read the interior across them, and the top levels the whole
+  // pages inside.
+  for (const std::uint32_t side : {0u, 3u, 2u}) {
+    const Solid whole = side == 0 ? Solid{} : MakeSolid(sphere, resolution, side, false, false);
+    ASSERT_TRUE(WriteSvo(side == 0 ? s.svo : whole.svo, dir / "whole.svo").ok());
+    const std::string want = test::ReadText(dir / "whole.svo");
+    bo.brick_side = side;
+    for (const std::uint64_t limit : {std::uint64_t{0}, std::uint64_t{16} << 20}) {
+      for (const std::size_t threads : {1, 2}) {
+        if (side == 2 && (limit == 0 || threads == 1)) continue;  // side 3's paths, other weights
+        ThreadLimit limit_threads(threads);
+        auto stats = BuildSvoByPages(**regions, bo, R"({"source":"solid test"})", dir / "paged.svo",
+                                     {}, limit);
+        ASSERT_TRUE(stats.ok()) << stats.status().message();
+        EXPECT_TRUE(test::ReadText(dir / "paged.svo") == want)
+            << "bricks " << side << ", limit " << limit << ", threads " << threads;
+      }
     }
   }
   // Parts cannot fill: the top levels' full leaves depend on every part's pages.

@@ -15,7 +15,10 @@
 #include "svokit/svo/build_options.hpp"
 #include "svokit/svo/compact_build.hpp"
 #include "svokit/validate/validate.hpp"
+#include "svokit/voxelize/solid_fill.hpp"
+#include "svokit/voxelize/voxelize.hpp"
 #include "tests/formats/paged_torus.hpp"
+#include "tests/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace svokit::validate {
@@ -151,6 +154,45 @@ TEST(ValidatePages, ChangedVoxelsSameFindings) {
     EXPECT_NE(report.find(kind), std::string::npos) << kind << "\n" << report;
   }
   ExpectSameAtEveryLimit(bytes, &TorusMesh());
+}
+
+// A solid over several pages (a whole page inside it is a full leaf of the top levels): the
+// recomputed bricks agree, page by page as whole; with the bricks the surface alone gives (its
+// interior's opacity zeroed), every level above the voxels is a filter finding that says what
+// the filter gives there.
+TEST(ValidatePages, SolidsPassAndBricksWithoutTheirInteriorFail) {
+  const Mesh ball = test::Icosphere(3, false);
+  auto grid = GridTransform::FitResolution(ball.Bounds(), 400);
+  ASSERT_TRUE(grid.ok());
+  VoxelizeOptions vo;
+  vo.colors = vo.normals = true;
+  auto voxels = Voxelize(ball, *grid, vo);
+  ASSERT_TRUE(voxels.ok());
+  auto interior = FillInterior(ball, *grid, voxels->keys);
+  ASSERT_TRUE(interior.ok());
+  BuildOptions bo;
+  bo.contours = false;
+  auto surface = BuildCompactSvo(*voxels, nullptr, bo);
+  bo.interior = &*interior;
+  auto solid = BuildCompactSvo(*voxels, nullptr, bo);
+  ASSERT_TRUE(surface.ok() && solid.ok());
+  ASSERT_FALSE(interior->levels[2].empty()) << "no page inside the ball";
+  const auto bytes = EncodeSvo(*solid);
+  const std::string valid = Whole(bytes, nullptr);
+  EXPECT_NE(valid.find("result          valid"), std::string::npos) << valid;
+  StatusOr<std::string> paged = Paged(bytes, nullptr, 0);
+  ASSERT_TRUE(paged.ok()) << paged.status().message();
+  EXPECT_EQ(*paged, valid);
+
+  // The same tree and layouts, the surface's samples.
+  solid->whole.samples = surface->whole.samples;
+  const auto zeroed = EncodeSvo(*solid);
+  const std::string whole = Whole(zeroed, nullptr);
+  EXPECT_NE(whole.find("brick_filter"), std::string::npos) << whole;
+  EXPECT_NE(whole.find("where the filter gives 255"), std::string::npos) << whole;
+  paged = Paged(zeroed, nullptr, 0);
+  ASSERT_TRUE(paged.ok()) << paged.status().message();
+  EXPECT_EQ(*paged, whole);
 }
 
 }  // namespace

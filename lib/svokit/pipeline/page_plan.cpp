@@ -91,9 +91,10 @@ StatusOr<SvoChunk> BuildPageAlone(VoxelSet voxels, const BuildOptions& options,
   return PageChunk(*svo, page_level, at, nbs[at], cell);
 }
 
-StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
+StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t depth,
                               const TopContours* words, std::uint32_t side,
                               const LevelSamples& roots, const CubesOf& cubes) {
+  const std::uint32_t page_level = PageLevel(depth);
   const std::vector<std::vector<std::uint64_t>> level_keys = LevelKeysFromVoxels(keys, page_level);
   SvoChunk top;
   top.tree = MaskTreeFromKeys(level_keys);
@@ -115,15 +116,25 @@ StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t
       }
     }
   }
-  if (side != 0 && page_level != 0) FilterTopSamples(top, side, roots);
+  if (side != 0 && page_level != 0) FilterTopSamples(top, side, depth, roots);
   return top;
 }
 
 Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const BuiltPages& built,
                    std::size_t in_flight, const PagedSvoWriter::Take& take, LevelSamples& roots,
-                   Progress& progress) {
+                   Progress& progress, const CubesOf& cubes) {
   const std::uint32_t page_level = PageLevel(frame.depth());
   const std::int64_t cells = std::int64_t{1} << page_level;
+  // A solid's pages that are full leaves of the top levels: their neighbours' faces read them.
+  std::vector<std::vector<std::uint64_t>> top_cubes;
+  if (cubes && page_level > 0) top_cubes = cubes(built.keys, page_level, 0);
+  const auto full_page = [&](std::uint64_t cell) {
+    for (std::uint32_t l = 1; l <= page_level && l < top_cubes.size(); ++l) {
+      const std::uint64_t cube = cell >> (3 * (page_level - l));
+      if (std::binary_search(top_cubes[l].begin(), top_cubes[l].end(), cube)) return true;
+    }
+    return false;
+  };
   Progress::Stage stage(progress, "page faces", built.keys.size());
   struct Made {
     std::optional<PagedSvoWriter::EncodedPage> page;
@@ -141,6 +152,7 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
     // The shells of the pages around, by their keys.
     const MortonCoord c = MortonDecode(key);
     std::array<std::vector<std::uint8_t>, 27> shells;
+    std::uint32_t full_pages = 0;
     for (int o = 0; o < 27; ++o) {
       const std::int64_t at[3] = {c.x + o % 3 - 1, c.y + o / 3 % 3 - 1, c.z + o / 9 - 1};
       if (std::any_of(at, at + 3, [&](std::int64_t v) { return v < 0 || v >= cells; })) continue;
@@ -148,14 +160,17 @@ Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const Bu
           MortonEncode(static_cast<std::uint32_t>(at[0]), static_cast<std::uint32_t>(at[1]),
                        static_cast<std::uint32_t>(at[2]));
       const auto it = std::lower_bound(built.keys.begin(), built.keys.end(), k);
-      if (it == built.keys.end() || *it != k) continue;
+      if (it == built.keys.end() || *it != k) {
+        if (full_page(k)) full_pages |= 1u << o;
+        continue;
+      }
       StatusOr<std::vector<std::uint8_t>> shell =
           built.shell(static_cast<std::size_t>(it - built.keys.begin()));
       if (!shell.ok()) return shell.status();
       shells[o] = std::move(*shell);
     }
     const std::vector<std::span<const std::uint8_t>> views(shells.begin(), shells.end());
-    SVOKIT_RETURN_IF_ERROR(PatchPageFaces(*page, frame.shape, views, name));
+    SVOKIT_RETURN_IF_ERROR(PatchPageFaces(*page, frame.shape, views, name, full_pages));
     made.root = RootBrick(*page, frame.shape.brick_side);
     made.page = writer.Encode(*page);
     return Status::Ok();

@@ -49,9 +49,10 @@ IBox3 CellBox(std::uint64_t cell, std::uint32_t bits, std::int64_t grow);
 StatusOr<SvoChunk> BuildPageAlone(VoxelSet voxels, const BuildOptions& options,
                                   std::uint32_t page_level, std::uint64_t cell);
 
-/// The top chunk of the pages with these root keys: masks, the contours `words` gives, and with
-/// bricks (side ≠ 0) the samples filtered from the bricks of the pages' roots.
-StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t page_level,
+/// The top chunk of the pages with these root keys in an octree of `depth`: masks, the contours
+/// `words` gives, and with bricks (side ≠ 0) the samples filtered from the bricks of the pages'
+/// roots.
+StatusOr<SvoChunk> TopOfPages(std::span<const std::uint64_t> keys, std::uint32_t depth,
                               const TopContours* words, std::uint32_t side,
                               const LevelSamples& roots, const CubesOf& cubes);
 
@@ -64,11 +65,11 @@ struct BuiltPages {
 };
 
 /// The second pass: each page with the samples of its faces set from the shells of the pages
-/// around it, encoded and handed to `take` in order; the bricks of their roots are appended to
-/// `roots` in the same order.
+/// around it (and a solid's top-level cubes, `cubes`), encoded and handed to `take` in order; the
+/// bricks of their roots are appended to `roots` in the same order.
 Status FinishPages(const SvoFrame& frame, const PagedSvoWriter& writer, const BuiltPages& built,
                    std::size_t in_flight, const PagedSvoWriter::Take& take, LevelSamples& roots,
-                   Progress& progress);
+                   Progress& progress, const CubesOf& cubes = {});
 
 class PagePlan {
  public:
@@ -98,7 +99,7 @@ class PagePlan {
   /// FinishPages with this plan's pages in flight.
   Status Finish(const PagedSvoWriter& writer, const BuiltPages& built,
                 const PagedSvoWriter::Take& take, LevelSamples& roots, Progress& progress) const {
-    return FinishPages(frame_, writer, built, in_flight_, take, roots, progress);
+    return FinishPages(frame_, writer, built, in_flight_, take, roots, progress, cubes_);
   }
   /// The words of every top-level node that may exist (empty without contours).
   TopContours FitTopContours(Progress& progress) const;

@@ -31,7 +31,7 @@ StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options
               progress);
         },
         [&](std::span<const std::uint64_t> keys) {
-          return TopOfPages(keys, p.page_level(), top_words, 0, {}, p.cubes());
+          return TopOfPages(keys, p.frame().depth(), top_words, 0, {}, p.cubes());
         });
   }
   // With bricks, two passes: the pages built alone and their shells go to a scratch file; then
@@ -67,7 +67,7 @@ StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options
         return p.Finish(writer, built, take, roots, progress);
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, p.page_level(), top_words, options.brick_side, roots, p.cubes());
+        return TopOfPages(keys, p.frame().depth(), top_words, options.brick_side, roots, p.cubes());
       });
 }
 

@@ -249,8 +249,8 @@ StatusOr<SvoFileStats> MergeBuiltAlone(const std::vector<SvoPart>& parts,
         return FinishPages(head.frame, writer, built, MostInFlight(), take, roots, progress);
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, PageLevel(head.frame.depth()), top_words,
-                          head.frame.shape.brick_side, roots, {});
+        return TopOfPages(keys, head.frame.depth(), top_words, head.frame.shape.brick_side, roots,
+                          {});
       });
 }
 
@@ -283,7 +283,7 @@ StatusOr<SvoFileStats> MergeFinished(const std::vector<SvoPart>& parts,
         return Status::Ok();
       },
       [&](std::span<const std::uint64_t> keys) {
-        return TopOfPages(keys, PageLevel(head.frame.depth()), top_words, 0, {}, {});
+        return TopOfPages(keys, head.frame.depth(), top_words, 0, {}, {});
       });
 }
 

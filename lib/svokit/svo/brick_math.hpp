@@ -86,6 +86,49 @@ inline void StoreSample(const EncodedSample& e, std::uint64_t at, LevelSamples& 
 /// A sample whose opacity rounds to 0 is empty: no colour, no normal. Out of line
 /// (sample_filter.cpp): too large to be inlined, and a program's own copy must not stand in for it.
 EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p);
+/// A solid's sample: opacity `opacity` (the surface's and the interior's), colour and normal from
+/// `p`, whose opacity weighs them (the surface's alone: the interior was never seen).
+EncodedSample Encode(bool color, bool normal, const PremultipliedSample& p, float opacity);
+
+/// In a solid, a finer sample with opacity but colour 0 holds interior alone: it weighs no colour
+/// (its normal, 0, adds nothing either), so the interior never darkens the surface's colours.
+inline PremultipliedSample ColourWeighted(PremultipliedSample p, const EncodedSample& e,
+                                          bool color) {
+  if (color && e.color == 0) p.opacity = 0;
+  return p;
+}
+
+/// The opacity byte of a sample `above_voxels` levels above the voxels (≥ 1) whose reach holds no
+/// surface voxel: each of the 8 octants of its reach (bit ox + 2·oy + 4·oz, o = 1 on the high side)
+/// is wholly inside (bit set) or wholly empty. What the filter gives such a point, level by level,
+/// with its own arithmetic: a full leaf's contribution in closed form (formats/svo.md, "Solids").
+std::uint8_t FullOctantsOpacity(std::uint32_t above_voxels, unsigned octants);
+
+/// The cells (per axis lo, hi: equal when the point lies inside a cell) of lattice point t of a
+/// level with bricks of `side`, in that level's node units: the octants of the point's reach.
+inline void CellsOfPoint(std::uint32_t side, std::int64_t t, std::int64_t& lo, std::int64_t& hi) {
+  if (side == 3 && (t & 1) != 0) {
+    lo = hi = (t - 1) / 2;  // odd t: the middle of that cell (t − 1 is even: exact)
+    return;
+  }
+  hi = side == 3 ? t / 2 : t;  // on a node plane: the cells on both sides
+  lo = hi - 1;
+}
+
+/// The octants of lattice point t = (x, y, z) (CellsOfPoint) that `full(cx, cy, cz)` says are
+/// inside.
+template <class Full>
+unsigned FullOctants(std::uint32_t side, const std::int64_t t[3], const Full& full) {
+  std::int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) CellsOfPoint(side, t[a], lo[a], hi[a]);
+  unsigned octants = 0;
+  for (unsigned o = 0; o < 8; ++o) {
+    if (full(o & 1u ? hi[0] : lo[0], o & 2u ? hi[1] : lo[1], o & 4u ? hi[2] : lo[2])) {
+      octants |= 1u << o;
+    }
+  }
+  return octants;
+}
 
 /// Premultiply(decoded sample), without the straight sample in between (the same products: absent
 /// colour and normal stay 0).
@@ -193,6 +236,24 @@ PremultipliedSample AboveVoxels(const Cell& cell) {
 template <class Cell>
 PremultipliedSample AboveVoxels(std::uint32_t side, const Cell& cell) {
   return side == 3 ? AboveVoxels<3>(cell) : AboveVoxels<2>(cell);
+}
+
+/// The opacity AboveVoxels gives at a voxel corner where filled(dx, dy, dz) says which voxels are
+/// filled (a solid's: surface or interior): the sums are of small integers, exact in any order.
+template <std::uint32_t kSide, class Filled>
+float AboveVoxelsOpacity(const Filled& filled) {
+  constexpr int n = kSide == 3 ? 2 : 4, first = kSide == 3 ? -1 : -2;
+  static constexpr int kWeights[4] = {1, 3, 3, 1};  // side 2's; side 3's are all 1
+  int sum = 0;
+  for (int z = 0; z < n; ++z) {
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        if (!filled(first + x, first + y, first + z)) continue;
+        sum += kSide == 3 ? 1 : kWeights[x] * kWeights[y] * kWeights[z];
+      }
+    }
+  }
+  return static_cast<float>(sum * (kSide == 3 ? 0x1p-3 : 0x1p-9));
 }
 
 inline constexpr float kTent[3] = {0.25f, 0.5f, 0.25f};

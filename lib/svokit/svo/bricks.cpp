@@ -23,8 +23,9 @@ constexpr std::size_t BlockIndex(int x, int y, int z) {
   return static_cast<std::size_t>(x + kBlock * (y + kBlock * z));
 }
 
-// The block of a level-L node from its 27 neighbours (level-L indices, −1 where absent, in
-// (x, y, z) order with x fastest): each neighbour's children at their block positions.
+// The block of a level-L node from its 27 neighbours (level-L indices, −1 where absent,
+// kFullCell inside a solid's full leaf, in (x, y, z) order with x fastest): each neighbour's
+// children at their block positions (kFullCell for its full leaves).
 Block FillBlock(const std::vector<SvoNode>& nodes, const std::array<std::int64_t, 27>& neighbours) {
   Block block;
   block.fill(-1);
@@ -33,19 +34,40 @@ Block FillBlock(const std::vector<SvoNode>& nodes, const std::array<std::int64_t
       for (int ox = -1; ox <= 1; ++ox) {
         const std::int64_t q =
             neighbours[static_cast<std::size_t>((ox + 1) + 3 * ((oy + 1) + 3 * (oz + 1)))];
-        if (q < 0) continue;
-        const SvoNode& n = nodes[static_cast<std::size_t>(q)];
-        std::int64_t child = n.first_child;  // children are stored in child-bit order
+        if (q < 0 && q != kFullCell) continue;
+        const SvoNode* n = q >= 0 ? &nodes[static_cast<std::size_t>(q)] : nullptr;
+        std::int64_t child = n != nullptr ? n->first_child : 0;  // in child-bit order
         for (unsigned ch = 0; ch < 8; ++ch) {
-          if (!(n.child_mask & (1u << ch))) continue;
-          block[BlockIndex(2 * ox + static_cast<int>(ch & 1) + 2,
-                           2 * oy + static_cast<int>((ch >> 1) & 1) + 2,
-                           2 * oz + static_cast<int>((ch >> 2) & 1) + 2)] = child++;
+          std::int64_t& cell = block[BlockIndex(2 * ox + static_cast<int>(ch & 1) + 2,
+                                                2 * oy + static_cast<int>((ch >> 1) & 1) + 2,
+                                                2 * oz + static_cast<int>((ch >> 2) & 1) + 2)];
+          if (n == nullptr || (n->full_mask & (1u << ch))) {
+            cell = kFullCell;
+          } else if (n->child_mask & (1u << ch)) {
+            cell = child++;
+          }
         }
       }
     }
   }
   return block;
+}
+
+// Whether the level-`level` cell (x, y, z), no node, lies inside a full leaf: walked from the root.
+bool InFullLeaf(const Svo& svo, std::uint32_t level, std::int64_t x, std::int64_t y,
+                std::int64_t z) {
+  if (!svo.solid) return false;
+  std::uint64_t node = 0;
+  for (std::uint32_t l = 0; l < level; ++l) {
+    const int shift = static_cast<int>(level - l - 1);
+    const unsigned ch =
+        static_cast<unsigned>((x >> shift & 1) | (y >> shift & 1) << 1 | (z >> shift & 1) << 2);
+    const SvoNode& n = svo.levels[l].nodes[node];
+    if (n.full_mask >> ch & 1u) return true;
+    if (!(n.child_mask >> ch & 1u)) return false;
+    node = n.Child(ch);
+  }
+  return false;
 }
 
 // The block of `node` (level `level`, Morton `key`), its neighbours found by key lookups.
@@ -67,6 +89,7 @@ Block GatherChildren(const Svo& svo, std::uint32_t level, const KeyIndex& index,
                                   : index.Find(MortonEncode(static_cast<std::uint32_t>(x),
                                                             static_cast<std::uint32_t>(y),
                                                             static_cast<std::uint32_t>(z)));
+          if (q < 0 && InFullLeaf(svo, level, x, y, z)) q = kFullCell;
         }
       }
     }
@@ -214,8 +237,15 @@ void AboveVoxelBrick(const VoxelSamplesSource& voxels, const Svo& svo, const Blo
           const std::size_t c = BlockIndex(p[0] + dx, p[1] + dy, p[2] + dz);
           return block[c] < 0 ? nullptr : &cells[c];
         });
-    Store(Encode(color, normal, sum), node * svo.brick_samples() + static_cast<std::size_t>(k),
-          out);
+    // A solid's opacity counts its interior voxels too.
+    const auto filled = [&](int dx, int dy, int dz) {
+      const std::int64_t c = block[BlockIndex(p[0] + dx, p[1] + dy, p[2] + dz)];
+      return c >= 0 || c == kFullCell;
+    };
+    const float opacity = side == 3 ? brick_math::AboveVoxelsOpacity<3>(filled)
+                                    : brick_math::AboveVoxelsOpacity<2>(filled);
+    Store(Encode(color, normal, sum, opacity),
+          node * svo.brick_samples() + static_cast<std::size_t>(k), out);
   }
 }
 
@@ -237,15 +267,25 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
   // [cell − 1, cell − 1 + n): only those lattice points are decoded.
   const int lo = cell - 1, n = 2 * side + 1;
   // Zero between calls: each call clears the points it filled (a full clear per node cost more
-  // than the filter).
-  static thread_local std::vector<PremultipliedSample> lattice;
+  // than the filter). In a solid, `opacity` holds each point's stored opacity apart from the
+  // weight of its colour in `lattice` (brick_math::ColourWeighted).
+  static thread_local std::vector<PremultipliedSample> lattice, opacity;
   static thread_local std::vector<std::uint8_t> filled;
   static thread_local std::vector<std::uint32_t> filled_points;
   lattice.resize(static_cast<std::size_t>(n * n * n));
+  opacity.resize(lattice.size());
   filled.resize(lattice.size());
   filled_points.clear();
+  bool differs = false;
   const auto at = [n](int x, int y, int z) {
     return static_cast<std::size_t>(x + n * (y + n * z));
+  };
+  const auto put = [&](std::size_t p, const PremultipliedSample& weighted, float stored) {
+    filled[p] = 1;
+    filled_points.push_back(static_cast<std::uint32_t>(p));
+    lattice[p] = weighted;
+    opacity[p].opacity = stored;
+    differs = differs || weighted.opacity != stored;
   };
   const std::uint32_t samples = svo.brick_samples();
   const SvoLevel& finer = svo.levels[level + 1];
@@ -276,52 +316,88 @@ void ParentBrick(const Svo& svo, std::uint32_t level, const Block& block, std::u
               const std::size_t i = first + static_cast<std::size_t>(nx + side * (ny + side * nz));
               const std::size_t p = at(x, y, z);
               if (finer.opacity[i] == 0 || filled[p]) continue;
-              filled[p] = 1;
-              filled_points.push_back(static_cast<std::uint32_t>(p));
-              lattice[p] = DecodePremultiplied(finer, i, svo.has_color, svo.has_normal);
+              const PremultipliedSample v =
+                  DecodePremultiplied(finer, i, svo.has_color, svo.has_normal);
+              const brick_math::EncodedSample e{finer.opacity[i],
+                                                svo.has_color ? finer.color[i] : 0u, 0};
+              put(p, svo.solid ? brick_math::ColourWeighted(v, e, svo.has_color) : v, v.opacity);
             }
           }
         }
       }
     }
   }
+  if (svo.solid) {
+    // The points no finer brick holds whose reach meets a full leaf: their opacity in closed
+    // form. Point x of the window lies at x + lo over the block, whose cell b spans
+    // [(b − 1)·cell, b·cell].
+    const std::uint32_t above_voxels = svo.depth - (level + 1);
+    const auto full = [&](std::int64_t cx, std::int64_t cy, std::int64_t cz) {
+      const auto in = [](std::int64_t c) { return c >= -1 && c < kBlock - 1; };
+      return in(cx) && in(cy) && in(cz) &&
+             block[BlockIndex(static_cast<int>(cx) + 1, static_cast<int>(cy) + 1,
+                              static_cast<int>(cz) + 1)] == kFullCell;
+    };
+    for (int z = 0; z < n; ++z) {
+      for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+          if (filled[at(x, y, z)]) continue;
+          const std::int64_t t[3] = {x + lo, y + lo, z + lo};
+          const unsigned octants = brick_math::FullOctants(svo.brick_side, t, full);
+          if (octants == 0) continue;
+          put(at(x, y, z), PremultipliedSample{},
+              DecodeUnorm8(brick_math::FullOctantsOpacity(above_voxels, octants)));
+        }
+      }
+    }
+  }
   // Separable tent, one axis at a time (x, then y, then z): every shared sample is the same sum
   // of the same values in the same order, whichever parent computes it.
-  std::array<PremultipliedSample, 7 * 7 * 3> fx{};
-  std::array<PremultipliedSample, 7 * 3 * 3> fy{};
-  for (int z = 0; z < n; ++z) {
-    for (int y = 0; y < n; ++y) {
+  const auto tent = [&](const std::vector<PremultipliedSample>& points) {
+    std::array<PremultipliedSample, 7 * 7 * 3> fx{};
+    std::array<PremultipliedSample, 7 * 3 * 3> fy{};
+    std::array<PremultipliedSample, 27> o{};
+    for (int z = 0; z < n; ++z) {
+      for (int y = 0; y < n; ++y) {
+        for (int k = 0; k < side; ++k) {
+          PremultipliedSample& f = fx[static_cast<std::size_t>(k + side * (y + n * z))];
+          for (int d = 0; d < 3; ++d) Accumulate(f, points[at(2 * k + d, y, z)], kTent[d]);
+        }
+      }
+    }
+    for (int z = 0; z < n; ++z) {
       for (int k = 0; k < side; ++k) {
-        PremultipliedSample& o = fx[static_cast<std::size_t>(k + side * (y + n * z))];
-        for (int d = 0; d < 3; ++d) Accumulate(o, lattice[at(2 * k + d, y, z)], kTent[d]);
+        for (int x = 0; x < side; ++x) {
+          PremultipliedSample& f = fy[static_cast<std::size_t>(x + side * (k + side * z))];
+          for (int d = 0; d < 3; ++d) {
+            Accumulate(f, fx[static_cast<std::size_t>(x + side * (2 * k + d + n * z))], kTent[d]);
+          }
+        }
       }
     }
-  }
-  for (int z = 0; z < n; ++z) {
     for (int k = 0; k < side; ++k) {
-      for (int x = 0; x < side; ++x) {
-        PremultipliedSample& o = fy[static_cast<std::size_t>(x + side * (k + side * z))];
-        for (int d = 0; d < 3; ++d) {
-          Accumulate(o, fx[static_cast<std::size_t>(x + side * (2 * k + d + n * z))], kTent[d]);
+      for (int y = 0; y < side; ++y) {
+        for (int x = 0; x < side; ++x) {
+          PremultipliedSample& f = o[static_cast<std::size_t>(x + side * (y + side * k))];
+          for (int d = 0; d < 3; ++d) {
+            Accumulate(f, fy[static_cast<std::size_t>(x + side * (y + side * (2 * k + d)))],
+                       kTent[d]);
+          }
         }
       }
     }
-  }
-  for (int k = 0; k < side; ++k) {
-    for (int y = 0; y < side; ++y) {
-      for (int x = 0; x < side; ++x) {
-        PremultipliedSample o;
-        for (int d = 0; d < 3; ++d) {
-          Accumulate(o, fy[static_cast<std::size_t>(x + side * (y + side * (2 * k + d)))],
-                     kTent[d]);
-        }
-        Store(Encode(svo.has_color, svo.has_normal, o),
-              node * samples + static_cast<std::size_t>(x + side * (y + side * k)), out);
-      }
-    }
+    return o;
+  };
+  const std::array<PremultipliedSample, 27> weighted = tent(lattice);
+  std::array<PremultipliedSample, 27> stored{};
+  if (differs) stored = tent(opacity);
+  for (std::uint32_t k = 0; k < samples; ++k) {
+    Store(Encode(svo.has_color, svo.has_normal, weighted[k],
+                 differs ? stored[k].opacity : weighted[k].opacity),
+          node * samples + k, out);
   }
   for (const std::uint32_t p : filled_points) {
-    lattice[p] = PremultipliedSample{};
+    lattice[p] = opacity[p] = PremultipliedSample{};
     filled[p] = 0;
   }
 }

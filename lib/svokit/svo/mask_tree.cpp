@@ -57,8 +57,15 @@ ChildNeighbourhoods::ChildNeighbourhoods(const MaskTree& tree, std::uint32_t lev
             parent[static_cast<std::size_t>(NeighbourSlot(kParent[bx], kParent[by], kParent[bz]))];
         const unsigned m = p < 0 ? 0u : masks[p];
         const unsigned bit = kBit[bx] | kBit[by] << 1 | kBit[bz] << 2;
-        block_[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))] =
-            (m >> bit & 1u) ? static_cast<std::int64_t>(first[p] + RankInByte(m, bit)) : -1;
+        std::int64_t& cell = block_[static_cast<std::size_t>(bx + 4 * (by + 4 * bz))];
+        if (m >> bit & 1u) {
+          cell = static_cast<std::int64_t>(first[p] + RankInByte(m, bit));
+        } else {
+          const bool full =
+              p == kFullCell || (p >= 0 && !tree.full.empty() &&
+                                 (tree.full[level - tree.first_level][p] >> bit & 1u));
+          cell = full ? kFullCell : -1;
+        }
       }
     }
   }

@@ -5,7 +5,8 @@
 // Node i of level L has child c (0..7; bit 0 = x, 1 = y, 2 = z) when bit c of its mask is set; its
 // children are nodes first_child + rank of the next level, every level in ascending Morton order.
 // A neighbourhood is 27 node indices, slot (x+1) + 3(y+1) + 9(z+1) for the offset (x, y, z) ∈
-// {−1, 0, 1}³, −1 where there is no node; slot 13 is the node itself. A child's neighbourhood
+// {−1, 0, 1}³, negative where there is no node (kFullCell inside a solid's full leaf, else −1);
+// slot 13 is the node itself. A child's neighbourhood
 // follows from its parent's: node 2p + c + o has parent p + ⌊(c + o)/2⌋, child bit (c + o) mod 2.
 
 #include <array>
@@ -21,6 +22,10 @@
 namespace svokit {
 
 using Neighbourhood = std::array<std::int64_t, 27>;
+
+/// A neighbourhood's entry for a cell that is no node but lies inside a full leaf of a solid
+/// (MaskTree::full); −1 is a cell outside everything. Both are negative: "no node".
+inline constexpr std::int64_t kFullCell = -2;
 
 /// Slot of offset (x, y, z) ∈ {−1, 0, 1}³ in a Neighbourhood.
 constexpr int NeighbourSlot(int x, int y, int z) {

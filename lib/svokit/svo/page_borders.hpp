@@ -24,20 +24,23 @@ namespace svokit {
 /// kept until its neighbours are built too. Empty when the page has no levels above the voxels.
 std::vector<std::uint8_t> EncodePageShell(const SvoChunk& page, const SvoShape& shape);
 
-/// Sets the samples of `page` on its faces, at levels page_level .. depth − 2, to the whole
-/// tree's, from the encoded shells of the 27 pages around it: shells[NeighbourSlot(offset)] is the
-/// page at that offset's (empty where it has no voxels), slot 13 the page's own. A damaged shell
-/// is an error naming `name`.
+/// Sets the samples of `page` on its faces, at levels page_level .. depth − 2 (a solid's from
+/// depth − 1, which read the interior across the faces), to the whole tree's, from the encoded
+/// shells of the 27 pages around it: shells[NeighbourSlot(offset)] is the page at that offset's
+/// (empty where it has no voxels), slot 13 the page's own; bit NeighbourSlot(offset) of
+/// `full_pages` is set where that page's cube lies inside a solid's full leaf. A damaged shell is
+/// an error naming `name`.
 Status PatchPageFaces(SvoChunk& page, const SvoShape& shape,
                       std::span<const std::span<const std::uint8_t>> shells,
-                      const std::string& name);
+                      const std::string& name, std::uint32_t full_pages = 0);
 
 /// The brick of the page's root node: side³ samples in brick order.
 LevelSamples RootBrick(const SvoChunk& page, std::uint32_t side);
 
 /// Fills the layouts and samples of the top chunk `top` (levels 0 .. P − 1, its masks naming the
-/// pages) from the bricks of the pages' roots, side³ samples each, in page order: the whole
-/// tree's, as FilterSamples makes them.
-void FilterTopSamples(SvoChunk& top, std::uint32_t side, const LevelSamples& root_bricks);
+/// pages, and a solid's full leaves) of an octree of `depth` from the bricks of the pages' roots,
+/// side³ samples each, in page order: the whole tree's, as FilterSamples makes them.
+void FilterTopSamples(SvoChunk& top, std::uint32_t side, std::uint32_t depth,
+                      const LevelSamples& root_bricks);
 
 }  // namespace svokit

@@ -37,10 +37,11 @@ std::vector<LevelSamples> FilterSamples(const MaskTree& tree, std::span<const Sa
 
 /// Samples of the levels first_level .. last_level() − 1 of `tree` from those of its last level,
 /// `last` (laid out by layouts.back()), as FilterSamples filters each level from the one below:
-/// the top levels of an octree built one page at a time, from its pages' roots.
+/// the top levels of an octree of `depth` built one page at a time, from its pages' roots.
 std::vector<LevelSamples> FilterSamplesAbove(const MaskTree& tree,
                                              std::span<const SampleLayout> layouts,
-                                             std::uint32_t side, LevelSamples last);
+                                             std::uint32_t side, std::uint32_t depth,
+                                             LevelSamples last);
 
 /// Where bricks are assembled: side³ samples per node in node order, as SvoLevel holds them
 /// (colour and normal empty where the bricks carry none).

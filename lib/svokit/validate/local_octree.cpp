@@ -53,8 +53,37 @@ Svo Frame(const SvoShape& shape, const GridTransform& grid, VoxelMode mode, std:
   svo.has_color = shape.brick_side != 0 && shape.has_color;
   svo.has_normal = shape.brick_side != 0 && shape.has_normal;
   svo.has_contours = shape.has_contours;
+  svo.solid = shape.solid;
   svo.levels.resize(levels);
   return svo;
+}
+
+// Each node's full mask at `level` from `full` (in node order); nothing for a surface.
+void SetFullMasks(const std::vector<std::uint8_t>& full, SvoLevel& level) {
+  for (std::size_t i = 0; i < full.size() && i < level.nodes.size(); ++i) {
+    level.nodes[i].full_mask = full[i];
+  }
+}
+
+// The top chunk's nodes above the 27 page cubes around `cube` (besides the ancestors of the pages
+// `keys` holds): a cube wholly inside is a full leaf of one of them, and no page stands for it.
+void AddTopNodesAround(std::uint64_t cube, std::uint32_t page_level, const TopFullLeaves& top,
+                       std::vector<std::vector<std::uint64_t>>& keys) {
+  const MortonCoord c = MortonDecode(cube);
+  const std::int64_t limit = std::int64_t{1} << page_level;
+  for (int o = 0; o < 27; ++o) {
+    const std::int64_t at[3] = {c.x + o % 3 - 1, c.y + o / 3 % 3 - 1, c.z + o / 9 - 1};
+    if (std::any_of(at, at + 3, [&](std::int64_t v) { return v < 0 || v >= limit; })) continue;
+    const std::uint64_t cell =
+        MortonEncode(static_cast<std::uint32_t>(at[0]), static_cast<std::uint32_t>(at[1]),
+                     static_cast<std::uint32_t>(at[2]));
+    for (std::uint32_t l = 0; l < page_level && l < top.keys.size(); ++l) {
+      const std::uint64_t node = cell >> (3 * (page_level - l));
+      if (!std::binary_search(top.keys[l].begin(), top.keys[l].end(), node)) continue;
+      const auto it = std::lower_bound(keys[l].begin(), keys[l].end(), node);
+      if (it == keys[l].end() || *it != node) keys[l].insert(it, node);
+    }
+  }
 }
 
 }  // namespace
@@ -62,6 +91,7 @@ Svo Frame(const SvoShape& shape, const GridTransform& grid, VoxelMode mode, std:
 void PageLevels::CountBytes() {
   bytes = sizeof(PageLevels) + Bytes(colors) + Bytes(normals);
   for (const auto& k : keys) bytes += Bytes(k);
+  for (const auto& f : full) bytes += Bytes(f);
   for (const auto& w : words) bytes += Bytes(w);
   for (const SvoLevel& b : bricks) bytes += Bytes(b.opacity) + Bytes(b.color) + Bytes(b.normal);
 }
@@ -71,6 +101,7 @@ void PageLevels::Swap(PageLevels& o) noexcept {
   std::swap(key, o.key);
   keys.swap(o.keys);
   words.swap(o.words);
+  full.swap(o.full);
   bricks.swap(o.bricks);
   colors.swap(o.colors);
   normals.swap(o.normals);
@@ -86,6 +117,7 @@ PageLevels LevelsOf(const SvoChunk& chunk, const SvoShape& shape) {
     out.keys.push_back(std::move(lv.keys));
     out.words.push_back(shape.has_contours ? std::move(lv.contours) : std::vector<std::uint32_t>{});
     out.bricks.push_back(std::move(lv.bricks));
+    if (shape.solid && k + 1 < chunk.levels_held()) out.full.push_back(chunk.tree.full[k]);
   }
   if (shape.has_color && shape.shared_color.empty()) out.colors = chunk.colors;
   if (shape.has_normal) out.normals = chunk.normals;
@@ -118,11 +150,13 @@ PageLevels ShellOf(const SvoChunk& chunk, const SvoShape& shape) {
     SvoChunkLevel lv = AssembleChunkLevel(chunk, no_voxel_bricks, level);
     std::vector<std::uint64_t> keys;
     std::vector<std::uint32_t> words;
+    std::vector<std::uint8_t> full;
     SvoLevel bricks;
     for (std::size_t i = 0; i < lv.keys.size(); ++i) {
       if (!NearFaces(lv.keys[i], level, first)) continue;
       keys.push_back(lv.keys[i]);
       if (shape.has_contours) words.push_back(lv.contours[i]);
+      if (shape.solid && level < depth) full.push_back(chunk.tree.full[level - first][i]);
       if (samples == 0 || level == depth) continue;
       const SvoLevel& b = lv.bricks;
       const std::size_t s = i * samples;
@@ -139,6 +173,7 @@ PageLevels ShellOf(const SvoChunk& chunk, const SvoShape& shape) {
     bricks.node_count = keys.size();
     out.keys.push_back(std::move(keys));
     out.words.push_back(std::move(words));
+    if (shape.solid && level < depth) out.full.push_back(std::move(full));
     out.bricks.push_back(std::move(bricks));
   }
   // The near voxels' attributes, and their bricks from them, the voxels a few further in (a
@@ -185,7 +220,8 @@ PageLevels ShellOf(const SvoChunk& chunk, const SvoShape& shape) {
 
 LocalOctree JoinPages(std::span<const std::pair<std::uint64_t, const PageLevels*>> parts,
                       std::uint64_t cube, const SvoShape& shape, const GridTransform& grid,
-                      VoxelMode mode, std::uint32_t page_level) {
+                      VoxelMode mode, std::uint32_t page_level, const TopFullLeaves& top) {
+  std::vector<std::vector<std::uint8_t>> full(shape.solid ? shape.depth : 0);
   const std::uint32_t depth = shape.depth;
   LocalOctree out;
   out.svo = Frame(shape, grid, mode, depth + 1);
@@ -199,6 +235,7 @@ LocalOctree JoinPages(std::span<const std::pair<std::uint64_t, const PageLevels*
     for (const auto& [key, part] : parts) {
       if (key == cube) out.first[level] = out.keys[level].size();
       AppendTo(out.keys[level], part->keys[k]);
+      if (shape.solid && level < depth) AppendTo(full[level], part->full[k]);
       if (shape.has_contours) AppendTo(out.words[level], part->words[k]);
       const SvoLevel& b = part->bricks[k];
       lv.opacity.insert(lv.opacity.end(), b.opacity.begin(), b.opacity.end());
@@ -218,7 +255,24 @@ LocalOctree JoinPages(std::span<const std::pair<std::uint64_t, const PageLevels*
       if (up.empty() || up.back() != key >> 3) up.push_back(key >> 3);
     }
   }
+  if (shape.solid) AddTopNodesAround(cube, page_level, top, out.keys);
   LinkNodes(out.keys, depth, out.svo);
+  if (shape.solid) {
+    for (std::uint32_t level = page_level; level < depth; ++level) {
+      SetFullMasks(full[level], out.svo.levels[level]);
+    }
+    // Above the pages, the ancestors' full leaves are the top chunk's (whole pages inside).
+    for (std::uint32_t level = 0; level < page_level && level < top.keys.size(); ++level) {
+      const std::vector<std::uint64_t>& keys = top.keys[level];
+      for (std::size_t i = 0; i < out.keys[level].size(); ++i) {
+        const auto it = std::lower_bound(keys.begin(), keys.end(), out.keys[level][i]);
+        if (it != keys.end() && *it == out.keys[level][i]) {
+          out.svo.levels[level].nodes[i].full_mask =
+              top.full[level][static_cast<std::size_t>(it - keys.begin())];
+        }
+      }
+    }
+  }
   return out;
 }
 
@@ -236,6 +290,10 @@ LocalOctree JoinTop(const SvoChunk& top, std::span<const std::uint64_t> page_key
   out.keys[page_level].assign(page_keys.begin(), page_keys.end());
   out.svo.levels[page_level] = std::move(roots);
   LinkNodes(out.keys, shape.depth, out.svo);
+  if (shape.solid) {
+    for (std::uint32_t l = 0; l < page_level; ++l)
+      SetFullMasks(top.tree.full[l], out.svo.levels[l]);
+  }
   return out;
 }
 

@@ -54,6 +54,7 @@ PageLevels Select(const PageLevels& from, const Keep& keep, std::uint32_t sample
   const std::size_t levels = from.keys.size();
   out.keys.resize(levels);
   out.words.resize(levels);
+  out.full.resize(from.full.size());
   out.bricks.resize(levels);
   const std::size_t voxel_level = levels - 1;
   for (std::size_t k = 0; k < levels; ++k) {
@@ -64,6 +65,7 @@ PageLevels Select(const PageLevels& from, const Keep& keep, std::uint32_t sample
       if (!keep(level, from.keys[k][i])) continue;
       out.keys[k].push_back(from.keys[k][i]);
       if (!from.words[k].empty()) out.words[k].push_back(from.words[k][i]);
+      if (k < from.full.size()) out.full[k].push_back(from.full[k][i]);
       if (samples != 0) {
         const std::size_t s = i * samples;
         o.opacity.insert(o.opacity.end(), b.opacity.begin() + s, b.opacity.begin() + s + samples);
@@ -190,6 +192,7 @@ class PagedValidator {
   int filter_;
   std::unique_ptr<ShellCache> shells_;
   std::vector<std::uint64_t> page_keys_;
+  paged_detail::TopFullLeaves top_full_;  // a solid's, for the pages' octrees
   std::unique_ptr<paged_detail::MeshChecks> mesh_;
   std::vector<std::uint64_t> items_;  // cube keys at the page level: the pages and, with a mesh,
                                       // the cubes its triangles meet
@@ -227,6 +230,7 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
   own.key = cube;
   own.keys.resize(levels);
   own.words.resize(levels);
+  if (shape_.solid) own.full.resize(levels - 1);
   own.bricks.resize(levels);
   SvoChunk chunk;
   if (has_page) {
@@ -349,8 +353,8 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
   for (const auto& [k, part] : parts) all.emplace_back(k, part.get());
   all.emplace_back(cube, &own);
   std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  paged_detail::LocalOctree local =
-      paged_detail::JoinPages(all, cube, shape_, reader_.grid(), reader_.mode(), page_level_);
+  paged_detail::LocalOctree local = paged_detail::JoinPages(all, cube, shape_, reader_.grid(),
+                                                            reader_.mode(), page_level_, top_full_);
   {
     PageLevels().Swap(own);  // its nodes are in `local` now
   }
@@ -430,6 +434,10 @@ void PagedValidator::Take(std::size_t item, PageResult r) {
 void PagedValidator::CheckTop(const SvoChunk& top) {
   for (std::uint32_t l = 0; l < page_level_; ++l) {
     const SvoChunkLevel lv = AssembleChunkLevel(top, shape_, l);
+    if (shape_.solid) {
+      top_full_.keys.push_back(lv.keys);
+      top_full_.full.push_back(top.tree.full[l]);
+    }
     counts_[l][0] = lv.keys.size();
     counts_[l][1] = static_cast<std::uint64_t>(
         std::count_if(lv.contours.begin(), lv.contours.end(), [](auto w) { return w != 0; }));

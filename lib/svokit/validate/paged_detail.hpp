@@ -27,6 +27,8 @@ struct PageLevels {
   std::uint64_t key = 0;  ///< the page's root key
   std::vector<std::vector<std::uint64_t>> keys;
   std::vector<std::vector<std::uint32_t>> words;
+  /// A solid's full leaves: per level above the voxels, each node's full mask (else empty).
+  std::vector<std::vector<std::uint8_t>> full;
   std::vector<SvoLevel> bricks;
   DefaultInitVector<HalfRgba> colors;
   DefaultInitVector<OctNormal> normals;
@@ -59,11 +61,18 @@ struct LocalOctree {
   VoxelSamplesSource voxels() const { return {colors, normals}; }
 };
 
+/// The full leaves of the top chunk (a solid's): per level above the pages, the nodes' keys and
+/// full masks.
+struct TopFullLeaves {
+  std::vector<std::vector<std::uint64_t>> keys;
+  std::vector<std::vector<std::uint8_t>> full;
+};
+
 /// The octree of `parts` (page key, its levels or some of their nodes; ascending keys), the
-/// nodes of page `cube` marked.
+/// nodes of page `cube` marked; a solid's full leaves above the pages from `top`.
 LocalOctree JoinPages(std::span<const std::pair<std::uint64_t, const PageLevels*>> parts,
                       std::uint64_t cube, const SvoShape& shape, const GridTransform& grid,
-                      VoxelMode mode, std::uint32_t page_level);
+                      VoxelMode mode, std::uint32_t page_level, const TopFullLeaves& top);
 
 /// Levels 0 .. page_level of the whole octree: the top chunk's, and the pages' roots with
 /// `roots` (their bricks, in page order).
