@@ -343,8 +343,8 @@ int main(int argc, char** argv) {
   std::vector<Loaded> meshes;
   fmt::print(
       "# ambient occlusion: cones (default options: aperture 1, offset 1, distance 0.25 x\n"
-      "# the grid's diagonal, falloff 1, jitter seed 0) against Embree with {} cosine-weighted rays per\n"
-      "# point at the same points, distance and falloff; absolute AO error per point\n",
+      "# the grid's diagonal, falloff 1, jitter seed 0) against Embree with {} cosine-weighted\n"
+      "# rays per point at the same points, distance and falloff; absolute AO error per point\n",
       reference_rays);
   for (const MeshSpec& spec : specs) {
     auto mesh = ImportMesh(spec.path);
