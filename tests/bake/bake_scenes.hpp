@@ -32,14 +32,7 @@ inline Mesh PlaneMesh() {
 
 /// The closed box [−a, a]² × [0, h], twelve triangles facing out.
 inline Mesh BoxMesh(double a, double h) {
-  Mesh m;
-  for (int i = 0; i < 8; ++i) {
-    m.positions.push_back({i & 1 ? a : -a, i & 2 ? a : -a, i & 4 ? h : 0});
-  }
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  EnsureDefaultMaterial(m);
-  return m;
+  return BoxMesh(Vec3d{-a, -a, 0}, Vec3d{a, a, h});
 }
 
 /// An octree as svo-bake reads it: a file (in memory) opened for tracing.

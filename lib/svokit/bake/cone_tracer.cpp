@@ -135,21 +135,28 @@ ConeTracer::ConeTracer(const TraceOctree& octree, const ConeOptions& options)
   for (std::size_t i = 0; i < cones_.size(); ++i) {
     std::vector<ConeSample> samples;
     for (double t = 1;;) {
-      const double cos_theta = cones_[i].axis.z;
-      const double r =
-          std::sqrt(offset_voxels_ * offset_voxels_ + t * t + 2 * offset_voxels_ * t * cos_theta);
-      if (r > distance_voxels_) break;
+      if (DistanceFromPoint(i, t) > distance_voxels_) break;
       samples.push_back(SampleAt(i, t));
-      t += kStep * Footprint(offset_voxels_ + t * cos_theta, t * tan_half_[i]);
+      t += kStep * Footprint(offset_voxels_ + t * cones_[i].axis.z, t * tan_half_[i]);
     }
     schedule_.push_back(std::move(samples));
   }
 }
 
-ConeTracer::ConeSample ConeTracer::SampleAt(std::size_t cone, double t) const {
+double ConeTracer::DistanceFromPoint(std::size_t cone, double t) const {
+  // The origin sits offset_voxels_ above the point along the normal.
   const double cos_theta = cones_[cone].axis.z, o = offset_voxels_;
-  const double r = std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
-  const double footprint = Footprint(o + t * cos_theta, t * tan_half_[cone]);
+  return std::sqrt(o * o + t * t + 2 * o * t * cos_theta);
+}
+
+bool ConeTracer::InCube(const Vec3d& v) const {
+  return v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
+         v.z < root_side_;
+}
+
+ConeTracer::ConeSample ConeTracer::SampleAt(std::size_t cone, double t) const {
+  const double r = DistanceFromPoint(cone, t);
+  const double footprint = Footprint(offset_voxels_ + t * cones_[cone].axis.z, t * tan_half_[cone]);
   const auto depth = static_cast<float>(octree_->depth());
   const float lod = std::clamp(depth - static_cast<float>(std::log2(footprint)), 0.f, depth);
   ConeSample s;
@@ -161,10 +168,7 @@ ConeTracer::ConeSample ConeTracer::SampleAt(std::size_t cone, double t) const {
 }
 
 int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
-  if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
-        v.z < root_side_)) {
-    return -1;
-  }
+  if (!InCube(v)) return -1;
   const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
   const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
              z = static_cast<std::uint32_t>(v.z);
@@ -216,10 +220,7 @@ int ConeTracer::Descend(const Vec3d& v, std::uint32_t level, Cursor& cursor) con
 int ConeTracer::Probe(const Vec3d& v, std::uint32_t level, Cursor& cursor) const {
   const std::uint32_t depth = octree_->depth(), page_level = octree_->page_level();
   if (level <= page_level || octree_->solid()) return Descend(v, level, cursor);
-  if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < root_side_ && v.y < root_side_ &&
-        v.z < root_side_)) {
-    return -1;
-  }
+  if (!InCube(v)) return -1;
   const auto x = static_cast<std::uint32_t>(v.x), y = static_cast<std::uint32_t>(v.y),
              z = static_cast<std::uint32_t>(v.z);
   // The cursor's page, unless the point lies in another one.
@@ -432,9 +433,7 @@ float ConeTracer::Trace(const AoPoint& point, Cursor& cursor, ConeStats& stats) 
     m.cone = i;
     m.next = schedule_[i].data();
     m.end = m.next + schedule_[i].size();
-    const bool inside = origin.x >= 0 && origin.y >= 0 && origin.z >= 0 && origin.x < root_side_ &&
-                        origin.y < root_side_ && origin.z < root_side_;
-    m.face = inside ? ExitDistance(origin, m.inverse_axis, 0) - 2e-6 * root_side_ : 0;
+    m.face = InCube(origin) ? ExitDistance(origin, m.inverse_axis, 0) - 2e-6 * root_side_ : 0;
     while (Step(m, cursor, stats.samples)) {
     }
     sum += m.occlusion;

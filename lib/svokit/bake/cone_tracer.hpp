@@ -116,6 +116,10 @@ class ConeTracer {
   struct ConeMarch;
 
   ConeSample SampleAt(std::size_t cone, double t) const;
+  // Distance from the surface point of cone `cone`'s sample at `t`, in voxels.
+  double DistanceFromPoint(std::size_t cone, double t) const;
+  // Whether voxel-space point `v` lies in the octree's cube.
+  bool InCube(const Vec3d& v) const;
   // Walks `cursor` towards the node of `level` holding voxel-space point `v`: the deepest level
   // reached (`level` when that node exists), or −1 outside the octree's cube. cursor.full says
   // whether the child it stopped at is a full leaf.
