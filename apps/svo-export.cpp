@@ -1,5 +1,6 @@
 // svo-export: .svo → OpenVDB (.vdb), NanoVDB (.nvdb), binvox, MagicaVoxel (.vox), PLY points, xyz
-// text or a voxel mesh (.obj, .glb), at the voxel level or a coarser one.
+// text, a voxel mesh (.obj, .glb) or a sparse voxel DAG (.dag.bin, .svdag), at the voxel level or
+// a coarser one.
 
 #include <filesystem>
 #include <optional>
@@ -9,6 +10,7 @@
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/thread_limit.hpp"
+#include "svokit/export/dag_files.hpp"
 #include "svokit/export/export.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
@@ -19,8 +21,8 @@ int main(int argc, char** argv) {
   CLI::App cli{
       "Exports a sparse voxel octree's voxels (or the nodes of a coarser level) as OpenVDB grids "
       "(.vdb), NanoVDB grids (.nvdb: density, colour, AO), binvox, MagicaVoxel (.vox), PLY "
-      "points, xyz text or a voxel mesh (.obj with a palette .mtl, .glb), by the output's "
-      "extension.",
+      "points, xyz text, a voxel mesh (.obj with a palette .mtl, .glb) or a sparse voxel DAG "
+      "(HashDAG .dag.bin with its colours beside, SymVox .svdag), by the output's extension.",
       tool};
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
@@ -28,7 +30,7 @@ int main(int argc, char** argv) {
   app::MemoryLimitOption memory_limit;
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
   app::AddFile(cli, "-o,--output", output,
-               "Output: .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj or .glb")
+               "Output: .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb, .dag.bin or .svdag")
       ->required();
   cli.add_option("--level", level,
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
@@ -56,6 +58,35 @@ int main(int argc, char** argv) {
     options.level = level;
     options.merge_faces = !no_merge;
 
+    if (IsDagPath(output)) {
+      StatusOr<SvoReader> reader = SvoReader::Open(input);
+      if (!reader.ok()) return app::Fail(tool, reader.status());
+      const std::uint32_t exported = level.value_or(reader->depth());
+      StatusOr<DagExport> dag = ExportDag(*reader, output, exported, limit->value_or(0), progress);
+      if (!dag.ok()) return app::Fail(tool, dag.status());
+      app::Report report(common);
+      report.Line("octree", {{"path", input.string()}, {"depth", reader->depth()}},
+                  fmt::format("{} (depth {})", input.string(), reader->depth()));
+      const double bits = 8.0 * static_cast<double>(dag->file_bytes) /
+                          static_cast<double>(std::max<std::uint64_t>(dag->voxels, 1));
+      report.Line("dag",
+                  {{"level", exported},
+                   {"voxels", dag->voxels},
+                   {"nodes", dag->nodes},
+                   {"level_nodes", dag->level_nodes},
+                   {"bytes", dag->file_bytes},
+                   {"bits_per_voxel", bits}},
+                  fmt::format("level {}: {} voxels, {} distinct nodes, {} bytes, {:.3f} bits/voxel",
+                              exported, dag->voxels, dag->nodes, dag->file_bytes, bits));
+      if (dag->color_bytes != 0) {
+        report.Line(
+            "colors", {{"path", HashDagColorsPath(output).string()}, {"bytes", dag->color_bytes}},
+            fmt::format("{} ({} bytes)", HashDagColorsPath(output).string(), dag->color_bytes));
+      }
+      app::AddOutput(report, output, std::nullopt);
+      report.Print();
+      return 0;
+    }
     // A paged file streams its pages into the writer; version 1, .vox and solids read whole.
     std::uint32_t depth = 0;
     std::uint64_t nodes = 0;

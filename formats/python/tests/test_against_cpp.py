@@ -6,7 +6,6 @@ and SVOKIT_ASSIMP_MODELS, as ctest sets them (tests/CMakeLists.txt).
 """
 
 import json
-import os
 import pathlib
 import subprocess
 import sys
@@ -21,13 +20,7 @@ import numpy as np  # noqa: E402
 
 import svokit  # noqa: E402
 from compare import check  # noqa: E402
-
-
-def env_path(name):
-    value = os.environ.get(name)
-    if not value:
-        raise unittest.SkipTest(f"{name} is not set (run through ctest)")
-    return pathlib.Path(value)
+from tool_env import env_path  # noqa: E402
 
 
 # name, mesh (folder variable, file), mesh2svo options, then svo-bake options (None: no bake).

@@ -433,8 +433,14 @@ std::string ReadFullyAt(int fd, std::uint64_t offset, std::span<std::uint8_t> ou
 Status CheckOutputPath(const std::filesystem::path& path,
                        const std::vector<std::string>& extensions,
                        const std::filesystem::path& input) {
-  const std::string ext = LowerExtension(path);
-  if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+  // Matched on the name's tail, so that an extension may have two parts (x.dag.bin).
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const auto named = [&](const std::string& e) {
+    return name.size() > e.size() + 1 && name.ends_with("." + e);
+  };
+  if (std::none_of(extensions.begin(), extensions.end(), named)) {
     std::string list;
     for (const std::string& e : extensions) list += (list.empty() ? "." : ", .") + e;
     return Status::BadInput("{}: output must be a {} file", path.string(), list);

@@ -83,6 +83,13 @@ struct MortonBrick {
   static_assert(kSideBits >= 1 && kCodeBits <= 16, "local codes are kept in 16 bits");
 };
 
+/// The key with x and z exchanged: its order is the depth-first order of a tree whose child index
+/// is 4x + 2y + z (HashDAG's and SymVox's octants), where this one's is x + 2y + 4z.
+constexpr std::uint64_t MortonSwapXZ(std::uint64_t key) {
+  constexpr std::uint64_t kX = 0x9249249249249249ull, kY = kX << 1, kZ = kX << 2;
+  return (key & kY) | (key & kX) << 2 | (key & kZ) >> 2;
+}
+
 /// Which of the 8 children of its parent a key is (bit 0: x, bit 1: y, bit 2: z).
 constexpr unsigned MortonChildIndex(std::uint64_t key) {
   return static_cast<unsigned>(key & 7u);

@@ -8,6 +8,7 @@
 #include "svokit/core/file_io.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
+#include "svokit/export/dag_files.hpp"
 #include "svokit/export/voxel_writers.hpp"
 
 namespace svokit {
@@ -31,15 +32,11 @@ std::vector<std::uint32_t> NodeSamples(std::uint32_t side) {
 }  // namespace
 
 const std::vector<std::string>& ExportExtensions() {
-  static const std::vector<std::string> kExtensions = {"vdb", "nvdb", "binvox", "vox",
-                                                       "ply", "xyz",  "obj",    "glb"};
+  static const std::vector<std::string> kExtensions = {"vdb", "nvdb", "binvox", "vox",   "ply",
+                                                       "xyz", "obj",  "glb",    "svdag", "dag.bin"};
   return kExtensions;
 }
 
-namespace {
-
-// The voxels of a level's nodes on the octree's origin: dims the leaf grid's rounded up to whole
-// nodes.
 GridTransform LevelGrid(const GridTransform& grid, std::uint32_t depth, std::uint32_t level) {
   const std::uint32_t shift = depth - level;
   std::array<std::uint32_t, 3> dims = grid.dims();
@@ -47,10 +44,8 @@ GridTransform LevelGrid(const GridTransform& grid, std::uint32_t depth, std::uin
   return GridTransform(grid.origin(), grid.voxel_size() * static_cast<double>(1u << shift), dims);
 }
 
-// Each node's colour and normal from `bricks` (its level's pool, in the order of set.keys), and
-// when asked for its density: the opacity at its centre (1 without bricks).
 void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_color, bool has_normal,
-                        VoxelSet& set, std::vector<float>* density = nullptr) {
+                        VoxelSet& set, std::vector<float>* density) {
   const std::vector<std::uint32_t> samples = NodeSamples(side);
   if (density != nullptr) density->assign(set.keys.size(), 1.f);
   if (samples.empty()) return;
@@ -82,8 +77,6 @@ void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_col
     }
   });
 }
-
-}  // namespace
 
 VoxelSet LevelVoxels(const Svo& svo, std::uint32_t level, std::vector<float>* density) {
   VoxelSet set;
@@ -166,11 +159,13 @@ namespace {
 
 // The format `path` names, if it is one, and not a directory.
 StatusOr<std::string> CheckExport(const std::filesystem::path& path) {
-  const std::string ext = LowerExtension(path);
+  const std::string ext =
+      IsDagPath(path) && LowerExtension(path) == "bin" ? "dag.bin" : LowerExtension(path);
   const auto& known = ExportExtensions();
   if (std::find(known.begin(), known.end(), ext) == known.end()) {
     return Status::BadInput(
-        "{}: unknown export format (use .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj or .glb)",
+        "{}: unknown export format (use .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb, "
+        ".svdag or .dag.bin)",
         path.string());
   }
   std::error_code ec;
@@ -192,6 +187,10 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
   }
   if (level >= svo.levels.size()) {
     return Status::BadInput("{}: level {} was not loaded", path.string(), level);
+  }
+  if (IsDagPath(path)) {
+    return Status::BadInput("{}: a DAG is written from a .svo file (ExportSvoPages, svo-export)",
+                            path.string());
   }
   const bool grids = *ext == "vdb" || *ext == "nvdb";
   std::vector<float> density;
@@ -247,7 +246,7 @@ Status ExportSvo(const Svo& svo, const std::filesystem::path& path, const Export
 }
 
 bool ExportStreams(const SvoReader& reader, const std::filesystem::path& path) {
-  return !reader.shape().solid && LowerExtension(path) != "vox";
+  return IsDagPath(path) || (!reader.shape().solid && LowerExtension(path) != "vox");
 }
 
 Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& path,
@@ -356,6 +355,7 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   }
   StatusOr<std::string> ext = CheckExport(path);
   if (!ext.ok()) return ext.status();
+  if (IsDagPath(path)) return ExportDag(reader, path, level, memory_limit).status();
   if (!ExportStreams(reader, path)) {
     return Status::BadInput("{}: a .vox or a solid's export takes the octree whole", path.string());
   }

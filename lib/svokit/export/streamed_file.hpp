@@ -27,6 +27,7 @@ class StreamedFile {
     if (buffer_.size() >= (1u << 20)) Flush();
   }
   const Status& status() const { return status_; }
+  std::uint64_t bytes_written() const { return file_.bytes_written() + buffer_.size(); }
   Status Commit() {
     Flush();
     return status_.ok() ? file_.Commit() : status_;

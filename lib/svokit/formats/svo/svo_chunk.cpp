@@ -781,8 +781,10 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
       1u << kContourBits | 1u << kContourThickness | 1u << kContourPosition |
       1u << kContourNormals | 1u << kColors | 1u << kNormals | 1u << kVoxelColors |
       1u << kVoxelNormals | 1u << kHaloColors | 1u << kHaloNormals;
+  constexpr std::uint32_t kNotMasks = ~(1u << kMasks | 1u << kFullMasks);
   const std::uint32_t skip = counts_only                           ? kAttributeStreams
                              : frame.parts == ChunkParts::kOpacity ? kNotOpacity
+                             : frame.parts == ChunkParts::kMasks   ? kNotMasks
                                                                    : 0;
   StatusOr<StreamSet> read = StreamSet::Read(bytes, name, skip);
   if (!read.ok()) return read.status();
@@ -794,6 +796,10 @@ StatusOr<SvoChunk> DecodeChunk(std::span<const std::uint8_t> bytes, const SvoSha
   StatusOr<std::vector<std::uint64_t>> counts = DecodeMasks(set, shape, frame, name, chunk);
   if (!counts.ok()) return counts.status();
   SVOKIT_RETURN_IF_ERROR(DecodeFullMasks(set, shape, frame, name, chunk));
+  if (frame.parts == ChunkParts::kMasks) {
+    chunk.contours.resize(frame.levels);
+    return chunk;
+  }
   SVOKIT_RETURN_IF_ERROR(DecodeContours(set, shape, frame, *counts, name, chunk));
   SVOKIT_RETURN_IF_ERROR(DecodeSamples(set, shape, frame, name, chunk));
   if (counts_only) return chunk;

@@ -57,8 +57,9 @@ inline constexpr std::uint64_t kChunkLimit = std::uint64_t{4} << 30;
 /// attributes or halo, and the samples not laid out over the nodes, every level's in one
 /// LevelSamples (SvoChunk::layouts empty), their count unchecked against the tree; or what cone
 /// tracing needs: masks, opacity samples laid out, halo keys (no contours, whose levels are held
-/// empty, and no colour or normal).
-enum class ChunkParts { kAll, kCounts, kOpacity };
+/// empty, and no colour or normal); or the tree alone (masks and full masks: a DAG's build; contour
+/// levels held empty, no samples, voxels' attributes or halo).
+enum class ChunkParts { kAll, kCounts, kOpacity, kMasks };
 
 struct ChunkFrame {
   std::uint32_t root_level = 0;

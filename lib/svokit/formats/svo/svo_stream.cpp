@@ -43,6 +43,11 @@ void Sort(const SvoReader& reader, SvoPageOrder order, std::uint32_t level,
           std::vector<std::size_t>& pages) {
   if (order == SvoPageOrder::kSlabsAlongX) SortBySlabs(reader, pages);
   if (order == SvoPageOrder::kVdbTree) SortForVdb(reader, level, pages);
+  if (order == SvoPageOrder::kKeysSwappedXZ) {
+    std::sort(pages.begin(), pages.end(), [&](std::size_t a, std::size_t b) {
+      return MortonSwapXZ(reader.page(a).key) < MortonSwapXZ(reader.page(b).key);
+    });
+  }
 }
 
 }  // namespace

@@ -29,8 +29,9 @@ namespace svokit {
 /// (ascending x, then by key), the order of formats that run along x (binvox); or by the nodes of
 /// an OpenVDB tree over the voxels of SvoStreamOptions::level (kVdbTree): its 4096³ cubes in x,
 /// y, z order, within each its 128³ cubes in x, y, z order, then by key; the order a .vdb file
-/// stores its nodes in.
-enum class SvoPageOrder { kKeys, kSlabsAlongX, kVdbTree };
+/// stores its nodes in; or by keys with x and z exchanged (MortonSwapXZ), the depth-first order
+/// of HashDAG and SymVox, whose child index is 4x + 2y + z.
+enum class SvoPageOrder { kKeys, kSlabsAlongX, kVdbTree, kKeysSwappedXZ };
 
 /// Which pages a streamed read visits, in which order, and the bytes it may hold.
 struct SvoStreamOptions {

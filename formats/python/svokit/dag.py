@@ -1,0 +1,151 @@
+"""Readers of the sparse voxel DAG files svo-export writes (formats/dag.md): HashDAG's basic_dag
+(``x.dag.bin`` and ``x.uncompressed_colors.bin``) and SymVox's ``.svdag``, expanded to voxels as
+those renderers walk them. Written from the layouts' own descriptions, independently of svokit's
+C++ writers.
+
+Both number a node's children ``4x + 2y + z``; the voxels come out in that depth-first order (the
+order of HashDAG's colours) as integer (x, y, z) rows.
+"""
+
+import struct
+
+import numpy as np
+
+from .errors import FormatError
+
+# Child (or voxel of a 2³ block) c = 4x + 2y + z: its (x, y, z) offset.
+_OCTANT = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], np.int64)
+# Per child c and mask m, the children of m below c and above c: where c's pointer is when the
+# pointers are stored ascending (HashDAG) or descending (SymVox).
+_BELOW = np.array([[bin(m & ((1 << c) - 1)).count("1") for m in range(256)] for c in range(8)])
+_ABOVE = np.array([[bin(m >> (c + 1)).count("1") for m in range(256)] for c in range(8)])
+
+
+class HashDag:
+    """A ``.dag.bin``: the cube ``bmin`` .. ``bmax``, ``levels`` (grid 2^levels a side) and the node
+    array ``words`` (uint32, root at 0)."""
+
+    def __init__(self, bmin, bmax, levels, words):
+        self.bmin, self.bmax, self.levels, self.words = bmin, bmax, levels, words
+
+
+class HashDagColors:
+    """An ``uncompressed_colors.bin``: ``top_levels``, ``enclosed`` (voxel counts of the nodes above
+    ``top_levels``) and ``rgba`` (uint8 rows R, G, B, A in depth-first voxel order)."""
+
+    def __init__(self, top_levels, enclosed, rgba):
+        self.top_levels, self.enclosed, self.rgba = top_levels, enclosed, rgba
+
+
+class Svdag:
+    """A ``.svdag``: the box ``bmin`` .. ``bmax``, the root cube's ``root_side``, ``levels``, the
+    header's ``nodes`` and ``first_leaf`` and the node array ``words`` (root at 0)."""
+
+    def __init__(self, bmin, bmax, root_side, levels, nodes, first_leaf, words):
+        self.bmin, self.bmax, self.root_side, self.levels = bmin, bmax, root_side, levels
+        self.nodes, self.first_leaf, self.words = nodes, first_leaf, words
+
+
+def _read(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def read_hashdag(path):
+    data = _read(path)
+    if len(data) < 60:
+        raise FormatError(f"{path}: {len(data)} bytes, shorter than a .dag.bin header")
+    bmin = struct.unpack_from("<3d", data, 0)
+    bmax = struct.unpack_from("<3d", data, 24)
+    (levels,) = struct.unpack_from("<I", data, 48)
+    (n,) = struct.unpack_from("<Q", data, 52)
+    if not 3 <= levels <= 21 or len(data) != 60 + 4 * n:
+        raise FormatError(f"{path}: {levels} levels and {n} words in {len(data)} bytes")
+    return HashDag(bmin, bmax, levels, np.frombuffer(data, "<u4", n, 60))
+
+
+def read_hashdag_colors(path):
+    data = _read(path)
+    (top_levels,) = struct.unpack_from("<I", data, 0)
+    (e,) = struct.unpack_from("<Q", data, 4)
+    enclosed = np.frombuffer(data, "<u8", e, 12)
+    (c,) = struct.unpack_from("<Q", data, 12 + 8 * e)
+    if len(data) != 20 + 8 * e + 4 * c:
+        raise FormatError(f"{path}: {e} counts and {c} colours in {len(data)} bytes")
+    rgba = np.frombuffer(data, np.uint8, 4 * c, 20 + 8 * e).reshape(-1, 4)
+    return HashDagColors(top_levels, enclosed, rgba)
+
+
+def read_svdag(path):
+    data = _read(path)
+    if len(data) < 44:
+        raise FormatError(f"{path}: {len(data)} bytes, shorter than a .svdag header")
+    bmin = struct.unpack_from("<3f", data, 0)
+    bmax = struct.unpack_from("<3f", data, 12)
+    (root_side,) = struct.unpack_from("<f", data, 24)
+    levels, nodes, first_leaf, count = struct.unpack_from("<4I", data, 28)
+    if len(data) != 44 + 4 * count:
+        raise FormatError(f"{path}: {count} words in {len(data)} bytes")
+    words = np.frombuffer(data, "<u4", count, 44)
+    return Svdag(bmin, bmax, root_side, levels, nodes, first_leaf, words)
+
+
+def _children(words, nodes, xyz, descending):
+    """The children of ``nodes`` (word indices, in depth-first order, at ``xyz``) in depth-first
+    order: each node's in ascending child index, its pointers stored ascending or descending."""
+    masks = (words[nodes] & 0xFF).astype(np.int64)
+    rows, kids, cells = [], [], []
+    for c in range(8):
+        has = np.nonzero((masks >> c) & 1)[0]
+        slot = 1 + (_ABOVE if descending else _BELOW)[c][masks[has]]
+        rows.append(has * 8 + c)
+        kids.append(words[nodes[has] + slot].astype(np.int64))
+        cells.append(2 * xyz[has] + _OCTANT[c])
+    order = np.argsort(np.concatenate(rows), kind="stable")
+    return np.concatenate(kids)[order], np.concatenate(cells)[order], np.concatenate(rows)[order] // 8
+
+
+def _expand(words, levels, leaf_level, descending, leaf_voxels):
+    """Voxels (x, y, z rows, depth-first) and, per level, each visited node's word index and the
+    index of its parent among the level above's."""
+    nodes = np.zeros(1, np.int64)
+    xyz = np.zeros((1, 3), np.int64)
+    visits = [(nodes, None)]
+    for _ in range(leaf_level):
+        nodes, xyz, parent = _children(words, nodes, xyz, descending)
+        visits.append((nodes, parent))
+    return leaf_voxels(words, nodes, xyz), visits
+
+
+def _hashdag_leaf_voxels(words, nodes, xyz):
+    bits = words[nodes].astype(np.uint64) | (words[nodes + 1].astype(np.uint64) << np.uint64(32))
+    out_rows, out_cells = [], []
+    for b in range(64):
+        has = np.nonzero((bits >> np.uint64(b)) & np.uint64(1))[0]
+        out_rows.append(has * 64 + b)
+        out_cells.append(4 * xyz[has] + 2 * _OCTANT[b >> 3] + _OCTANT[b & 7])
+    order = np.argsort(np.concatenate(out_rows), kind="stable")
+    return np.concatenate(out_cells)[order]
+
+
+def hashdag_voxels(dag, with_visits=False):
+    """The voxels of a HashDAG file as (x, y, z) rows in its depth-first (colour) order."""
+    voxels, visits = _expand(dag.words, dag.levels, dag.levels - 2, False, _hashdag_leaf_voxels)
+    return (voxels, visits) if with_visits else voxels
+
+
+def _svdag_leaf_voxels(words, nodes, xyz):
+    masks = (words[nodes] & 0xFF).astype(np.int64)
+    out_rows, out_cells = [], []
+    for c in range(8):
+        has = np.nonzero((masks >> c) & 1)[0]
+        out_rows.append(has * 8 + c)
+        out_cells.append(2 * xyz[has] + _OCTANT[c])
+    order = np.argsort(np.concatenate(out_rows), kind="stable")
+    return np.concatenate(out_cells)[order]
+
+
+def svdag_voxels(dag):
+    """The voxels of a SymVox file as (x, y, z) rows in depth-first order."""
+    voxels, _ = _expand(dag.words, dag.levels, dag.levels - 1, True, _svdag_leaf_voxels)
+    return voxels
