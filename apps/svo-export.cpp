@@ -36,6 +36,13 @@ int main(int argc, char** argv) {
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
                  "(default: the voxels)")
       ->option_text("L");
+  std::string dag_colors = "default";
+  cli.add_option("--colors", dag_colors,
+                 "DAGs: the colour file beside it: hashdag (HashDAG's uncompressed_colors.bin, "
+                 "the default beside a .dag.bin), packed (svokit's .dagcolors, zstd-compressed, "
+                 "the default beside a .svdag) or none")
+      ->check(CLI::IsMember({"default", "hashdag", "packed", "none"}))
+      ->option_text("FILE");
   bool no_merge = false;
   cli.add_flag("--no-merge", no_merge,
                "Voxel meshes: one quad per voxel face (default: coplanar faces of one colour "
@@ -62,7 +69,11 @@ int main(int argc, char** argv) {
       StatusOr<SvoReader> reader = SvoReader::Open(input);
       if (!reader.ok()) return app::Fail(tool, reader.status());
       const std::uint32_t exported = level.value_or(reader->depth());
-      StatusOr<DagExport> dag = ExportDag(*reader, output, exported, limit->value_or(0), progress);
+      DagExportOptions dag_options{exported, limit->value_or(0), DagColorFile::kDefault};
+      if (dag_colors == "hashdag") dag_options.colors = DagColorFile::kHashDag;
+      if (dag_colors == "packed") dag_options.colors = DagColorFile::kPacked;
+      if (dag_colors == "none") dag_options.colors = DagColorFile::kNone;
+      StatusOr<DagExport> dag = ExportDag(*reader, output, dag_options, progress);
       if (!dag.ok()) return app::Fail(tool, dag.status());
       app::Report report(common);
       report.Line("octree", {{"path", input.string()}, {"depth", reader->depth()}},
@@ -78,10 +89,19 @@ int main(int argc, char** argv) {
                    {"bits_per_voxel", bits}},
                   fmt::format("level {}: {} voxels, {} distinct nodes, {} bytes, {:.3f} bits/voxel",
                               exported, dag->voxels, dag->nodes, dag->file_bytes, bits));
-      if (dag->color_bytes != 0) {
-        report.Line(
-            "colors", {{"path", HashDagColorsPath(output).string()}, {"bytes", dag->color_bytes}},
-            fmt::format("{} ({} bytes)", HashDagColorsPath(output).string(), dag->color_bytes));
+      if (!dag->color_path.empty()) {
+        const double color_bits = 8.0 * static_cast<double>(dag->color_bytes) /
+                                  static_cast<double>(std::max<std::uint64_t>(dag->voxels, 1));
+        report.Line("colors",
+                    {{"path", dag->color_path.string()},
+                     {"bytes", dag->color_bytes},
+                     {"bits_per_voxel", color_bits},
+                     {"mean_error", dag->color_error.mean()},
+                     {"max_error", dag->color_error.max}},
+                    fmt::format("{} ({} bytes, {:.2f} bits/voxel; error {:.3f} mean, {:.3f} max "
+                                "8-bit sRGB codes)",
+                                dag->color_path.string(), dag->color_bytes, color_bits,
+                                dag->color_error.mean(), dag->color_error.max));
       }
       app::AddOutput(report, output, std::nullopt);
       report.Print();

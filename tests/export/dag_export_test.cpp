@@ -30,6 +30,22 @@ std::vector<std::uint64_t> LevelKeys(const SvoReader& reader, std::uint32_t leve
   return keys;
 }
 
+// SymVox's node array of `dag`, and its node count.
+std::vector<std::uint32_t> SvdagWords(VoxelDag dag, std::uint64_t& nodes) {
+  const SvdagLayout layout(dag);
+  nodes = layout.nodes();
+  std::vector<std::uint32_t> words;
+  EXPECT_TRUE(layout
+                  .Emit(dag,
+                        [&](std::span<const std::uint32_t> w) {
+                          words.insert(words.end(), w.begin(), w.end());
+                          return Status::Ok();
+                        })
+                  .ok());
+  EXPECT_EQ(words.size(), layout.words());
+  return words;
+}
+
 // HashDAG's node array of `dag`: its levels turned, one after another.
 std::vector<std::uint32_t> HashDagWords(VoxelDag dag, std::vector<std::uint64_t>& enclosed) {
   ToHashDagLayout(dag, 1, enclosed);
@@ -57,11 +73,12 @@ TEST(DagExport, SameDagAndFilesAtEveryMemoryLimitAndThreadCount) {
   StatusOr<VoxelDag> want = BuildDag(r, r.depth(), 0);
   ASSERT_TRUE(want.ok());
   const std::filesystem::path hashdag = Out("whole.dag.bin"), svdag = Out("whole.svdag");
-  ASSERT_TRUE(ExportDag(r, hashdag, r.depth(), 0).ok());
-  ASSERT_TRUE(ExportDag(r, svdag, r.depth(), 0).ok());
+  ASSERT_TRUE(ExportDag(r, hashdag, {r.depth(), 0}).ok());
+  ASSERT_TRUE(ExportDag(r, svdag, {r.depth(), 0}).ok());
   const std::vector<std::uint8_t> want_hashdag = test::ReadBytes(hashdag),
                                   want_colors = test::ReadBytes(HashDagColorsPath(hashdag)),
-                                  want_svdag = test::ReadBytes(svdag);
+                                  want_svdag = test::ReadBytes(svdag),
+                                  want_packed = test::ReadBytes(PackedColorsPath(svdag));
   // The DAG by itself within 4 MiB (one page in flight); with its colours, whose pages are
   // decoded whole, within 16 MiB.
   {
@@ -84,14 +101,19 @@ TEST(DagExport, SameDagAndFilesAtEveryMemoryLimitAndThreadCount) {
           << "level " << l << ", limit " << limit << ", threads " << threads;
     }
     const std::filesystem::path h = Out("limited.dag.bin"), s = Out("limited.svdag");
-    ASSERT_TRUE(ExportDag(r, h, r.depth(), limit).ok());
-    ASSERT_TRUE(ExportDag(r, s, r.depth(), limit).ok());
+    ASSERT_TRUE(ExportDag(r, h, {r.depth(), limit}).ok());
+    ASSERT_TRUE(ExportDag(r, s, {r.depth(), limit}).ok());
     EXPECT_TRUE(test::ReadBytes(h) == want_hashdag) << limit;
     EXPECT_TRUE(test::ReadBytes(HashDagColorsPath(h)) == want_colors) << limit;
     EXPECT_TRUE(test::ReadBytes(s) == want_svdag) << limit;
-    for (const auto& p : {h, HashDagColorsPath(h), s}) std::filesystem::remove(p);
+    EXPECT_TRUE(test::ReadBytes(PackedColorsPath(s)) == want_packed) << limit;
+    for (const auto& p : {h, HashDagColorsPath(h), s, PackedColorsPath(s)}) {
+      std::filesystem::remove(p);
+    }
   }
-  for (const auto& p : {hashdag, HashDagColorsPath(hashdag), svdag}) std::filesystem::remove(p);
+  for (const auto& p : {hashdag, HashDagColorsPath(hashdag), svdag, PackedColorsPath(svdag)}) {
+    std::filesystem::remove(p);
+  }
 }
 
 TEST(DagExport, NodeArraysOfTheSpecsExamples) {
@@ -136,15 +158,17 @@ TEST(DagExport, BadRequestsFailAndLeaveNoFile) {
     EXPECT_EQ(got.status().message().find('\n'), std::string::npos);
     EXPECT_FALSE(std::filesystem::exists(p));
     EXPECT_FALSE(std::filesystem::exists(HashDagColorsPath(hashdag)));
+    EXPECT_FALSE(std::filesystem::exists(PackedColorsPath(p)));
   };
-  expect_refused(ExportDag(r, svdag, 1, 0), svdag, "level 2 or deeper");
-  expect_refused(ExportDag(r, hashdag, 2, 0), hashdag, "level 3 or deeper");
-  expect_refused(ExportDag(r, hashdag, r.depth() + 1, 0), hashdag, "exceeds the octree's depth");
+  expect_refused(ExportDag(r, svdag, {1, 0}), svdag, "level 2 or deeper");
+  expect_refused(ExportDag(r, hashdag, {2, 0}), hashdag, "level 3 or deeper");
+  expect_refused(ExportDag(r, hashdag, {r.depth() + 1, 0}), hashdag, "exceeds the octree's depth");
   // One page's masks and subtree fit 1.75 MiB, the DAG (about 1 MiB with its tables) not what
   // is left.
-  expect_refused(ExportDag(r, svdag, r.depth(), std::uint64_t{7} << 18), svdag, "--memory-limit");
+  expect_refused(ExportDag(r, svdag, {r.depth(), std::uint64_t{7} << 18, DagColorFile::kNone}),
+                 svdag, "--memory-limit");
   // A limit below one page's: refused before anything is built.
-  expect_refused(ExportDag(r, hashdag, r.depth(), std::uint64_t{1} << 20), hashdag,
+  expect_refused(ExportDag(r, hashdag, {r.depth(), std::uint64_t{1} << 20}), hashdag,
                  "too small for this file");
 }
 

@@ -149,3 +149,39 @@ def svdag_voxels(dag):
     """The voxels of a SymVox file as (x, y, z) rows in depth-first order."""
     voxels, _ = _expand(dag.words, dag.levels, dag.levels - 1, True, _svdag_leaf_voxels)
     return voxels
+
+
+DAG_COLORS_MAGIC = b"\x89DGC\r\n\x1a\n"
+
+
+def read_packed_colors(path):
+    """svokit's packed colours (``x.dagcolors``): uint8 rows R, G, B, A (sRGB colour, linear
+    alpha) in the DAG's depth-first order, and the level they are of."""
+    import zstandard
+
+    from .container import Container
+
+    c = Container(path, DAG_COLORS_MAGIC, 1)
+    try:
+        head = c.payload("HEAD")
+        if len(head) != 20:
+            c.fail(f"HEAD of {len(head)} bytes")
+        count, block, level, _ = struct.unpack_from("<QIII", head, 0)
+        table = np.frombuffer(c.payload("BLKS"), np.dtype([("offset", "<u8"), ("size", "<u4"),
+                                                          ("count", "<u4")]))
+        data = c.payload("DATA")
+        if int(table["count"].sum()) != count or np.any(table["count"][:-1] != block):
+            c.fail(f"blocks of {list(table['count'][:3])}... colours for {count}")
+        out = np.empty((count, 4), np.uint8)
+        at = 0
+        for offset, size, n in table:
+            planes = zstandard.ZstdDecompressor().decompress(bytes(data[offset:offset + size]),
+                                                            max_output_size=4 * int(n))
+            if len(planes) != 4 * n:
+                c.fail(f"a block of {len(planes)} bytes for {n} colours")
+            deltas = np.frombuffer(planes, np.uint8).reshape(4, n)
+            out[at:at + n] = np.cumsum(deltas, axis=1, dtype=np.uint64).astype(np.uint8).T
+            at += n
+        return out, level
+    finally:
+        c.close()

@@ -106,7 +106,7 @@ class DagFiles(unittest.TestCase):
         bits = h.words[leaves].astype(np.uint64) | (h.words[leaves + 1].astype(np.uint64) << np.uint64(32))
         leaf_counts = np.array([bin(int(b)).count("1") for b in bits], np.int64)
         counts = counts_below(h.words, visits, leaf_counts)
-        if not f.has_color or f.brick_side == 0 or f.is_solid:
+        if not f.has_color or (f.brick_side == 0 and level < f.depth) or f.is_solid:
             self.assertFalse(colors_path.exists())
             return
         c = dag.read_hashdag_colors(colors_path)
@@ -136,6 +136,19 @@ class DagFiles(unittest.TestCase):
         self.assertEqual(as_set(voxels), want)
         self.assertEqual(len(voxels), len(want))
         self.assertTrue(np.all(s.words[0] & np.uint32(0xFFFFFF00) == 0))
+        # svokit's packed colours beside it, in the same depth-first order.
+        packed = path.with_suffix(".dagcolors")
+        if not f.has_color or (f.brick_side == 0 and level < f.depth) or f.is_solid:
+            self.assertFalse(packed.exists())
+            return
+        rgba, colors_level = dag.read_packed_colors(packed)
+        self.assertEqual(colors_level, level)
+        self.assertEqual(len(rgba), len(voxels))
+        if level == f.depth:
+            v = f.voxels()
+            index = np.searchsorted(v.keys, codecs.morton_encode(voxels))
+            want_rgb = codecs.srgb8(v.colors[index, :3])
+            self.assertLessEqual(int(np.abs(want_rgb.astype(np.int64) - rgba[:, :3]).max()), 1)
 
     def test_files_expand_to_the_octrees_voxels(self):
         for name, mesh, options, levels in CASES:

@@ -1,8 +1,11 @@
 #include "svokit/export/dag_files.hpp"
 
+#include <zstd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -16,6 +19,7 @@
 #include "svokit/export/dag_build.hpp"
 #include "svokit/export/export.hpp"
 #include "svokit/export/streamed_file.hpp"
+#include "svokit/formats/container/container.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
 
 namespace svokit {
@@ -49,6 +53,14 @@ std::string Lower(std::string s) {
   return s;
 }
 
+// `dag_path` with its .dag.bin or .svdag replaced by `suffix`.
+std::filesystem::path BesideDag(const std::filesystem::path& dag_path, std::string_view suffix) {
+  const std::string name = dag_path.filename().string();
+  const std::size_t tail = Lower(name).ends_with(".svdag") ? 6 : 8;
+  const std::string stem = name.size() > tail ? name.substr(0, name.size() - tail) : name;
+  return dag_path.parent_path() / (stem + std::string(suffix));
+}
+
 // The words before each level in a node array that keeps svokit's node sizes.
 std::vector<std::uint64_t> LevelBases(const VoxelDag& dag) {
   std::vector<std::uint64_t> base(dag.levels.size() + 1, 0);
@@ -57,54 +69,31 @@ std::vector<std::uint64_t> LevelBases(const VoxelDag& dag) {
   return base;
 }
 
-std::uint8_t SrgbByte(float linear) {
-  return static_cast<std::uint8_t>(std::lround(255.f * LinearToSrgb(std::clamp(linear, 0.f, 1.f))));
-}
-
-// RGBA8 of a linear colour: sRGB codes, alpha 255 (HashDAG's colours have none).
-std::uint32_t HashDagColor(const Rgba& c) {
-  return std::uint32_t{SrgbByte(c.r)} | std::uint32_t{SrgbByte(c.g)} << 8 |
-         std::uint32_t{SrgbByte(c.b)} << 16 | 0xff000000u;
-}
-
-// Appends the colours of one page's nodes (`keys`, colour(i)) in depth-first order: keys with x
-// and z exchanged, ascending.
+// One page's colours in depth-first order: keys with x and z exchanged, ascending.
+using DagColors = std::vector<std::pair<std::uint64_t, Rgba>>;
 template <class ColorOf>
-void PutColorsInOrder(std::span<const std::uint64_t> keys, const ColorOf& color,
-                      StreamedFile& out) {
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> colors(keys.size());
-  for (std::size_t i = 0; i < colors.size(); ++i) {
-    colors[i] = {MortonSwapXZ(keys[i]), HashDagColor(color(i))};
-  }
-  std::sort(colors.begin(), colors.end());
-  ByteWriter w;
-  for (const auto& [key, rgba] : colors) w.Put(rgba);
-  out.Put(w.bytes());
+DagColors InDagOrder(std::span<const std::uint64_t> keys, const ColorOf& color) {
+  DagColors colors(keys.size());
+  for (std::size_t i = 0; i < colors.size(); ++i) colors[i] = {MortonSwapXZ(keys[i]), color(i)};
+  std::sort(colors.begin(), colors.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  return colors;
 }
 
-// HashDAG's colour file: the header ToHashDagLayout's counts make, then one colour per node of
-// `level` in depth-first order, the pages in that order: the voxels' own colours, or a coarser
-// node's from its brick.
-Status WriteHashDagColors(const SvoReader& reader, std::uint32_t level, std::uint32_t top_levels,
-                          const std::vector<std::uint64_t>& enclosed, std::uint64_t memory_limit,
-                          StreamedFile& out, Progress::Stage* stage) {
-  ByteWriter head;
-  head.Put(top_levels);
-  head.Put(static_cast<std::uint64_t>(enclosed.size()));
-  head.PutArray(std::span(enclosed));
-  head.Put(reader.NodeCount(level));
-  out.Put(head.bytes());
+// The colours of the nodes of `level` in the DAG's depth-first order, a page at a time, the
+// pages in that order: the voxels' own colours, or a coarser node's from its brick.
+Status ForEachDagColors(const SvoReader& reader, std::uint32_t level, std::uint64_t memory_limit,
+                        Progress::Stage* stage,
+                        const std::function<Status(const DagColors&)>& take) {
   const SvoStreamOptions stream{.memory_limit = memory_limit,
                                 .order = SvoPageOrder::kKeysSwappedXZ};
   if (level == reader.depth()) {
     return ForEachVoxelPage(
         reader, level, stream,
         [&](SvoVoxelPage& page) {
-          PutColorsInOrder(
-              page.keys,
-              [&](std::size_t i) { return Rgba(page.colors[page.colors.size() == 1 ? 0 : i]); },
-              out);
-          return out.status();
+          return take(InDagOrder(page.keys, [&](std::size_t i) {
+            return Rgba(page.colors[page.colors.size() == 1 ? 0 : i]);
+          }));
         },
         stage);
   }
@@ -115,11 +104,123 @@ Status WriteHashDagColors(const SvoReader& reader, std::uint32_t level, std::uin
         VoxelSet part;
         part.keys.assign(nodes.keys.begin(), nodes.keys.end());
         FillNodeAttributes(nodes.bricks, side, true, false, part);
-        PutColorsInOrder(
-            nodes.keys, [&](std::size_t i) { return Rgba(part.color(i)); }, out);
-        return out.status();
+        return take(InDagOrder(nodes.keys, [&](std::size_t i) { return Rgba(part.color(i)); }));
       },
       stage);
+}
+
+// 8-bit codes of a linear colour: sRGB for colour, linear for alpha; `error` gets the distance of
+// each colour code from the exact value in codes (its rounding).
+std::array<std::uint8_t, 4> Rgba8(const Rgba& c, DagColorError& error) {
+  std::array<std::uint8_t, 4> out;
+  const float exact[4] = {255.f * LinearToSrgb(std::clamp(c.r, 0.f, 1.f)),
+                          255.f * LinearToSrgb(std::clamp(c.g, 0.f, 1.f)),
+                          255.f * LinearToSrgb(std::clamp(c.b, 0.f, 1.f)),
+                          255.f * std::clamp(c.a, 0.f, 1.f)};
+  for (int k = 0; k < 4; ++k) {
+    out[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(std::lround(exact[k]));
+    if (k < 3) {
+      const double e = std::abs(exact[k] - out[static_cast<std::size_t>(k)]);
+      error.sum += e;
+      error.max = std::max(error.max, e);
+    }
+  }
+  error.channels += 3;
+  return out;
+}
+
+// HashDAG's colour file: the header ToHashDagLayout's counts make, then one colour per node of
+// `level` in depth-first order, alpha 255 (its colours have none).
+Status WriteHashDagColors(const SvoReader& reader, std::uint32_t level, std::uint32_t top_levels,
+                          const std::vector<std::uint64_t>& enclosed, std::uint64_t memory_limit,
+                          StreamedFile& out, Progress::Stage* stage, DagColorError& error) {
+  ByteWriter head;
+  head.Put(top_levels);
+  head.Put(static_cast<std::uint64_t>(enclosed.size()));
+  head.PutArray(std::span(enclosed));
+  head.Put(reader.NodeCount(level));
+  out.Put(head.bytes());
+  return ForEachDagColors(reader, level, memory_limit, stage, [&](const DagColors& colors) {
+    ByteWriter w;
+    for (const auto& [key, linear] : colors) {
+      std::array<std::uint8_t, 4> c = Rgba8(linear, error);
+      c[3] = 255;
+      w.Put(c);
+    }
+    out.Put(w.bytes());
+    return out.status();
+  });
+}
+
+// svokit's packed colours (formats/dag.md, "Packed colours"): blocks of kDagColorBlock colours in
+// depth-first order, each four planes (R, G, B, A) delta-coded and compressed with zstd.
+Status WritePackedColors(const SvoReader& reader, std::uint32_t level, std::uint64_t memory_limit,
+                         const std::filesystem::path& path, Progress::Stage* stage,
+                         DagColorError& error, std::uint64_t& bytes) {
+  struct Block {
+    std::uint64_t offset = 0;
+    std::uint32_t size = 0, count = 0;
+  };
+  std::vector<Block> blocks;
+  container::Writer writer(kDagColorsFormat, 0);
+  ByteWriter head;
+  head.Put(reader.NodeCount(level));
+  head.Put(kDagColorBlock);
+  head.Put(level);
+  head.Put(std::uint32_t{0});
+  writer.AddSection(container::MakeTag("HEAD"), std::move(head.bytes()));
+  writer.AddSectionProduced(container::MakeTag("DATA"), [&](const container::Writer::Emit& emit) {
+    std::vector<std::uint8_t> planes, packed;
+    std::uint64_t offset = 0;
+    std::uint32_t count = 0;
+    std::array<std::vector<std::uint8_t>, 4> block;
+    ZSTD_CCtx* cctx = ZSTD_createCCtx();
+    const auto flush = [&]() -> Status {
+      if (count == 0) return Status::Ok();
+      planes.clear();
+      for (const std::vector<std::uint8_t>& plane : block) {
+        std::uint8_t previous = 0;
+        for (const std::uint8_t v : plane) {
+          planes.push_back(static_cast<std::uint8_t>(v - previous));
+          previous = v;
+        }
+      }
+      packed.resize(ZSTD_compressBound(planes.size()));
+      const std::size_t n =
+          ZSTD_compressCCtx(cctx, packed.data(), packed.size(), planes.data(), planes.size(), 9);
+      if (ZSTD_isError(n)) return Status::Internal("zstd: {}", ZSTD_getErrorName(n));
+      blocks.push_back({offset, static_cast<std::uint32_t>(n), count});
+      offset += n;
+      count = 0;
+      for (std::vector<std::uint8_t>& plane : block) plane.clear();
+      return emit(std::span(packed.data(), n));
+    };
+    const Status status =
+        ForEachDagColors(reader, level, memory_limit, stage, [&](const DagColors& colors) {
+          for (const auto& [key, linear] : colors) {
+            const std::array<std::uint8_t, 4> c = Rgba8(linear, error);
+            for (std::size_t k = 0; k < 4; ++k) block[k].push_back(c[k]);
+            if (++count == kDagColorBlock) SVOKIT_RETURN_IF_ERROR(flush());
+          }
+          return Status::Ok();
+        });
+    const Status last = status.ok() ? flush() : status;
+    ZSTD_freeCCtx(cctx);
+    return last;
+  });
+  writer.AddSectionProduced(container::MakeTag("BLKS"), [&](const container::Writer::Emit& emit) {
+    ByteWriter table;
+    for (const Block& b : blocks) {
+      table.Put(b.offset);
+      table.Put(b.size);
+      table.Put(b.count);
+    }
+    return emit(table.bytes());
+  });
+  SVOKIT_RETURN_IF_ERROR(writer.WriteFile(path));
+  std::error_code ec;
+  bytes = std::filesystem::file_size(path, ec);
+  return Status::Ok();
 }
 
 }  // namespace
@@ -134,9 +235,7 @@ bool IsDagPath(const std::filesystem::path& path) {
 }
 
 std::filesystem::path HashDagColorsPath(const std::filesystem::path& dag_path) {
-  std::string name = dag_path.filename().string();
-  name.resize(name.size() - std::string_view(".dag.bin").size());
-  return dag_path.parent_path() / (name + ".uncompressed_colors.bin");
+  return BesideDag(dag_path, ".uncompressed_colors.bin");
 }
 
 void ToHashDagLayout(VoxelDag& dag, std::uint32_t top_levels,
@@ -186,75 +285,100 @@ void ToHashDagLayout(VoxelDag& dag, std::uint32_t top_levels,
   }
 }
 
-std::vector<std::uint32_t> SvdagWords(const VoxelDag& dag, std::uint64_t& nodes) {
+SvdagLayout::SvdagLayout(const VoxelDag& dag) : base_(LevelBases(dag)) {
   const std::uint32_t leaf = dag.leaf_level();
   const DagLevel& leaves = dag.levels[leaf];
-  // svokit's 4³ leaves become inner nodes over 2³ leaves, which are told apart by their byte
-  // (at most 255), numbered as they are first met in the order they are written.
-  std::vector<std::uint64_t> base = LevelBases(dag);
-  std::vector<std::uint32_t> leaf_offset(leaves.words.size() / 2);
-  std::array<std::int32_t, 256> byte_leaf;
-  byte_leaf.fill(-1);
-  std::vector<std::uint32_t> byte_leaves;
+  leaf_offset_.resize(leaves.words.size() / 2);
+  byte_leaf_.fill(-1);
   std::uint64_t words = 0;
-  for (std::size_t i = 0; i < leaf_offset.size(); ++i) {
+  for (std::size_t i = 0; i < leaf_offset_.size(); ++i) {
     const std::uint64_t bits = DagLeafMask(leaves, static_cast<std::uint32_t>(2 * i));
-    leaf_offset[i] = static_cast<std::uint32_t>(words);
+    leaf_offset_[i] = static_cast<std::uint32_t>(words);
     ++words;
     for (unsigned h = 8; h-- > 0;) {
       const std::uint8_t b = kSwappedMask[LeafByte(bits, SwapXZ(h))];
       if (b == 0) continue;
       ++words;
-      if (byte_leaf[b] < 0) {
-        byte_leaf[b] = static_cast<std::int32_t>(byte_leaves.size());
-        byte_leaves.push_back(b);
+      if (byte_leaf_[b] < 0) {
+        byte_leaf_[b] = static_cast<std::int32_t>(byte_leaves_.size());
+        byte_leaves_.push_back(b);
       }
     }
   }
-  base[leaf + 1] = base[leaf] + words;
-  nodes = leaf_offset.size() + byte_leaves.size();
-  for (std::uint32_t l = 0; l < leaf; ++l) nodes += dag.levels[l].nodes;
+  base_[leaf + 1] = base_[leaf] + words;
+  nodes_ = leaf_offset_.size() + byte_leaves_.size();
+  for (std::uint32_t l = 0; l < leaf; ++l) nodes_ += dag.levels[l].nodes;
+  words_ = base_[leaf + 1] + byte_leaves_.size();
+}
 
+Status SvdagLayout::Emit(VoxelDag& dag,
+                         const std::function<Status(std::span<const std::uint32_t>)>& emit) const {
+  const std::uint32_t leaf = dag.leaf_level();
   std::vector<std::uint32_t> out;
-  out.reserve(base[leaf + 1] + byte_leaves.size());
+  const auto put = [&](std::uint32_t word) -> Status {
+    out.push_back(word);
+    if (out.size() < (1u << 20)) return Status::Ok();
+    const Status s = emit(out);
+    out.clear();
+    return s;
+  };
   for (std::uint32_t l = 0; l < leaf; ++l) {
     const std::vector<std::uint32_t>& level = dag.levels[l].words;
     for (std::size_t offset = 0; offset < level.size();) {
       const unsigned mask = level[offset], turned = kSwappedMask[mask];
-      out.push_back(turned);
+      SVOKIT_RETURN_IF_ERROR(put(turned));
       for (unsigned h = 8; h-- > 0;) {  // pointers from child 7 down to child 0
         if (!(turned >> h & 1u)) continue;
         const std::uint32_t child = level[offset + 1 + RankInByte(mask, SwapXZ(h))];
-        const std::uint64_t at = l + 1 == leaf ? leaf_offset[child / 2] : child;
-        out.push_back(static_cast<std::uint32_t>(base[l + 1] + at));
+        const std::uint64_t at = l + 1 == leaf ? leaf_offset_[child / 2] : child;
+        SVOKIT_RETURN_IF_ERROR(put(static_cast<std::uint32_t>(base_[l + 1] + at)));
       }
       offset += 1 + CountBits8(mask);
     }
+    dag.levels[l] = DagLevel{};
   }
-  for (std::size_t i = 0; i < leaf_offset.size(); ++i) {
+  const DagLevel& leaves = dag.levels[leaf];
+  for (std::size_t i = 0; i < leaf_offset_.size(); ++i) {
     const std::uint64_t bits = DagLeafMask(leaves, static_cast<std::uint32_t>(2 * i));
     unsigned turned = 0;
     for (unsigned c = 0; c < 8; ++c) turned |= LeafByte(bits, c) != 0 ? 1u << SwapXZ(c) : 0u;
-    out.push_back(turned);
+    SVOKIT_RETURN_IF_ERROR(put(turned));
     for (unsigned h = 8; h-- > 0;) {
       const std::uint8_t b = kSwappedMask[LeafByte(bits, SwapXZ(h))];
-      if (b != 0) out.push_back(static_cast<std::uint32_t>(base[leaf + 1] + byte_leaf[b]));
+      if (b != 0) {
+        SVOKIT_RETURN_IF_ERROR(put(static_cast<std::uint32_t>(base_[leaf + 1] + byte_leaf_[b])));
+      }
     }
   }
-  out.insert(out.end(), byte_leaves.begin(), byte_leaves.end());
-  return out;
+  dag.levels[leaf] = DagLevel{};
+  for (const std::uint32_t b : byte_leaves_) SVOKIT_RETURN_IF_ERROR(put(b));
+  return out.empty() ? Status::Ok() : emit(out);
+}
+
+std::filesystem::path PackedColorsPath(const std::filesystem::path& dag_path) {
+  return BesideDag(dag_path, ".dagcolors");
 }
 
 StatusOr<DagExport> ExportDag(const SvoReader& reader, const std::filesystem::path& path,
-                              std::uint32_t level, std::uint64_t memory_limit, Progress& progress) {
-  const std::string name = Lower(path.filename().string());
-  const bool hashdag = !name.ends_with(".svdag");
+                              const DagExportOptions& options, Progress& progress) {
+  const std::uint32_t level = options.level;
+  const std::uint64_t memory_limit = options.memory_limit;
+  const bool hashdag = !Lower(path.filename().string()).ends_with(".svdag");
   if (hashdag && level < 3) {  // its root is an inner node, its leaves 4³ below
     return Status::BadInput("{}: a HashDAG file needs level 3 or deeper", path.string());
   }
+  SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, level));
   const SvoShape& shape = reader.shape();
-  const bool colors = hashdag && shape.has_color && shape.brick_side != 0 && !shape.solid;
-  if (colors) {  // the colours' pages are decoded whole: refused before the DAG is built
+  DagColorFile colors = options.colors;
+  if (colors == DagColorFile::kDefault)
+    colors = hashdag ? DagColorFile::kHashDag : DagColorFile::kPacked;
+  const bool has_colors =
+      shape.has_color && (level == reader.depth() || shape.brick_side != 0) && !shape.solid;
+  if (!has_colors) colors = DagColorFile::kNone;
+  if (colors == DagColorFile::kHashDag && !hashdag) {
+    return Status::BadInput("{}: HashDAG's colour file goes beside a .dag.bin", path.string());
+  }
+  if (colors != DagColorFile::kNone) {  // the colours' pages are decoded whole: refused first
     StatusOr<SvoStreamPlan> plan = PlanStream(reader, {.memory_limit = memory_limit});
     if (!plan.ok()) return plan.status();
   }
@@ -288,61 +412,66 @@ StatusOr<DagExport> ExportDag(const SvoReader& reader, const std::filesystem::pa
 
   StreamedFile file(path);
   ByteWriter head;
-  if (!hashdag) {
-    std::uint64_t nodes = 0;
-    const std::vector<std::uint32_t> words = SvdagWords(*dag, nodes);
+  std::uint32_t top_levels = 0;
+  std::vector<std::uint64_t> enclosed;
+  if (hashdag) {
+    // Below level `levels` − 7 a node holds at most 2²¹ voxels, so its count fits its 24 bits.
+    top_levels = level > 8 ? level - 7 : 1;
+    ToHashDagLayout(*dag, top_levels, enclosed);
+    if (enclosed.size() >= (1u << 24)) {
+      return Status::BadInput("{}: the DAG has {} nodes above level {}, more than HashDAG's 2^24",
+                              path.string(), enclosed.size(), top_levels);
+    }
+    for (const double v : min) head.Put(v);
+    for (const double v : max) head.Put(v);
+    head.Put(level);
+    head.Put(dag->WordCount());
+    file.Put(head.bytes());
+    for (DagLevel& l : dag->levels) {
+      put_words(file, l.words);
+      l = DagLevel{};
+    }
+  } else {
+    const SvdagLayout layout(*dag);
     for (const double v : min) head.Put(static_cast<float>(v));
     for (const double v : max) head.Put(static_cast<float>(v));
     head.Put(static_cast<float>(side));
     head.Put(level);
-    head.Put(static_cast<std::uint32_t>(nodes));
-    head.Put(static_cast<std::uint32_t>(words.size()));  // firstLeafPtr, as SymVox writes it
-    head.Put(static_cast<std::uint32_t>(words.size()));
+    head.Put(static_cast<std::uint32_t>(layout.nodes()));
+    head.Put(static_cast<std::uint32_t>(layout.words()));  // firstLeafPtr, as SymVox writes it
+    head.Put(static_cast<std::uint32_t>(layout.words()));
     file.Put(head.bytes());
-    put_words(file, words);
-    SVOKIT_RETURN_IF_ERROR(file.Commit());
-    report.file_bytes = file.bytes_written();
-    return report;
-  }
-
-  // Below level `levels` − 7 a node holds at most 2²¹ voxels, so its count fits its 24 bits.
-  const std::uint32_t top_levels = level > 8 ? level - 7 : 1;
-  std::vector<std::uint64_t> enclosed;
-  ToHashDagLayout(*dag, top_levels, enclosed);
-  if (enclosed.size() >= (1u << 24)) {
-    return Status::BadInput("{}: the DAG has {} nodes above level {}, more than HashDAG's 2^24",
-                            path.string(), enclosed.size(), top_levels);
-  }
-  for (const double v : min) head.Put(v);
-  for (const double v : max) head.Put(v);
-  head.Put(level);
-  head.Put(dag->WordCount());
-  file.Put(head.bytes());
-  for (DagLevel& l : dag->levels) {
-    put_words(file, l.words);
-    l = DagLevel{};
+    SVOKIT_RETURN_IF_ERROR(layout.Emit(*dag, [&](std::span<const std::uint32_t> words) {
+      put_words(file, words);
+      return file.status();
+    }));
   }
   SVOKIT_RETURN_IF_ERROR(file.status());
-  if (!colors) {
-    SVOKIT_RETURN_IF_ERROR(file.Commit());
-    report.file_bytes = file.bytes_written();
-    return report;
+
+  // The colours, committed before the DAG, which is the file that says the export is whole.
+  if (colors != DagColorFile::kNone) {
+    Progress::Stage stage(progress, "colors", 0);
+    Status written;
+    if (colors == DagColorFile::kHashDag) {
+      report.color_path = HashDagColorsPath(path);
+      StreamedFile color_file(report.color_path);
+      written = WriteHashDagColors(reader, level, top_levels, enclosed, memory_limit, color_file,
+                                   &stage, report.color_error);
+      if (written.ok()) written = color_file.Commit();
+      report.color_bytes = color_file.bytes_written();
+    } else {
+      report.color_path = PackedColorsPath(path);
+      written = WritePackedColors(reader, level, memory_limit, report.color_path, &stage,
+                                  report.color_error, report.color_bytes);
+    }
+    if (!written.ok()) {
+      stage.Cancel();
+      return written;
+    }
   }
-  const std::filesystem::path colors_path = HashDagColorsPath(path);
-  StreamedFile color_file(colors_path);
-  SVOKIT_RETURN_IF_ERROR(color_file.status());
-  Progress::Stage color_stage(progress, "colors", 0);
-  if (const Status written = WriteHashDagColors(reader, level, top_levels, enclosed, memory_limit,
-                                                color_file, &color_stage);
-      !written.ok()) {
-    color_stage.Cancel();
-    return written;
-  }
-  SVOKIT_RETURN_IF_ERROR(color_file.Commit());
-  report.color_bytes = color_file.bytes_written();
   if (const Status committed = file.Commit(); !committed.ok()) {
     std::error_code ec;
-    std::filesystem::remove(colors_path, ec);
+    if (!report.color_path.empty()) std::filesystem::remove(report.color_path, ec);
     return committed;
   }
   report.file_bytes = file.bytes_written();

@@ -355,7 +355,7 @@ Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path
   }
   StatusOr<std::string> ext = CheckExport(path);
   if (!ext.ok()) return ext.status();
-  if (IsDagPath(path)) return ExportDag(reader, path, level, memory_limit).status();
+  if (IsDagPath(path)) return ExportDag(reader, path, {level, memory_limit}).status();
   if (!ExportStreams(reader, path)) {
     return Status::BadInput("{}: a .vox or a solid's export takes the octree whole", path.string());
   }
