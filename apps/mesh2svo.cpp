@@ -38,6 +38,17 @@ void PrintSummary(const MeshToSvoRequest& request, const MeshToSvoReport& report
   const OctreeReport& octree = report.octree;
   app::AddMeshAndGrid(out, request.input.string(), report.triangles, report.orientation,
                       report.grid, true);
+  if (report.dag) {  // the octree was a scratch file on the way
+    out.Line("voxels", {{"count", octree.voxels}, {"mode", mode}},
+             fmt::format("{} ({})", octree.voxels, mode));
+    if (octree.interior) app::AddInterior(out, *octree.interior);
+    app::AddDagSummary(out, *report.dag);
+    app::AddTimes(out, progress);
+    out.Line("warnings", warnings, fmt::format("{}", warnings));
+    app::AddOutput(out, request.output, report.dag->file_bytes);
+    out.Print();
+    return;
+  }
   if (octree.memory.by_pages()) {
     out.Line("build", {{"by_pages", true}, {"within", octree.memory.WithinText()}},
              fmt::format("by pages {}", octree.memory.WithinText()));
@@ -70,7 +81,11 @@ int main(int argc, char** argv) {
   app::AddFile(cli, "input", request.input,
                "Mesh (.obj, .ply, .off, .stl, .gltf, .glb, .drc, .svm)")
       ->required();
-  app::AddFile(cli, "-o,--output", request.output, "Output .svo")->required();
+  app::AddFile(cli, "-o,--output", request.output,
+               "Output .svo, or a sparse voxel DAG of the geometry and voxel colours: HashDAG "
+               ".dag.bin (colours in .uncompressed_colors.bin beside it), SymVox .svdag or "
+               ".ssvdag (colours in .dagcolors), as svo-export writes them")
+      ->required();
   voxelize.Add(cli);
   build.Add(cli);
   memory_limit.Add(cli,

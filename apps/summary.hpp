@@ -15,6 +15,7 @@
 #include "apps/cli.hpp"
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
+#include "svokit/export/dag_files.hpp"
 #include "svokit/formats/svo/section_key.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
@@ -158,6 +159,40 @@ inline void AddTimes(Report& report, const Progress& progress) {
   }
   seconds["total"] = total;
   report.Line("time", seconds, fmt::format("{}total {:.2f} s", times, total));
+}
+
+/// The report's lines of a DAG written (svo-export, mesh2svo): its size per voxel of the level,
+/// distinct nodes per level, and its colour file with the colours' loss.
+inline void AddDagSummary(Report& report, const DagExport& dag) {
+  const auto bits = [&](std::uint64_t bytes) {
+    return 8.0 * static_cast<double>(bytes) /
+           static_cast<double>(std::max<std::uint64_t>(dag.voxels, 1));
+  };
+  report.Line("dag",
+              {{"level", dag.levels},
+               {"voxels", dag.voxels},
+               {"nodes", dag.nodes},
+               {"level_nodes", dag.level_nodes},
+               {"symmetric_nodes", dag.symmetric_nodes},
+               {"bytes", dag.file_bytes},
+               {"bits_per_voxel", bits(dag.file_bytes)}},
+              fmt::format("level {}: {} voxels, {} distinct nodes{}, {} bytes, {:.3f} bits/voxel",
+                          dag.levels, dag.voxels, dag.nodes,
+                          dag.symmetric_nodes == 0
+                              ? ""
+                              : fmt::format(" ({} up to reflection)", dag.symmetric_nodes),
+                          dag.file_bytes, bits(dag.file_bytes)));
+  if (dag.color_path.empty()) return;
+  report.Line("colors",
+              {{"path", dag.color_path.string()},
+               {"bytes", dag.color_bytes},
+               {"bits_per_voxel", bits(dag.color_bytes)},
+               {"mean_error", dag.color_error.mean()},
+               {"max_error", dag.color_error.max}},
+              fmt::format("{} ({} bytes, {:.2f} bits/voxel; error {:.3f} mean, {:.3f} max 8-bit "
+                          "sRGB codes)",
+                          dag.color_path.string(), dag.color_bytes, bits(dag.color_bytes),
+                          dag.color_error.mean(), dag.color_error.max));
 }
 
 /// The report's line of the output file and its size.

@@ -22,15 +22,17 @@ int main(int argc, char** argv) {
       "Exports a sparse voxel octree's voxels (or the nodes of a coarser level) as OpenVDB grids "
       "(.vdb), NanoVDB grids (.nvdb: density, colour, AO), binvox, MagicaVoxel (.vox), PLY "
       "points, xyz text, a voxel mesh (.obj with a palette .mtl, .glb) or a sparse voxel DAG "
-      "(HashDAG .dag.bin with its colours beside, SymVox .svdag), by the output's extension.",
+      "(HashDAG .dag.bin with its colours beside, SymVox .svdag and symmetry-aware .ssvdag), by "
+      "the output's extension.",
       tool};
   std::filesystem::path input, output;
   std::optional<std::uint32_t> level;
   app::CommonOptions common;
   app::MemoryLimitOption memory_limit;
   app::AddFile(cli, "input", input, "Octree (.svo from svo-build or mesh2svo)")->required();
-  app::AddFile(cli, "-o,--output", output,
-               "Output: .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb, .dag.bin or .svdag")
+  app::AddFile(
+      cli, "-o,--output", output,
+      "Output: .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb, .dag.bin, .svdag or .ssvdag")
       ->required();
   cli.add_option("--level", level,
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
@@ -40,7 +42,7 @@ int main(int argc, char** argv) {
   cli.add_option("--colors", dag_colors,
                  "DAGs: the colour file beside it: hashdag (HashDAG's uncompressed_colors.bin, "
                  "the default beside a .dag.bin), packed (svokit's .dagcolors, zstd-compressed, "
-                 "the default beside a .svdag) or none")
+                 "the default beside a .svdag or .ssvdag) or none")
       ->check(CLI::IsMember({"default", "hashdag", "packed", "none"}))
       ->option_text("FILE");
   bool no_merge = false;
@@ -78,31 +80,7 @@ int main(int argc, char** argv) {
       app::Report report(common);
       report.Line("octree", {{"path", input.string()}, {"depth", reader->depth()}},
                   fmt::format("{} (depth {})", input.string(), reader->depth()));
-      const double bits = 8.0 * static_cast<double>(dag->file_bytes) /
-                          static_cast<double>(std::max<std::uint64_t>(dag->voxels, 1));
-      report.Line("dag",
-                  {{"level", exported},
-                   {"voxels", dag->voxels},
-                   {"nodes", dag->nodes},
-                   {"level_nodes", dag->level_nodes},
-                   {"bytes", dag->file_bytes},
-                   {"bits_per_voxel", bits}},
-                  fmt::format("level {}: {} voxels, {} distinct nodes, {} bytes, {:.3f} bits/voxel",
-                              exported, dag->voxels, dag->nodes, dag->file_bytes, bits));
-      if (!dag->color_path.empty()) {
-        const double color_bits = 8.0 * static_cast<double>(dag->color_bytes) /
-                                  static_cast<double>(std::max<std::uint64_t>(dag->voxels, 1));
-        report.Line("colors",
-                    {{"path", dag->color_path.string()},
-                     {"bytes", dag->color_bytes},
-                     {"bits_per_voxel", color_bits},
-                     {"mean_error", dag->color_error.mean()},
-                     {"max_error", dag->color_error.max}},
-                    fmt::format("{} ({} bytes, {:.2f} bits/voxel; error {:.3f} mean, {:.3f} max "
-                                "8-bit sRGB codes)",
-                                dag->color_path.string(), dag->color_bytes, color_bits,
-                                dag->color_error.mean(), dag->color_error.max));
-      }
+      app::AddDagSummary(report, *dag);
       app::AddOutput(report, output, std::nullopt);
       report.Print();
       return 0;

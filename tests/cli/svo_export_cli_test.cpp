@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "svokit/formats/vfrag/vfrag.hpp"
 #include "tests/cli/run_tool.hpp"
 
@@ -91,6 +93,57 @@ TEST(SvoExportCli, CoarserLevelsAndAnyThreadCount) {
   }
 }
 
+// The files in `dir`, by name.
+std::set<std::string> FilesIn(const std::filesystem::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    names.insert(e.path().filename().string());
+  }
+  return names;
+}
+
+TEST(SvoExportCli, DagsFromTheOctreeAndStraightFromTheMesh) {
+  TempDir out;
+  const std::string mesh = (DataDir() / "uv-torus.obj").string();
+  const std::string svo = (out / "torus.svo").string();
+  ASSERT_EQ(RunTool("mesh2svo", {mesh, "-r", "96", "-o", svo, "-q"}).exit_code, 0);
+  for (const auto& [ext, colors] :
+       {std::pair<std::string, std::string>{"dag.bin", "uncompressed_colors.bin"},
+        {"svdag", "dagcolors"}}) {
+    const std::string exported = (out / ("exported." + ext)).string();
+    const ToolResult r = RunTool("svo-export", {svo, "-o", exported, "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* key : {"\"bits_per_voxel\"", "\"level_nodes\"", "\"mean_error\""}) {
+      EXPECT_NE(r.out.find(key), std::string::npos) << key << " in " << r.out;
+    }
+    // mesh2svo builds its scratch octree whole or by pages, on any thread count: the same files.
+    for (const std::vector<std::string>& more :
+         {std::vector<std::string>{}, {"--memory-limit", "48M", "--threads", "1"}}) {
+      std::vector<std::string> args = {mesh, "-r", "96", "-o", (out / ("direct." + ext)).string(),
+                                       "-q"};
+      args.insert(args.end(), more.begin(), more.end());
+      const ToolResult m = RunTool("mesh2svo", args);
+      ASSERT_EQ(m.exit_code, 0) << m.err;
+      EXPECT_EQ(ReadText(out / ("direct." + ext)), ReadText(exported)) << ext;
+      EXPECT_EQ(ReadText(out / ("direct." + colors)), ReadText(out / ("exported." + colors)))
+          << colors;
+    }
+  }
+  // Nothing but the outputs: the scratch octrees are gone.
+  EXPECT_EQ(FilesIn(out.path()),
+            (std::set<std::string>{
+                "torus.svo", "exported.dag.bin", "exported.uncompressed_colors.bin",
+                "exported.svdag", "exported.dagcolors", "direct.dag.bin",
+                "direct.uncompressed_colors.bin", "direct.svdag", "direct.dagcolors"}));
+  // A DAG is made whole, not by parts.
+  TempDir parts;
+  const ToolResult p = RunTool(
+      "mesh2svo", {mesh, "-r", "96", "-o", (parts / "x.dag.bin").string(), "--pages", "0/2", "-q"});
+  EXPECT_EQ(p.exit_code, 2) << p.err;
+  EXPECT_NE(p.err.find("svo-merge"), std::string::npos) << p.err;
+  EXPECT_TRUE(FilesIn(parts.path()).empty());
+}
+
 TEST(SvoExportCli, BadInputIsOneLineExitTwoAndNoOutput) {
   const std::string svo = (Chain() / "torus.svo").string();
   TempDir inputs;
@@ -107,7 +160,13 @@ TEST(SvoExportCli, BadInputIsOneLineExitTwoAndNoOutput) {
       {{corrupt, "-o", "{dir}/out.vox"}, "corrupt.svo"},
       {{garbage, "-o", "{dir}/out.xyz"}, "garbage.svo"},
       {{svo, "-o", "{dir}/out.stl"},
-       "output must be a .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb file"},
+       "output must be a .vdb, .nvdb, .binvox, .vox, .ply, .xyz, .obj, .glb, .svdag, .ssvdag, "
+       ".dag.bin file"},
+      {{svo, "-o", "{dir}/out.svdag", "--level", "1"}, "level 2 or deeper"},
+      {{svo, "-o", "{dir}/out.dag.bin", "--level", "2"}, "HashDAG file needs level 3 or deeper"},
+      {{svo, "-o", "{dir}/out.ssvdag", "--level", "2"}, ".ssvdag file needs level 3 or deeper"},
+      {{svo, "-o", "{dir}/out.svdag", "--colors", "hashdag"}, "goes beside a .dag.bin"},
+      {{svo, "-o", "{dir}/out.svdag", "--colors", "rgb"}, "--colors"},
       {{svo, "-o", "{dir}/out"}, "output must be a .vdb"},
       {{svo, "-o", "{dir}/out.vdb", "--level", "7"},
        "torus.svo: level 7 exceeds the octree's depth 6"},

@@ -148,6 +148,31 @@ TEST(DagExport, NodeArraysOfTheSpecsExamples) {
   EXPECT_EQ(nodes, 3u);
 }
 
+TEST(DagExport, SsvdagOfTheSpecsExamples) {
+  // Voxels (1, 0, 0) and (6, 0, 0) of an 8³ grid: one leaf, the second seen through mirror x
+  // (pointer bit 13) from SymVox's child 4; pointers from child 7 down (formats/dag.md).
+  VoxelDag pair;
+  pair.depth = 3;
+  pair.levels.resize(2);
+  pair.levels[0] = {{0x1u | 0x2u, 0u, 2u}, 1};  // svokit children 0 and 1 (x = 0, x = 1)
+  pair.levels[1] = {{1u << 1, 0u,               // (1, 0, 0): x bit 0 of octant 0
+                     1u << 8, 0u},              // (6, 0, 0) = (2, 0, 0) in octant 1: bit 8
+                    2};
+  StatusOr<SymmetricDag> symmetric = ReduceSymmetries(pair);
+  ASSERT_TRUE(symmetric.ok());
+  std::uint64_t nodes = 0;
+  StatusOr<std::vector<std::uint8_t>> got = SsvdagBody(*symmetric, nodes);
+  ASSERT_TRUE(got.ok());
+  const std::vector<std::uint8_t> want = {
+      3,    0,    0,    0,                  // 3 inner u16
+      0x01, 0x01, 0x00, 0x20, 0, 0,         // header 0x0101, child 4 → leaf 0 mirrored x, child 0
+      8,    0,    0,    0,                  // 8 leaf bytes
+      0,    0,    1,    0,    0, 0, 0, 0,   // bit 16: (1, 0, 0)
+      1,    0,    0,    0,    0, 0, 0, 0};  // one inner level, at 0
+  EXPECT_EQ(*got, want);
+  EXPECT_EQ(nodes, 1u);
+}
+
 TEST(DagExport, BadRequestsFailAndLeaveNoFile) {
   const SvoReader r = test::OpenPagedTorus();
   const std::filesystem::path svdag = Out("bad.svdag"), hashdag = Out("bad.dag.bin");

@@ -13,6 +13,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/mesh_import.hpp"
 #include "svokit/svo/mask_tree.hpp"
+#include "svokit/svo/symmetric_dag.hpp"
 #include "svokit/voxelize/voxelize.hpp"
 #include "tests/test_util.hpp"
 
@@ -172,26 +173,101 @@ TEST(VoxelDag, FullLeavesGiveTheDagOfTheirVoxels) {
   }
 }
 
-TEST(VoxelDag, RealMeshPagesGiveTheWholeDag) {
+// CGAL's bunny voxelized at 256³ (depth 8), or empty when its file is missing (the test skips).
+std::vector<std::uint64_t> BunnyKeys() {
   const std::filesystem::path path = test::CgalMeshes() / "bunny00.off";
   if (!std::filesystem::exists(path)) {
-    if (test::TestDataRequired()) FAIL() << "missing " << path;
-    GTEST_SKIP() << "missing " << path;
+    EXPECT_FALSE(test::TestDataRequired()) << "missing " << path;
+    return {};
   }
   StatusOr<Mesh> mesh = ImportMesh(path);
-  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(mesh.ok()) << mesh.status().message();
   auto grid = GridTransform::FitResolution(mesh->Bounds(), 256);
-  ASSERT_TRUE(grid.ok());
   auto voxels = Voxelize(*mesh, *grid, VoxelizeOptions{});
-  ASSERT_TRUE(voxels.ok()) << voxels.status().message();
+  EXPECT_TRUE(voxels.ok()) << voxels.status().message();
+  return {voxels->keys.begin(), voxels->keys.end()};
+}
+
+TEST(VoxelDag, RealMeshPagesGiveTheWholeDag) {
+  const std::vector<std::uint64_t> keys = BunnyKeys();
+  if (keys.empty()) GTEST_SKIP() << "no bunny00.off";
   const std::uint32_t depth = 8;
-  const std::vector<std::uint64_t> keys(voxels->keys.begin(), voxels->keys.end());
   const VoxelDag whole = WholeDag(TreeOf(keys, depth), depth);
   EXPECT_EQ(DagVoxelKeys(whole), keys);
   ExpectSameDag(PagedDag(keys, depth, 3), whole, "pages at level 3");
   // Even at 256³ a curved surface repeats a third of its 4³ blocks (8 235 of 13 959 distinct).
   EXPECT_LT(whole.levels.back().nodes * 10,
             LevelKeysFromVoxels(std::span(keys), depth)[6].size() * 7);
+}
+
+// The voxel (x, y, z) of a 4³ block as a bit of svokit's leaf mask.
+unsigned LeafBit(unsigned x, unsigned y, unsigned z) {
+  return static_cast<unsigned>(MortonEncode(x, y, z));
+}
+
+TEST(SymmetricDag, ReflectingALeafMirrorsItsVoxels) {
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 50; ++trial) {
+    const std::uint64_t bits = rng();
+    for (DagMirror m = 0; m < 8; ++m) {
+      std::uint64_t want = 0;
+      for (unsigned x = 0; x < 4; ++x)
+        for (unsigned y = 0; y < 4; ++y)
+          for (unsigned z = 0; z < 4; ++z) {
+            if (!(bits >> LeafBit(x, y, z) & 1u)) continue;
+            want |= std::uint64_t{1}
+                    << LeafBit(m & 1 ? 3 - x : x, m & 2 ? 3 - y : y, m & 4 ? 3 - z : z);
+          }
+      ASSERT_EQ(ReflectLeaf(bits, m), want) << "mirror " << int(m);
+    }
+  }
+}
+
+TEST(SymmetricDag, ExpandsToTheSameVoxelsWithNoMoreNodes) {
+  std::uint32_t seed = 11;
+  for (const std::uint32_t depth : {3u, 4u, 6u}) {
+    for (const double fill : {0.02, 0.3, 1.0}) {
+      const std::vector<std::uint64_t> keys = RandomKeys(depth, fill, seed++);
+      const VoxelDag dag = WholeDag(TreeOf(keys, depth), depth);
+      StatusOr<SymmetricDag> symmetric = ReduceSymmetries(dag);
+      ASSERT_TRUE(symmetric.ok());
+      EXPECT_EQ(SymmetricDagVoxelKeys(*symmetric), keys) << depth << " " << fill;
+      EXPECT_LE(symmetric->dag.NodeCount(), dag.NodeCount());
+      EXPECT_EQ(symmetric->dag.levels[0].nodes, 1u);
+    }
+  }
+}
+
+TEST(SymmetricDag, MirrorImagesShareOneNode) {
+  // A random 8³ pattern in the first octant of 16³ and its mirror images in x, y, z and xyz in
+  // the octants across: one node at the pattern's level, four parents' pointers to it.
+  const std::vector<std::uint64_t> tile = RandomKeys(3, 0.4, 5);
+  std::vector<std::uint64_t> keys;
+  for (const unsigned m : {0u, 1u, 2u, 4u, 7u}) {
+    for (const std::uint64_t k : tile) {
+      const MortonCoord c = MortonDecode(k);
+      keys.push_back(
+          MortonEncode(m & 1 ? 15 - c.x : c.x, m & 2 ? 15 - c.y : c.y, m & 4 ? 15 - c.z : c.z));
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  const VoxelDag dag = WholeDag(TreeOf(keys, 4), 4);
+  StatusOr<SymmetricDag> symmetric = ReduceSymmetries(dag);
+  ASSERT_TRUE(symmetric.ok());
+  EXPECT_EQ(SymmetricDagVoxelKeys(*symmetric), keys);
+  EXPECT_EQ(symmetric->dag.levels[1].nodes, 1u);
+  EXPECT_GT(dag.levels[1].nodes, 1u);
+}
+
+TEST(SymmetricDag, RealMeshMergesMoreThanThePlainDag) {
+  const std::vector<std::uint64_t> keys = BunnyKeys();
+  if (keys.empty()) GTEST_SKIP() << "no bunny00.off";
+  const VoxelDag dag = WholeDag(TreeOf(keys, 8), 8);
+  StatusOr<SymmetricDag> symmetric = ReduceSymmetries(dag);
+  ASSERT_TRUE(symmetric.ok());
+  EXPECT_EQ(SymmetricDagVoxelKeys(*symmetric), keys);
+  // Leaves of a curved surface come in mirror pairs: fewer than 60 % of the distinct ones stay.
+  EXPECT_LT(symmetric->dag.levels.back().nodes * 10, dag.levels.back().nodes * 6);
 }
 
 }  // namespace

@@ -185,3 +185,82 @@ def read_packed_colors(path):
         return out, level
     finally:
         c.close()
+
+
+class Ssvdag:
+    """A ``.ssvdag`` (SymVox's symmetry-aware DAG): the box, ``root_side``, ``levels``, the header's
+    ``nodes``, the u16 ``inner`` nodes, the 4³ ``leaves`` (uint64, bit 16x + 4y + z) and each inner
+    level's start in ``inner``."""
+
+    def __init__(self, bmin, bmax, root_side, levels, nodes, inner, leaves, level_offsets):
+        self.bmin, self.bmax, self.root_side, self.levels = bmin, bmax, root_side, levels
+        self.nodes, self.inner, self.leaves, self.level_offsets = nodes, inner, leaves, level_offsets
+
+
+def read_ssvdag(path):
+    data = _read(path)
+    if len(data) < 40:
+        raise FormatError(f"{path}: {len(data)} bytes, shorter than a .ssvdag header")
+    bmin = struct.unpack_from("<3f", data, 0)
+    bmax = struct.unpack_from("<3f", data, 12)
+    (root_side,) = struct.unpack_from("<f", data, 24)
+    levels, nodes, n16 = struct.unpack_from("<3I", data, 28)
+    at = 40
+    inner = np.frombuffer(data, "<u2", n16, at)
+    at += 2 * n16
+    (nb,) = struct.unpack_from("<I", data, at)
+    leaves = np.frombuffer(data[at + 4:at + 4 + nb], "<u8")
+    at += 4 + nb
+    (nl,) = struct.unpack_from("<I", data, at)
+    offsets = np.frombuffer(data, "<u4", nl, at + 4)
+    if nb % 8 or nl != levels - 2 or len(data) != at + 4 + 4 * nl:
+        raise FormatError(f"{path}: {n16} inner words, {nb} leaf bytes, {nl} levels in {len(data)} bytes")
+    return Ssvdag(bmin, bmax, root_side, levels, nodes, inner, leaves, offsets)
+
+
+# u16 words of a pointer by its 2-bit code: none, 16-bit, 32-bit (twice).
+_POINTER_SIZE = np.array([0, 1, 2, 2])
+
+
+def ssvdag_voxels(dag):
+    """The voxels of a SymVox symmetry-aware file as (x, y, z) rows, in no particular order."""
+    inner = dag.inner.astype(np.int64)
+    nodes = np.zeros(1, np.int64)  # u16 index of each node of the level
+    xyz = np.zeros((1, 3), np.int64)
+    mirror = np.zeros(1, np.int64)  # accumulated reflection, 4mx + 2my + mz
+    for level in range(dag.levels - 2):
+        header = inner[nodes]
+        codes = np.stack([(header >> (2 * c)) & 3 for c in range(8)], 1)
+        sizes = _POINTER_SIZE[codes]
+        from_child = np.cumsum(sizes[:, ::-1], axis=1)[:, ::-1]  # words of children c … 7
+        kids, cells, mirrors = [], [], []
+        for c in range(8):  # world child c is stored child c ^ M
+            stored = c ^ mirror
+            code = codes[np.arange(len(nodes)), stored]
+            has = np.nonzero(code)[0]
+            s = stored[has]
+            before = from_child[has, s] - sizes[has, s]
+            first = inner[nodes[has] + 1 + before]
+            wide = code[has] >= 2
+            second = np.where(wide, inner[np.minimum(nodes[has] + 2 + before, len(inner) - 1)], 0)
+            address = np.where(wide, ((first & 0x1FFF) << 16) | second | ((code[has] & 1) << 29), first & 0x1FFF)
+            field = (first >> 13) & 7  # x, y, z in bits 0, 1, 2
+            m = ((field & 1) << 2) | (field & 2) | ((field >> 2) & 1)
+            if level + 1 < dag.levels - 2:
+                address = address + int(dag.level_offsets[level + 1])
+            kids.append(address)
+            cells.append(2 * xyz[has] + _OCTANT[c])
+            mirrors.append(mirror[has] ^ m)
+        nodes, xyz, mirror = np.concatenate(kids), np.concatenate(cells), np.concatenate(mirrors)
+    bits = dag.leaves[nodes]
+    out = []
+    for b in range(64):
+        X, Y, Z = b >> 4, (b >> 2) & 3, b & 3
+        # World voxel (X, Y, Z) of a leaf seen through M is its stored voxel reflected by M.
+        sx = np.where(mirror & 4, 3 - X, X)
+        sy = np.where(mirror & 2, 3 - Y, Y)
+        sz = np.where(mirror & 1, 3 - Z, Z)
+        on = (bits >> (16 * sx + 4 * sy + sz).astype(np.uint64)) & np.uint64(1)
+        has = np.nonzero(on)[0]
+        out.append(4 * xyz[has] + np.array([X, Y, Z]))
+    return np.concatenate(out)

@@ -1,4 +1,4 @@
-"""svo-export's DAG files read as their renderers read them (svokit.dag, written from formats/dag.md)
+"""svo-export's DAG files (HashDAG, SymVox and its symmetry-aware form) read as their renderers read them (svokit.dag, written from formats/dag.md)
 against the octree read by the Python reader: the same voxels, colours in HashDAG's depth-first
 order, and every field a loader relies on (HashDAG's levels, root, voxel counts in the node
 headers and enclosed-leaves array; SymVox's box, levels and node count).
@@ -150,6 +150,16 @@ class DagFiles(unittest.TestCase):
             want_rgb = codecs.srgb8(v.colors[index, :3])
             self.assertLessEqual(int(np.abs(want_rgb.astype(np.int64) - rgba[:, :3]).max()), 1)
 
+    def check_ssvdag(self, f, path, level, want):
+        s = dag.read_ssvdag(path)
+        self.assertEqual(s.levels, level)
+        side = f.grid.voxel_size * (1 << f.depth)
+        self.assertAlmostEqual(s.root_side, side, delta=side * 1e-6)
+        self.assertEqual(s.level_offsets[0], 0)
+        voxels = dag.ssvdag_voxels(s)
+        self.assertEqual(as_set(voxels), want)
+        self.assertEqual(len(voxels), len(want))
+
     def test_files_expand_to_the_octrees_voxels(self):
         for name, mesh, options, levels in CASES:
             svo = self.make(name, mesh, options)
@@ -164,6 +174,9 @@ class DagFiles(unittest.TestCase):
                         self.run_tool("svo-export", svo, "-o", svdag, "--level", level)
                         self.check_hashdag(f, hashdag, level, want)
                         self.check_svdag(f, svdag, level, want)
+                        ssvdag = self.dir / f"{name}-{level}.ssvdag"
+                        self.run_tool("svo-export", svo, "-o", ssvdag, "--level", level, "--colors", "none")
+                        self.check_ssvdag(f, ssvdag, level, want)
 
     def test_the_spec_examples(self):
         # formats/dag.md's worked examples, by hand: one voxel at (1, 0, 0) of an 8³ grid, and at
@@ -172,6 +185,10 @@ class DagFiles(unittest.TestCase):
         self.assertEqual(as_set(dag.hashdag_voxels(h)), {(1, 0, 0)})
         s = dag.Svdag((0, 0, 0), (4, 4, 4), 4.0, 2, 2, 3, np.array([0x1, 2, 0x1], np.uint32))
         self.assertEqual(as_set(dag.svdag_voxels(s)), {(0, 0, 0)})
+        # (1, 0, 0) and its x mirror (6, 0, 0) in 8³: one leaf, child 4 seen through mirror x.
+        m = dag.Ssvdag((0, 0, 0), (8, 8, 8), 8.0, 3, 1, np.array([0x0101, 0x2000, 0x0000], np.uint16),
+                       np.array([1 << 16], np.uint64), np.array([0], np.uint32))
+        self.assertEqual(as_set(dag.ssvdag_voxels(m)), {(1, 0, 0), (6, 0, 0)})
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@
 #include "svokit/core/morton.hpp"
 #include "svokit/core/vec.hpp"
 #include "svokit/export/dag_build.hpp"
-#include "svokit/export/export.hpp"
+#include "svokit/export/level_attributes.hpp"
 #include "svokit/export/streamed_file.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
@@ -43,6 +43,19 @@ constexpr std::array<std::uint8_t, 256> kSwappedMask = [] {
   return t;
 }();
 
+// svokit's leaf bit b (8·c₁ + c₂, c = x + 2y + 4z) as SymVox's .ssvdag leaf bit 16x + 4y + z of the
+// 4³ block.
+constexpr std::array<std::uint8_t, 64> kSsvdagLeafBit = [] {
+  std::array<std::uint8_t, 64> t{};
+  for (unsigned b = 0; b < 64; ++b) {
+    const unsigned c1 = b >> 3, c2 = b & 7;
+    const unsigned x = 2 * (c1 & 1) + (c2 & 1), y = 2 * (c1 >> 1 & 1) + (c2 >> 1 & 1),
+                   z = 2 * (c1 >> 2) + (c2 >> 2);
+    t[b] = static_cast<std::uint8_t>(16 * x + 4 * y + z);
+  }
+  return t;
+}();
+
 std::uint8_t LeafByte(std::uint64_t bits, unsigned c) {
   return static_cast<std::uint8_t>(bits >> (8 * c));
 }
@@ -53,10 +66,20 @@ std::string Lower(std::string s) {
   return s;
 }
 
-// `dag_path` with its .dag.bin or .svdag replaced by `suffix`.
+// The file format a DAG path names, by its ending.
+enum class DagFormat { kHashDag, kSvdag, kSsvdag };
+DagFormat FormatOf(const std::filesystem::path& path) {
+  const std::string name = Lower(path.filename().string());
+  return name.ends_with(".ssvdag")  ? DagFormat::kSsvdag
+         : name.ends_with(".svdag") ? DagFormat::kSvdag
+                                    : DagFormat::kHashDag;
+}
+
+// `dag_path` with its .dag.bin, .svdag or .ssvdag replaced by `suffix`.
 std::filesystem::path BesideDag(const std::filesystem::path& dag_path, std::string_view suffix) {
   const std::string name = dag_path.filename().string();
-  const std::size_t tail = Lower(name).ends_with(".svdag") ? 6 : 8;
+  const DagFormat format = FormatOf(dag_path);
+  const std::size_t tail = format == DagFormat::kSvdag ? 6 : format == DagFormat::kSsvdag ? 7 : 8;
   const std::string stem = name.size() > tail ? name.substr(0, name.size() - tail) : name;
   return dag_path.parent_path() / (stem + std::string(suffix));
 }
@@ -231,7 +254,7 @@ bool IsDagPath(const std::filesystem::path& path) {
     return name.size() > tail.size() &&
            name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
   };
-  return ends(".dag.bin") || ends(".svdag");
+  return ends(".dag.bin") || ends(".svdag") || ends(".ssvdag");
 }
 
 std::filesystem::path HashDagColorsPath(const std::filesystem::path& dag_path) {
@@ -355,6 +378,107 @@ Status SvdagLayout::Emit(VoxelDag& dag,
   return out.empty() ? Status::Ok() : emit(out);
 }
 
+StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uint64_t& nodes) {
+  const VoxelDag& dag = sym.dag;
+  const std::uint32_t leaf = dag.leaf_level();
+  const auto node_size = [&](std::uint32_t level, std::size_t offset) -> std::size_t {
+    return level == leaf ? 2 : 1 + CountBits8(dag.levels[level].words[offset]);
+  };
+  // Each level's nodes in the file's order: most referenced first (small addresses, 16-bit
+  // pointers), then by offset.
+  std::vector<std::vector<std::uint32_t>> order(leaf + 1);
+  order[0] = {0};
+  nodes = 0;
+  for (std::uint32_t l = 1; l <= leaf; ++l) {
+    const std::vector<std::uint32_t>& parents = dag.levels[l - 1].words;
+    std::vector<std::uint32_t> references(dag.levels[l].words.size(), 0);
+    for (std::size_t offset = 0; offset < parents.size();) {
+      const std::size_t n = node_size(l - 1, offset);
+      for (std::size_t k = 1; k < n; ++k) ++references[parents[offset + k] >> 3];
+      offset += n;
+    }
+    for (std::size_t offset = 0; offset < references.size(); offset += node_size(l, offset)) {
+      order[l].push_back(static_cast<std::uint32_t>(offset));
+    }
+    std::stable_sort(order[l].begin(), order[l].end(), [&](std::uint32_t a, std::uint32_t b) {
+      return references[a] > references[b];
+    });
+    nodes += order[l].size();
+  }
+  // Addresses from the leaves up: a pointer takes one u16 below 2¹³, two above.
+  std::vector<std::vector<std::uint32_t>> address(leaf + 1);
+  address[leaf].resize(dag.levels[leaf].words.size());
+  for (std::size_t i = 0; i < order[leaf].size(); ++i) {
+    address[leaf][order[leaf][i]] = static_cast<std::uint32_t>(i);
+  }
+  std::vector<std::uint64_t> level_words(leaf, 0);
+  for (std::uint32_t l = leaf; l-- > 0;) {
+    const std::vector<std::uint32_t>& words = dag.levels[l].words;
+    address[l].resize(words.size());
+    std::uint64_t at = 0;
+    for (const std::uint32_t offset : order[l]) {
+      if (at >= (1u << 30)) {
+        return Status::BadInput(
+            "a level of the symmetric DAG passes 2^30 words, more than "
+            ".ssvdag pointers reach; export a coarser --level");
+      }
+      address[l][offset] = static_cast<std::uint32_t>(at);
+      std::uint64_t size = 1;
+      for (std::size_t k = 1; k < node_size(l, offset); ++k) {
+        size += address[l + 1][words[offset + k] >> 3] < (1u << 13) ? 1 : 2;
+      }
+      at += size;
+    }
+    level_words[l] = at;
+  }
+
+  ByteWriter w;
+  std::uint64_t inner = 0;
+  for (const std::uint64_t n : level_words) inner += n;
+  w.Put(static_cast<std::uint32_t>(inner));
+  for (std::uint32_t l = 0; l < leaf; ++l) {
+    const std::vector<std::uint32_t>& words = dag.levels[l].words;
+    for (const std::uint32_t offset : order[l]) {
+      const unsigned mask = words[offset];
+      std::uint16_t header = 0;
+      std::vector<std::uint16_t> pointers;
+      for (unsigned h = 8; h-- > 0;) {  // SymVox's children 7 down to 0
+        const unsigned c = SwapXZ(h);
+        if (!(mask >> c & 1u)) continue;
+        const std::uint32_t child = words[offset + 1 + RankInByte(mask, c)];
+        const std::uint32_t at = address[l + 1][child >> 3], mirror = child & 7u;
+        if (at < (1u << 13)) {
+          header = static_cast<std::uint16_t>(header | 1u << (2 * h));
+          pointers.push_back(static_cast<std::uint16_t>(at | mirror << 13));
+        } else {
+          header = static_cast<std::uint16_t>(header | (at >> 29 & 1u ? 3u : 2u) << (2 * h));
+          const std::uint32_t v = (at & ~(1u << 29)) | mirror << 29;
+          pointers.push_back(static_cast<std::uint16_t>(v >> 16));  // the high half first
+          pointers.push_back(static_cast<std::uint16_t>(v));
+        }
+      }
+      w.Put(header);
+      for (const std::uint16_t p : pointers) w.Put(p);
+    }
+  }
+  w.Put(static_cast<std::uint32_t>(8 * order[leaf].size()));
+  for (const std::uint32_t offset : order[leaf]) {
+    const std::uint64_t bits = DagLeafMask(dag.levels[leaf], offset);
+    std::uint64_t out = 0;
+    for (unsigned b = 0; b < 64; ++b) {
+      if (bits >> b & 1u) out |= std::uint64_t{1} << kSsvdagLeafBit[b];
+    }
+    w.Put(out);
+  }
+  w.Put(leaf);
+  std::uint64_t start = 0;
+  for (std::uint32_t l = 0; l < leaf; ++l) {
+    w.Put(static_cast<std::uint32_t>(start));
+    start += level_words[l];
+  }
+  return std::move(w.bytes());
+}
+
 std::filesystem::path PackedColorsPath(const std::filesystem::path& dag_path) {
   return BesideDag(dag_path, ".dagcolors");
 }
@@ -363,9 +487,11 @@ StatusOr<DagExport> ExportDag(const SvoReader& reader, const std::filesystem::pa
                               const DagExportOptions& options, Progress& progress) {
   const std::uint32_t level = options.level;
   const std::uint64_t memory_limit = options.memory_limit;
-  const bool hashdag = !Lower(path.filename().string()).ends_with(".svdag");
-  if (hashdag && level < 3) {  // its root is an inner node, its leaves 4³ below
-    return Status::BadInput("{}: a HashDAG file needs level 3 or deeper", path.string());
+  const DagFormat format = FormatOf(path);
+  const bool hashdag = format == DagFormat::kHashDag;
+  if (format != DagFormat::kSvdag && level < 3) {  // the root is inner, the leaves 4³ below
+    return Status::BadInput("{}: a {} file needs level 3 or deeper", path.string(),
+                            hashdag ? "HashDAG" : ".ssvdag");
   }
   SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, level));
   const SvoShape& shape = reader.shape();
@@ -431,6 +557,21 @@ StatusOr<DagExport> ExportDag(const SvoReader& reader, const std::filesystem::pa
       put_words(file, l.words);
       l = DagLevel{};
     }
+  } else if (format == DagFormat::kSsvdag) {
+    StatusOr<SymmetricDag> symmetric = ReduceSymmetries(*dag);
+    if (!symmetric.ok()) return symmetric.status().WithContext(path.string());
+    *dag = VoxelDag{};
+    report.symmetric_nodes = symmetric->dag.NodeCount();
+    std::uint64_t nodes = 0;
+    StatusOr<std::vector<std::uint8_t>> body = SsvdagBody(*symmetric, nodes);
+    if (!body.ok()) return body.status().WithContext(path.string());
+    for (const double v : min) head.Put(static_cast<float>(v));
+    for (const double v : max) head.Put(static_cast<float>(v));
+    head.Put(static_cast<float>(side));
+    head.Put(level);
+    head.Put(static_cast<std::uint32_t>(nodes));
+    file.Put(head.bytes());
+    file.Put(*body);
   } else {
     const SvdagLayout layout(*dag);
     for (const double v : min) head.Put(static_cast<float>(v));

@@ -16,16 +16,17 @@
 #include "svokit/core/status.hpp"
 #include "svokit/formats/container/container.hpp"
 #include "svokit/formats/svo/svo_reader.hpp"
+#include "svokit/svo/symmetric_dag.hpp"
 #include "svokit/svo/voxel_dag.hpp"
 
 namespace svokit {
 
-/// Whether `path` names a DAG file: it ends in .dag.bin or .svdag (any case).
+/// Whether `path` names a DAG file: it ends in .dag.bin, .svdag or .ssvdag (any case).
 bool IsDagPath(const std::filesystem::path& path);
 
 /// The colour file HashDAG loads beside `dag_path` (x.dag.bin → x.uncompressed_colors.bin).
 std::filesystem::path HashDagColorsPath(const std::filesystem::path& dag_path);
-/// svokit's packed colours beside `dag_path` (x.dag.bin, x.svdag → x.dagcolors).
+/// svokit's packed colours beside `dag_path` (x.dag.bin, x.svdag, x.ssvdag → x.dagcolors).
 std::filesystem::path PackedColorsPath(const std::filesystem::path& dag_path);
 
 /// The packed colour file (formats/dag.md, "Packed colours"), and its colours per block.
@@ -59,6 +60,7 @@ struct DagExport {
   std::uint64_t voxels = 0;  ///< the octree's nodes of the level (a solid's: its surface's)
   std::uint64_t nodes = 0;   ///< distinct nodes, in svokit's 4³-leaf form
   std::vector<std::uint64_t> level_nodes;  ///< the same per level, root first, leaves last
+  std::uint64_t symmetric_nodes = 0;       ///< .ssvdag: distinct nodes up to reflection
   std::uint64_t file_bytes = 0;
   std::filesystem::path color_path;  ///< empty: no colour file
   std::uint64_t color_bytes = 0;
@@ -97,5 +99,10 @@ class SvdagLayout {
   std::vector<std::uint32_t> byte_leaves_;
   std::uint64_t nodes_ = 0, words_ = 0;
 };
+
+/// SymVox's .ssvdag after its 36-byte header (formats/dag.md): the u16 inner nodes with 16- or
+/// 32-bit pointers carrying mirrors, the 4³ leaves, the levels' offsets; `nodes` gets the node
+/// count (the root aside) its header states.
+StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& dag, std::uint64_t& nodes);
 
 }  // namespace svokit

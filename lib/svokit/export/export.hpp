@@ -14,6 +14,7 @@
 
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/export/level_attributes.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/voxelize/solid_fill.hpp"
@@ -52,16 +53,6 @@ Status CheckWholeExport(const SvoReader& reader, const std::filesystem::path& pa
 Status ExportSvoPages(const SvoReader& reader, const std::filesystem::path& path,
                       const ExportOptions& options, std::uint64_t memory_limit,
                       Progress::Stage* stage = nullptr);
-
-/// The nodes of `level` of an octree of `depth` levels as voxels: the octree's origin, voxel size
-/// NodeSize(level), dims the leaf grid's rounded up to whole nodes.
-GridTransform LevelGrid(const GridTransform& grid, std::uint32_t depth, std::uint32_t level);
-
-/// Each node's colour and normal from `bricks` (its level's pool, in the order of set.keys): the
-/// brick's centre sample (side 3) or the opacity-weighted mean of its 8 corners (side 2); with
-/// `density`, the opacity at its centre (1 without bricks).
-void FillNodeAttributes(const SvoLevel& bricks, std::uint32_t side, bool has_color, bool has_normal,
-                        VoxelSet& set, std::vector<float>* density = nullptr);
 
 /// The nodes of `level` (≤ svo.depth, and loaded) as voxels: grid origin = the octree's, voxel
 /// size = NodeSize(level), dims = the leaf grid's rounded up to whole nodes; keys = LevelKeys.

@@ -13,6 +13,7 @@
 #include "svokit/core/grid_transform.hpp"
 #include "svokit/core/progress.hpp"
 #include "svokit/core/status.hpp"
+#include "svokit/export/dag_files.hpp"
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_file.hpp"
 #include "svokit/formats/svo/svo_part.hpp"
@@ -107,7 +108,7 @@ StatusOr<OctreeReport> VoxelsToSvo(const VoxelsToSvoRequest& request,
 
 struct MeshToSvoRequest {
   std::filesystem::path input;   ///< a mesh
-  std::filesystem::path output;  ///< .svo, or .svopart for a part
+  std::filesystem::path output;  ///< .svo, .svopart for a part, or a DAG (.dag.bin, .svdag)
   VoxelizeRequest voxelize;
   BuildSettings build;
   std::optional<std::uint64_t> memory_limit;
@@ -115,6 +116,7 @@ struct MeshToSvoRequest {
   WarningSink warn;
   ImportOptions import;  ///< where the mesh's side files may be read from
   bool strict = false;   ///< any warning is an error: nothing is written
+  DagColorFile dag_colors = DagColorFile::kDefault;  ///< a DAG's colour file
 };
 struct MeshToSvoReport {
   std::uint64_t triangles = 0;
@@ -122,7 +124,11 @@ struct MeshToSvoReport {
   GridTransform grid;
   OctreeReport octree;
   std::optional<SvoPartStats> part;  ///< a part was built
+  std::optional<DagExport> dag;      ///< a DAG was written (`octree`: the scratch one it came from)
 };
+/// The mesh's octree written to request.output; for a DAG output, its geometry and voxel colours
+/// (no bricks, no contours) built into a scratch .svo beside it, made into the DAG page by page
+/// (ExportDag) and removed.
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& request,
                                     Progress& progress = Progress::Silent());
 

@@ -1,11 +1,17 @@
 // mesh2svo's run: a mesh to an octree in one process — whole, by pages within a memory limit, or
-// one part of a build by pages — the same file as svo-voxelize and svo-build.
+// one part of a build by pages — the same file as svo-voxelize and svo-build; or to a DAG.
+
+#include <unistd.h>
 
 #include <memory>
 
+#include <fmt/format.h>
+
 #include "svokit/core/crc32c.hpp"
 #include "svokit/core/file_io.hpp"
+#include "svokit/export/dag_files.hpp"
 #include "svokit/formats/mesh_import.hpp"
+#include "svokit/formats/svo/svo_reader.hpp"
 #include "svokit/pipeline/chain.hpp"
 #include "svokit/pipeline/svo_by_pages.hpp"
 #include "svokit/svo/compact_build.hpp"
@@ -91,9 +97,45 @@ struct Build {
   }
 };
 
+// A DAG straight from a mesh: the octree of its geometry and voxel colours (no bricks, contours
+// or normals, so the smallest .svo) built into a scratch file beside the output, whole or by
+// pages as an octree would be, then reduced from it page by page and removed.
+StatusOr<MeshToSvoReport> MeshToDag(const MeshToSvoRequest& r, Progress& progress) {
+  if (r.part) {
+    return Status::BadInput(
+        "{}: a DAG is made whole: build the parts as .svopart, join them with "
+        "svo-merge, then svo-export the DAG",
+        r.output.string());
+  }
+  SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"dag.bin", "svdag", "ssvdag"}, r.input));
+  MeshToSvoRequest octree = r;
+  octree.output =
+      r.output.parent_path() / fmt::format(".{}.{}.svo", r.output.filename().string(), ::getpid());
+  octree.build.brick_side = 0;
+  octree.build.contours = false;
+  octree.voxelize.settings.normals = false;
+  struct Scratch {
+    std::filesystem::path path;
+    ~Scratch() {
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+    }
+  } scratch{octree.output};
+  StatusOr<MeshToSvoReport> report = MeshToSvo(octree, progress);
+  if (!report.ok()) return report.status();
+  StatusOr<SvoReader> reader = SvoReader::Open(octree.output);
+  if (!reader.ok()) return reader.status();
+  StatusOr<DagExport> dag = ExportDag(
+      *reader, r.output, {reader->depth(), r.memory_limit.value_or(0), r.dag_colors}, progress);
+  if (!dag.ok()) return dag.status();
+  report->dag = std::move(*dag);
+  return report;
+}
+
 }  // namespace
 
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
+  if (IsDagPath(r.output)) return MeshToDag(r, progress);
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
   StatusOr<FittedMesh> fitted =
       ImportAndFit(r.input, r.voxelize.grid, r.import, r.warn, r.strict, r.output, progress);
