@@ -378,8 +378,9 @@ Status SvdagLayout::Emit(VoxelDag& dag,
   return out.empty() ? Status::Ok() : emit(out);
 }
 
-StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uint64_t& nodes) {
-  const VoxelDag& dag = sym.dag;
+Status WriteSsvdagBody(SymmetricDag& sym, std::uint64_t& nodes,
+                       const std::function<Status(std::span<const std::uint8_t>)>& emit) {
+  VoxelDag& dag = sym.dag;
   const std::uint32_t leaf = dag.leaf_level();
   const auto node_size = [&](std::uint32_t level, std::size_t offset) -> std::size_t {
     return level == leaf ? 2 : 1 + CountBits8(dag.levels[level].words[offset]);
@@ -433,6 +434,12 @@ StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uin
   }
 
   ByteWriter w;
+  const auto flush = [&](bool always) -> Status {
+    if (!always && w.bytes().size() < (1u << 20)) return Status::Ok();
+    const Status s = emit(w.bytes());
+    w.bytes().clear();
+    return s;
+  };
   std::uint64_t inner = 0;
   for (const std::uint64_t n : level_words) inner += n;
   w.Put(static_cast<std::uint32_t>(inner));
@@ -441,7 +448,8 @@ StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uin
     for (const std::uint32_t offset : order[l]) {
       const unsigned mask = words[offset];
       std::uint16_t header = 0;
-      std::vector<std::uint16_t> pointers;
+      std::array<std::uint16_t, 16> pointers;
+      std::size_t n = 0;
       for (unsigned h = 8; h-- > 0;) {  // SymVox's children 7 down to 0
         const unsigned c = SwapXZ(h);
         if (!(mask >> c & 1u)) continue;
@@ -449,17 +457,21 @@ StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uin
         const std::uint32_t at = address[l + 1][child >> 3], mirror = child & 7u;
         if (at < (1u << 13)) {
           header = static_cast<std::uint16_t>(header | 1u << (2 * h));
-          pointers.push_back(static_cast<std::uint16_t>(at | mirror << 13));
+          pointers[n++] = static_cast<std::uint16_t>(at | mirror << 13);
         } else {
           header = static_cast<std::uint16_t>(header | (at >> 29 & 1u ? 3u : 2u) << (2 * h));
           const std::uint32_t v = (at & ~(1u << 29)) | mirror << 29;
-          pointers.push_back(static_cast<std::uint16_t>(v >> 16));  // the high half first
-          pointers.push_back(static_cast<std::uint16_t>(v));
+          pointers[n++] = static_cast<std::uint16_t>(v >> 16);  // the high half first
+          pointers[n++] = static_cast<std::uint16_t>(v);
         }
       }
       w.Put(header);
-      for (const std::uint16_t p : pointers) w.Put(p);
+      for (std::size_t k = 0; k < n; ++k) w.Put(pointers[k]);
+      SVOKIT_RETURN_IF_ERROR(flush(false));
     }
+    // Written: the level and the addresses of the one below it are given up.
+    dag.levels[l] = DagLevel{};
+    address[l + 1] = {};
   }
   w.Put(static_cast<std::uint32_t>(8 * order[leaf].size()));
   for (const std::uint32_t offset : order[leaf]) {
@@ -469,6 +481,7 @@ StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uin
       if (bits >> b & 1u) out |= std::uint64_t{1} << kSsvdagLeafBit[b];
     }
     w.Put(out);
+    SVOKIT_RETURN_IF_ERROR(flush(false));
   }
   w.Put(leaf);
   std::uint64_t start = 0;
@@ -476,7 +489,7 @@ StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& sym, std::uin
     w.Put(static_cast<std::uint32_t>(start));
     start += level_words[l];
   }
-  return std::move(w.bytes());
+  return flush(true);
 }
 
 std::filesystem::path PackedColorsPath(const std::filesystem::path& dag_path) {
@@ -558,20 +571,23 @@ StatusOr<DagExport> ExportDag(const SvoReader& reader, const std::filesystem::pa
       l = DagLevel{};
     }
   } else if (format == DagFormat::kSsvdag) {
-    StatusOr<SymmetricDag> symmetric = ReduceSymmetries(*dag);
+    StatusOr<SymmetricDag> symmetric = ReduceSymmetries(std::move(*dag));
     if (!symmetric.ok()) return symmetric.status().WithContext(path.string());
-    *dag = VoxelDag{};
     report.symmetric_nodes = symmetric->dag.NodeCount();
     std::uint64_t nodes = 0;
-    StatusOr<std::vector<std::uint8_t>> body = SsvdagBody(*symmetric, nodes);
-    if (!body.ok()) return body.status().WithContext(path.string());
     for (const double v : min) head.Put(static_cast<float>(v));
     for (const double v : max) head.Put(static_cast<float>(v));
     head.Put(static_cast<float>(side));
     head.Put(level);
-    head.Put(static_cast<std::uint32_t>(nodes));
+    head.Put(std::uint32_t{0});  // the node count, known once the body is laid out
     file.Put(head.bytes());
-    file.Put(*body);
+    const Status written =
+        WriteSsvdagBody(*symmetric, nodes, [&](std::span<const std::uint8_t> bytes) {
+          file.Put(bytes);
+          return file.status();
+        });
+    if (!written.ok()) return written.WithContext(path.string());
+    SVOKIT_RETURN_IF_ERROR(file.PutAt(32, static_cast<std::uint32_t>(nodes)));
   } else {
     const SvdagLayout layout(*dag);
     for (const double v : min) head.Put(static_cast<float>(v));

@@ -100,9 +100,11 @@ class SvdagLayout {
   std::uint64_t nodes_ = 0, words_ = 0;
 };
 
-/// SymVox's .ssvdag after its 36-byte header (formats/dag.md): the u16 inner nodes with 16- or
-/// 32-bit pointers carrying mirrors, the 4³ leaves, the levels' offsets; `nodes` gets the node
-/// count (the root aside) its header states.
-StatusOr<std::vector<std::uint8_t>> SsvdagBody(const SymmetricDag& dag, std::uint64_t& nodes);
+/// SymVox's .ssvdag after its 36-byte header (formats/dag.md), handed to `emit` a piece at a time:
+/// the u16 inner nodes with 16- or 32-bit pointers carrying mirrors, the 4³ leaves, the levels'
+/// offsets; each level of `dag` given up once written. `nodes` gets the node count (the root
+/// aside) the header states.
+Status WriteSsvdagBody(SymmetricDag& dag, std::uint64_t& nodes,
+                       const std::function<Status(std::span<const std::uint8_t>)>& emit);
 
 }  // namespace svokit

@@ -26,6 +26,13 @@ class StreamedFile {
     buffer_.push_back(byte);
     if (buffer_.size() >= (1u << 20)) Flush();
   }
+  /// Overwrites a 32-bit field already put, at `offset` (a header field known last).
+  Status PutAt(std::uint64_t offset, std::uint32_t value) {
+    Flush();
+    if (status_.ok())
+      status_ = file_.WriteAt(offset, std::span(reinterpret_cast<const std::uint8_t*>(&value), 4));
+    return status_;
+  }
   const Status& status() const { return status_; }
   std::uint64_t bytes_written() const { return file_.bytes_written() + buffer_.size(); }
   Status Commit() {

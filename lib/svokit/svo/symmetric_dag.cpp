@@ -59,7 +59,7 @@ std::uint64_t ReflectLeaf(std::uint64_t bits, DagMirror m) {
   return out;
 }
 
-StatusOr<SymmetricDag> ReduceSymmetries(const VoxelDag& dag) {
+StatusOr<SymmetricDag> ReduceSymmetries(VoxelDag dag) {
   const std::uint32_t leaf = dag.leaf_level();
   SymmetricDag out;
   dag_detail::DagLevels levels(0, dag.depth);
@@ -102,6 +102,7 @@ StatusOr<SymmetricDag> ReduceSymmetries(const VoxelDag& dag) {
       refs[offset] = *ref;
     }
     below.swap(refs);
+    dag.levels[leaf] = DagLevel{};
   }
 
   // Inner levels: each reflection's children moved and their mirrors composed (and reduced by
@@ -152,6 +153,7 @@ StatusOr<SymmetricDag> ReduceSymmetries(const VoxelDag& dag) {
       offset += 1 + n;
     }
     below.swap(refs);
+    dag.levels[l] = DagLevel{};
   }
   out.dag.depth = dag.depth;
   out.dag.levels = std::move(levels.levels);

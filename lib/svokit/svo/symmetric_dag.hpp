@@ -30,9 +30,9 @@ struct SymmetricDag {
 /// The 4³ leaf `bits` (VoxelDag's layout) reflected by `m`.
 std::uint64_t ReflectLeaf(std::uint64_t bits, DagMirror m);
 
-/// `dag` with nodes equal up to a reflection merged. Fails when a level passes 2²⁹ words (a
-/// child word keeps 29 bits of offset).
-StatusOr<SymmetricDag> ReduceSymmetries(const VoxelDag& dag);
+/// `dag` with nodes equal up to a reflection merged, its levels given up as they are reduced (pass
+/// a copy to keep it). Fails when a level passes 2²⁹ words (a child word keeps 29 bits of offset).
+StatusOr<SymmetricDag> ReduceSymmetries(VoxelDag dag);
 
 /// The voxels of `dag` as Morton keys, ascending (its expansion: for tests and small grids).
 std::vector<std::uint64_t> SymmetricDagVoxelKeys(const SymmetricDag& dag);
