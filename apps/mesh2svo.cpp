@@ -5,6 +5,7 @@
 
 #include "apps/chain_options.hpp"
 #include "apps/cli.hpp"
+#include "apps/dag_cli.hpp"
 #include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
                  "many; svo-merge joins the parts into the .svo")
       ->option_text("K/N");
   import.Add(cli);
+  app::AddDagColorsOption(cli, request.dag_colors);
   app::AddCommonOptions(cli, common, "mesh2svo bunny.obj -r 1024 -o bunny.svo");
 
   return app::Run(tool, cli, argc, argv, request.input, [&] {

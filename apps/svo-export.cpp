@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "apps/cli.hpp"
+#include "apps/dag_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
 #include "svokit/core/file_io.hpp"
@@ -38,13 +39,8 @@ int main(int argc, char** argv) {
                  "Export the nodes of this octree level (0 = root) as voxels of its node size "
                  "(default: the voxels)")
       ->option_text("L");
-  std::string dag_colors = "default";
-  cli.add_option("--colors", dag_colors,
-                 "DAGs: the colour file beside it: hashdag (HashDAG's uncompressed_colors.bin, "
-                 "the default beside a .dag.bin), packed (svokit's .dagcolors, zstd-compressed, "
-                 "the default beside a .svdag or .ssvdag) or none")
-      ->check(CLI::IsMember({"default", "hashdag", "packed", "none"}))
-      ->option_text("FILE");
+  DagColorFile dag_colors = DagColorFile::kDefault;
+  app::AddDagColorsOption(cli, dag_colors);
   bool no_merge = false;
   cli.add_flag("--no-merge", no_merge,
                "Voxel meshes: one quad per voxel face (default: coplanar faces of one colour "
@@ -71,11 +67,8 @@ int main(int argc, char** argv) {
       StatusOr<SvoReader> reader = SvoReader::Open(input);
       if (!reader.ok()) return app::Fail(tool, reader.status());
       const std::uint32_t exported = level.value_or(reader->depth());
-      DagExportOptions dag_options{exported, limit->value_or(0), DagColorFile::kDefault};
-      if (dag_colors == "hashdag") dag_options.colors = DagColorFile::kHashDag;
-      if (dag_colors == "packed") dag_options.colors = DagColorFile::kPacked;
-      if (dag_colors == "none") dag_options.colors = DagColorFile::kNone;
-      StatusOr<DagExport> dag = ExportDag(*reader, output, dag_options, progress);
+      StatusOr<DagExport> dag =
+          ExportDag(*reader, output, {exported, limit->value_or(0), dag_colors}, progress);
       if (!dag.ok()) return app::Fail(tool, dag.status());
       app::Report report(common);
       report.Line("octree", {{"path", input.string()}, {"depth", reader->depth()}},
