@@ -59,7 +59,11 @@ std::uint32_t NodeTable::Insert(DagLevel& level, std::span<const std::uint32_t> 
       ++count_;
       return offset;
     }
-    if (std::equal(node.begin(), node.end(), level.words.begin() + (slot - 1))) return slot - 1;
+    // The first words (an inner node's mask) agree before the rest is read: then so do lengths.
+    const std::uint32_t* stored = level.words.data() + (slot - 1);
+    if (stored[0] == node[0] && std::equal(node.begin() + 1, node.end(), stored + 1)) {
+      return slot - 1;
+    }
   }
 }
 
