@@ -430,17 +430,25 @@ std::string ReadFullyAt(int fd, std::uint64_t offset, std::span<std::uint8_t> ou
   return {};
 }
 
+bool HasExtension(const std::filesystem::path& path, std::string_view extension) {
+  const std::string name = path.filename().string();
+  if (name.size() <= extension.size() + 1) return false;
+  const std::size_t dot = name.size() - extension.size() - 1;
+  if (name[dot] != '.') return false;
+  for (std::size_t i = 0; i < extension.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(name[dot + 1 + i])) !=
+        std::tolower(static_cast<unsigned char>(extension[i]))) {
+      return false;
+    }
+  }
+  return true;
+}
+
 Status CheckOutputPath(const std::filesystem::path& path,
                        const std::vector<std::string>& extensions,
                        const std::filesystem::path& input) {
-  // Matched on the name's tail, so that an extension may have two parts (x.dag.bin).
-  std::string name = path.filename().string();
-  std::transform(name.begin(), name.end(), name.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const auto named = [&](const std::string& e) {
-    return name.size() > e.size() + 1 && name.ends_with("." + e);
-  };
-  if (std::none_of(extensions.begin(), extensions.end(), named)) {
+  if (std::none_of(extensions.begin(), extensions.end(),
+                   [&](const std::string& e) { return HasExtension(path, e); })) {
     std::string list;
     for (const std::string& e : extensions) list += (list.empty() ? "." : ", .") + e;
     return Status::BadInput("{}: output must be a {} file", path.string(), list);

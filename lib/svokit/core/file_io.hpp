@@ -49,6 +49,9 @@ std::string UnreadableReason(const Status& status, const std::filesystem::path& 
 
 /// Lower-case extension without the dot ("obj" for "Model.OBJ").
 std::string LowerExtension(const std::filesystem::path& path);
+/// Whether `path`'s file name ends in "." + `extension` (any case) after at least one character:
+/// an extension may have two parts ("dag.bin").
+bool HasExtension(const std::filesystem::path& path, std::string_view extension);
 
 /// Writes an output file so that it appears complete or not at all, whatever happens to the process
 /// or the machine. The data goes to an unnamed file (O_TMPFILE) in the output's directory, which

@@ -60,19 +60,12 @@ std::uint8_t LeafByte(std::uint64_t bits, unsigned c) {
   return static_cast<std::uint8_t>(bits >> (8 * c));
 }
 
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 // The file format a DAG path names, by its ending.
 enum class DagFormat { kHashDag, kSvdag, kSsvdag };
 DagFormat FormatOf(const std::filesystem::path& path) {
-  const std::string name = Lower(path.filename().string());
-  return name.ends_with(".ssvdag")  ? DagFormat::kSsvdag
-         : name.ends_with(".svdag") ? DagFormat::kSvdag
-                                    : DagFormat::kHashDag;
+  return HasExtension(path, "ssvdag")  ? DagFormat::kSsvdag
+         : HasExtension(path, "svdag") ? DagFormat::kSvdag
+                                       : DagFormat::kHashDag;
 }
 
 // `dag_path` with its .dag.bin, .svdag or .ssvdag replaced by `suffix`.
@@ -249,12 +242,8 @@ Status WritePackedColors(const SvoReader& reader, std::uint32_t level, std::uint
 }  // namespace
 
 bool IsDagPath(const std::filesystem::path& path) {
-  const std::string name = Lower(path.filename().string());
-  const auto ends = [&](std::string_view tail) {
-    return name.size() > tail.size() &&
-           name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
-  };
-  return ends(".dag.bin") || ends(".svdag") || ends(".ssvdag");
+  return HasExtension(path, "dag.bin") || HasExtension(path, "svdag") ||
+         HasExtension(path, "ssvdag");
 }
 
 std::filesystem::path HashDagColorsPath(const std::filesystem::path& dag_path) {
