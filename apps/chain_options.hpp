@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_part.hpp"
 #include "svokit/pipeline/chain.hpp"
+#include "svokit/svo/prune_tree.hpp"
 
 namespace svokit::app {
 
@@ -115,6 +117,7 @@ struct BuildCli {
   std::string bricks = "3";
   bool contours = true;
   std::string compression = "zstd";
+  std::optional<std::string> prune;
 
   void Add(CLI::App& cli) {
     cli.add_option("--bricks", bricks,
@@ -130,13 +133,23 @@ struct BuildCli {
                    "none")
         ->option_text("zstd[:LEVEL]|none")
         ->capture_default_str();
+    cli.add_option("--prune", prune,
+                   "Variable-resolution leaves: a node whose brick and contour describe every "
+                   "voxel below it within the tolerances becomes a leaf (ESVO's defaults: "
+                   "color=0.0625,normal=0.01,geometry=1.732 voxels; 'default' for those)")
+        ->option_text("default|color=E,normal=E,geometry=E");
   }
 
-  /// The build asked for, or why --compression is not one.
+  /// The build asked for, or why --compression or --prune is not one.
   StatusOr<BuildSettings> Settings() const {
     BuildSettings s;
     s.brick_side = bricks == "none" ? 0 : static_cast<std::uint32_t>(std::stoul(bricks));
     s.contours = contours;
+    if (prune) {
+      StatusOr<PruneTolerances> tolerances = ParsePruneTolerances(*prune);
+      if (!tolerances.ok()) return tolerances.status();
+      s.prune = *tolerances;
+    }
     if (compression == "none") {
       s.compression = {false, 0};
       return s;

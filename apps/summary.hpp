@@ -82,6 +82,30 @@ inline void AddFileSummary(Report& report, const SvoFileStats& stats) {
                {"largest_bytes", stats.largest_page}},
               fmt::format("{} below level {} ({} to {} bytes)", stats.pages, stats.page_level,
                           stats.smallest_page, stats.largest_page));
+  if (!stats.prune.nodes_before.empty()) {
+    const PruneStats& p = stats.prune;
+    std::uint64_t chunk_bytes = 0;
+    for (const SvoSectionBytes& s : stats.sections) {
+      if (s.name != "frame") chunk_bytes += s.stored;
+    }
+    const auto fewer = [](std::uint64_t before, std::uint64_t after) {
+      return before == 0 ? 0.0
+                         : 100.0 * (1.0 - static_cast<double>(after) / static_cast<double>(before));
+    };
+    report.Line(
+        "pruned",
+        {{"leaves", p.leaves},
+         {"page_nodes_before", p.NodesBefore()},
+         {"page_nodes_after", p.NodesAfter()},
+         {"chunk_bytes_before", stats.unpruned_chunk_bytes},
+         {"chunk_bytes_after", chunk_bytes},
+         {"halo_voxels_added", p.halo_added}},
+        fmt::format("{} leaves; page nodes {} -> {} ({:.1f} % fewer), stored bytes {} -> {} "
+                    "({:.1f} % fewer); {} dropped voxels kept in halos",
+                    p.leaves, p.NodesBefore(), p.NodesAfter(),
+                    fewer(p.NodesBefore(), p.NodesAfter()), stats.unpruned_chunk_bytes, chunk_bytes,
+                    fewer(stats.unpruned_chunk_bytes, chunk_bytes), p.halo_added));
+  }
 }
 
 /// The levels of the octree written to `output` (its HEAD: nodes and contours per level), as

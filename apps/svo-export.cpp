@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
     if (IsDagPath(output)) {
       StatusOr<SvoReader> reader = SvoReader::Open(input);
       if (!reader.ok()) return app::Fail(tool, reader.status());
+      if (Status s = RequireUnpruned(*reader, "a DAG"); !s.ok()) return app::Fail(tool, s);
       const std::uint32_t exported = level.value_or(reader->depth());
       StatusOr<DagExport> dag =
           ExportDag(*reader, output, {exported, limit->value_or(0), dag_colors}, progress);
@@ -83,6 +84,9 @@ int main(int argc, char** argv) {
     std::uint64_t nodes = 0;
     double node_size = 0;
     StatusOr<SvoReader> reader = SvoReader::Open(input);
+    if (reader.ok()) {
+      if (Status s = RequireUnpruned(*reader, "an export"); !s.ok()) return app::Fail(tool, s);
+    }
     if (reader.ok() && ExportStreams(*reader, output)) {
       depth = reader->depth();
       const std::uint32_t exported = level.value_or(depth);

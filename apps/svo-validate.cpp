@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
       "shared borders, the filter), contours, and with --mesh the voxels against an OpenVDB "
       "distance field of the surface and the contour slabs against sampled surface points.",
       tool};
-  std::filesystem::path input, mesh_path;
+  std::filesystem::path input, mesh_path, reference_path;
   app::MemoryLimitOption memory_limit;
   app::CommonOptions common;
   app::ImportCli import;
@@ -35,6 +35,9 @@ int main(int argc, char** argv) {
   app::AddFile(cli, "--mesh", mesh_path,
                "The mesh the octree was built from (.svm or any mesh file): enables the "
                "occupancy and contour-surface checks");
+  app::AddFile(cli, "--reference", reference_path,
+               "A pruned octree's full octree, the one it was pruned from (the same build without "
+               "--prune): enables its bricks and pruned-leaves checks");
   memory_limit.Add(cli,
                    "Bytes a paged file's pages and their checks (a page's distance field, its "
                    "neighbours' borders) hold at once, besides the mesh (default: a few pages per "
@@ -81,8 +84,15 @@ int main(int argc, char** argv) {
       }
       mesh = std::move(*m);
     }
+    std::optional<SvoReader> reference;
+    if (!reference_path.empty()) {
+      StatusOr<SvoReader> opened = SvoReader::Open(reference_path);
+      if (!opened.ok()) return app::Fail(tool, opened.status());
+      reference = std::move(*opened);
+    }
     validate::ValidateOptions options;
     options.mesh = mesh ? &*mesh : nullptr;
+    options.full = reference ? &*reference : nullptr;
     options.memory_limit = limit->value_or(0);
     StatusOr<validate::Report> checked =
         whole ? StatusOr<validate::Report>(

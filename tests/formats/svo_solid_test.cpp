@@ -579,7 +579,7 @@ TEST(SvoSolid, HeadFlagAndFullLeafStreamMustAgree) {
   ASSERT_FALSE(flagged.ok()) << "a solid without full-leaf masks";
   EXPECT_EQ(flagged.status().message().rfind("bad.svo: ", 0), 0u);
   // Unknown flags beside it are refused as before.
-  auto unknown = DecodeSvo(WithHeadFlags(solid, flags | 32), "bad.svo");
+  auto unknown = DecodeSvo(WithHeadFlags(solid, flags | 64), "bad.svo");
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.status().message().find("flags"), std::string::npos)
       << unknown.status().message();

@@ -158,5 +158,64 @@ TEST(SvoValidateCli, AnyMeshThatBuildsValidates) {
   }
 }
 
+// A pruned build: the same bytes whole and by pages, valid against the octree it was pruned from
+// (and its bricks unvouched for without it); refused where every voxel is needed, and refused
+// without bricks, for a solid and with a malformed tolerance, leaving no file.
+TEST(SvoValidateCli, PrunedOctreeValidatesAgainstItsFullOctree) {
+  const TempDir dir;
+  const std::string full = (dir / "full.svo").string(), pruned = (dir / "pruned.svo").string(),
+                    paged = (dir / "paged.svo").string();
+  const std::vector<std::string> build = {Torus(),        "-r",           "256",
+                                          "--attributes", "color,normal", "-q"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = build;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  ASSERT_EQ(RunTool("mesh2svo", with({"-o", full})).exit_code, 0);
+  ToolResult r = RunTool("mesh2svo", with({"-o", pruned, "--prune", "default", "--json"}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  EXPECT_GT(report["pruned"]["leaves"], 0);
+  EXPECT_LT(report["pruned"]["page_nodes_after"], report["pruned"]["page_nodes_before"]);
+  EXPECT_LT(report["pruned"]["chunk_bytes_after"], report["pruned"]["chunk_bytes_before"]);
+  r = RunTool("mesh2svo", with({"-o", paged, "--prune", "default", "--memory-limit", "16M"}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ReadText(paged), ReadText(pruned));
+
+  r = RunTool("svo-validate", {pruned, "--reference", full, "--json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["checks"]["bricks"]["status"], "passed");
+  EXPECT_EQ(j["checks"]["pruned_leaves"]["status"], "passed");
+  EXPECT_GT(j["checks"]["pruned_leaves"]["stats"]["leaves"], 0);
+  r = RunTool("svo-validate", {pruned, "--json", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["checks"]["pruned_leaves"]["status"], "skipped");
+  // The full octree as its own reference is refused: it is not pruned from anything.
+  r = RunTool("svo-validate", {pruned, "--reference", pruned, "-q"});
+  EXPECT_EQ(r.exit_code, 1);
+
+  const std::string ply = (dir / "x.ply").string();
+  r = RunTool("svo-export", {pruned, "-o", ply, "-q"});
+  EXPECT_EQ(r.exit_code, 2);
+  ASSERT_EQ(r.ErrLines().size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("pruned.svo: a pruned octree"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(ply));
+  const std::string refused = (dir / "refused.svo").string();
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--prune", "default", "--bricks", "none"},
+        {"--prune", "default", "--fill", "solid"},
+        {"--prune", "color=0.1,shape=2"}}) {
+    std::vector<std::string> args = with({"-o", refused});
+    args.insert(args.end(), bad.begin(), bad.end());
+    r = RunTool("mesh2svo", args);
+    EXPECT_EQ(r.exit_code, 2) << bad.back();
+    EXPECT_NE(r.err.find("--prune"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(refused));
+  }
+}
+
 }  // namespace
 }  // namespace svokit::test

@@ -17,7 +17,8 @@ MAGIC = b"\x89SVO\r\n\x1a\n"
 NEWEST_VERSION = 3
 
 FLAG_COLOR, FLAG_NORMAL, FLAG_CONTOURS, FLAG_SHARED_COLOR, FLAG_SOLID = 1, 2, 4, 8, 16
-_KNOWN_FLAGS = 31
+FLAG_PRUNED = 32
+_KNOWN_FLAGS = 63
 _STREAM_LIMIT, _CHUNK_LIMIT = 1 << 30, 4 << 30
 
 # Stream kinds of a chunk.
@@ -188,6 +189,7 @@ class SvoFile:
     has_normal = property(lambda self: bool(self.flags & FLAG_NORMAL))
     has_contours = property(lambda self: bool(self.flags & FLAG_CONTOURS))
     is_solid = property(lambda self: bool(self.flags & FLAG_SOLID))
+    is_pruned = property(lambda self: bool(self.flags & FLAG_PRUNED))
     has_ao = property(lambda self: "AOCC" in self._c.sections)
 
     def close(self):
@@ -254,10 +256,11 @@ class SvoFile:
             lv.full_masks = np.zeros(n, np.uint8) if full is None else np.frombuffer(full, np.uint8, n, used)
             if full is not None and len(full) != len(masks):
                 fail("full masks stream differs in size from the masks")
-            if self.is_solid:
-                if np.any((m == 0) & (lv.full_masks == 0)) or np.any(m & lv.full_masks):
-                    fail(f"level {level}: a node without children or a child both full and not")
-            elif np.any(m == 0):
+            # A node without children: a pruned leaf, or a solid's holding full leaves.
+            childless = (m == 0) & (lv.full_masks == 0)
+            if np.any(m & lv.full_masks):
+                fail(f"level {level}: a child both full and not")
+            if np.any(childless) and not self.is_pruned:
                 fail(f"level {level}: a node without children")
             used += n
             bits = np.unpackbits(m[:, None], axis=1, bitorder="little")
@@ -431,6 +434,14 @@ class SvoFile:
         xyz = codecs.morton_decode(keys)
         inside = np.all((xyz >= lo) & (xyz < lo + side), axis=1)
         near = np.all((xyz >= lo - 1) & (xyz <= lo + side), axis=1)
+        if self.is_pruned and np.any(inside):
+            # In a pruned octree a halo voxel may lie under one of the page's pruned leaves.
+            under = np.zeros(len(keys), bool)
+            for lv in chunk.levels[:-1]:
+                leaves = lv.keys[(lv.masks == 0) & (lv.full_masks == 0)]
+                shift = np.uint64(3 * (self.depth - lv.level))
+                under |= np.isin(keys >> shift, leaves)
+            inside &= ~under
         if np.any(inside) or not np.all(near):
             fail("halo keys inside the page or more than a voxel from it")
         chunk.halo_keys = keys
@@ -515,6 +526,14 @@ class SvoFile:
         ao = self.ao()
         out.ao = None if ao is None else ao[level]
         return out
+
+    def pruned_leaves(self, level):
+        """Keys of the pruned leaves of ``level``: nodes above the voxels without children, whose
+        brick and contour stand for the subtree pruning dropped."""
+        if not self.is_pruned or not 0 <= level < self.depth:
+            return np.zeros(0, np.uint64)
+        lv = self.level(level, bricks=False)
+        return lv.keys[(lv.masks == 0) & (lv.full_masks == 0)]
 
     def full_leaves(self, level):
         """Keys (at ``level``) of the full leaves among the children of level ``level`` − 1."""

@@ -279,6 +279,7 @@ StatusOr<AoBakeReport> BakeSvoAo(const AoBakeRequest& r, Progress& progress) {
   SVOKIT_RETURN_IF_ERROR(CheckOutputs(r, {}));
   StatusOr<SvoReader> reader = SvoReader::Open(r.input);
   if (!reader.ok()) return reader.status();
+  SVOKIT_RETURN_IF_ERROR(RequireUnpruned(*reader, "an ambient occlusion bake"));
   AoBakeReport report;
   report.depth = reader->depth();
   report.voxels = reader->NodeCount(reader->depth());

@@ -44,6 +44,10 @@ Json BuildJson(const BuildSettings& b) {
             {"contours", b.contours},
             {"compression", b.compression.zstd ? "zstd" : "none"}};
   if (b.compression.zstd) j["zstd_level"] = b.compression.level;
+  if (b.prune) {
+    j["prune"] = {
+        {"color", b.prune->color}, {"normal", b.prune->normal}, {"geometry", b.prune->geometry}};
+  }
   return j;
 }
 
@@ -109,6 +113,12 @@ std::optional<BuildSettings> ParseBuild(const Json& j) {
   b.contours = Member<bool>(j, "contours").value_or(false);
   b.compression.zstd = Member<std::string>(j, "compression") == "zstd";
   b.compression.level = static_cast<int>(Member<std::uint32_t>(j, "zstd_level").value_or(3));
+  if (const auto it = j.find("prune"); it != j.end() && it->is_object()) {
+    const std::optional<double> color = Member<double>(*it, "color"),
+                                normal = Member<double>(*it, "normal"),
+                                geometry = Member<double>(*it, "geometry");
+    if (color && normal && geometry) b.prune = PruneTolerances{*color, *normal, *geometry};
+  }
   return b;
 }
 

@@ -30,6 +30,7 @@ struct BuildSettings {
   std::uint32_t brick_side = 3;  ///< 3, 2 or 0 (no bricks)
   bool contours = true;
   SvoCompression compression;
+  std::optional<PruneTolerances> prune;  ///< variable-resolution leaves (svo/prune_tree.hpp)
   bool operator==(const BuildSettings&) const = default;
 };
 

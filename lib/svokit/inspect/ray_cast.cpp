@@ -258,6 +258,12 @@ class Caster {
     }
     const bool pages_below = level + 1 == page_level_;
     const SvoNode& node = svo.levels[level].nodes[index];
+    // A pruned leaf: its contour bounds the subtree pruning dropped, its brick (normals
+    // included: they are what the tolerances bound) shades it.
+    if (node.child_mask == 0 && node.full_mask == 0) {
+      Hit(svo, level, index, contour, lo, size, span, true);
+      return true;
+    }
     const double half = size * 0.5;
     Vec3d tm, t1;
     std::array<double, 3> t0{};
@@ -328,7 +334,7 @@ class Caster {
   }
 
   void Hit(const Svo& svo, std::uint32_t level, std::uint64_t index, std::uint32_t contour,
-           const Vec3d& lo, double size, const Span& span) {
+           const Vec3d& lo, double size, const Span& span, bool pruned_leaf = false) {
     hit_.hit = true;
     hit_.t = span.t0;
     hit_.level = level;
@@ -345,7 +351,9 @@ class Caster {
     // The leaf's own contour normal, else the filtered brick normal, else the face or slab the
     // span was entered through.
     Vec3d n = span.entry_normal;
-    if (contours_ && contour != 0) {
+    if (pruned_leaf && Length(brick.normal) > 0) {
+      n = brick.normal;
+    } else if (contours_ && contour != 0) {
       const Contour c = DecodeContour(contour);
       n = Normalized(
           Vec3d{static_cast<double>(c.nx), static_cast<double>(c.ny), static_cast<double>(c.nz)});

@@ -168,9 +168,14 @@ void MetadataLines(std::string& out, const SvoStats& st) {
   if (p.build) {
     const BuildSettings& b = *p.build;
     Line(out, "build",
-         fmt::format("bricks {}, contours {}, {}", b.brick_side, b.contours ? "on" : "off",
-                     b.compression.zstd ? fmt::format("zstd level {}", b.compression.level)
-                                        : std::string("stored")));
+         fmt::format(
+             "bricks {}, contours {}, {}{}", b.brick_side, b.contours ? "on" : "off",
+             b.compression.zstd ? fmt::format("zstd level {}", b.compression.level)
+                                : std::string("stored"),
+             b.prune
+                 ? fmt::format(", pruned to colour {:.4g}, normal {:.4g}, geometry {:.4g} voxels",
+                               b.prune->color, b.prune->normal, b.prune->geometry)
+                 : std::string()));
   }
   if (p.bake) {
     const BakeSettings& b = *p.bake;

@@ -101,6 +101,10 @@ struct Build {
 // or normals, so the smallest .svo) built into a scratch file beside the output, whole or by
 // pages as an octree would be, then reduced from it page by page and removed.
 StatusOr<MeshToSvoReport> MeshToDag(const MeshToSvoRequest& r, Progress& progress) {
+  if (r.build.prune) {
+    return Status::BadInput("{}: --prune makes an .svo's leaves coarser; a DAG holds every voxel",
+                            r.output.string());
+  }
   if (r.part) {
     return Status::BadInput(
         "{}: a DAG is made whole: build the parts as .svopart, join them with "
@@ -136,6 +140,16 @@ StatusOr<MeshToSvoReport> MeshToDag(const MeshToSvoRequest& r, Progress& progres
 
 StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progress) {
   if (IsDagPath(r.output)) return MeshToDag(r, progress);
+  if (r.build.prune && r.part) {
+    return Status::BadInput(
+        "{}: --prune builds on one machine (whole or by pages): joining parts checks each page "
+        "against its voxels, which pruning drops",
+        r.output.string());
+  }
+  if (r.build.prune && r.voxelize.settings.solid) {
+    return Status::BadInput("{}: --prune does not apply to solids (--fill solid)",
+                            r.output.string());
+  }
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {r.part ? "svopart" : "svo"}, r.input));
   StatusOr<FittedMesh> fitted =
       ImportAndFit(r.input, r.voxelize.grid, r.import, r.warn, r.strict, r.output, progress);
@@ -152,6 +166,7 @@ StatusOr<MeshToSvoReport> MeshToSvo(const MeshToSvoRequest& r, Progress& progres
   Build build{r, *mesh, *grid, ProvenanceJson(provenance), {}, report, progress};
   build.options.brick_side = r.build.brick_side;
   build.options.contours = r.build.contours;
+  build.options.prune = r.build.prune;
   // A solid's interior is decided by what the mesh is: exact crossings build by pages too, the
   // winding numbers of a surface with open edges only whole.
   std::unique_ptr<InteriorFinder> finder;

@@ -271,6 +271,8 @@ PagePlan::PagePlan(const BuildOptions& options, const std::string& metadata,
   frame_.shape.has_color = colors;
   frame_.shape.has_normal = normals;
   frame_.shape.has_contours = options.contours;
+  frame_.shape.pruned = options.prune.has_value();
+  frame_.prune = options.prune;
   if (shared_color) frame_.shape.shared_color = {*shared_color};
   frame_.metadata = metadata;
   page_level_ = PageLevel(frame_.depth());

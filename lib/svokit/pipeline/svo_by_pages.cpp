@@ -44,7 +44,10 @@ StatusOr<SvoFileStats> WritePages(const PagePlan& p, const BuildOptions& options
   };
   std::vector<Stored> stored;
   BuiltPages built;
-  const PagedSvoWriter alone(p.frame(), kAloneCompression);
+  // Pages are pruned once their faces are set, in the second pass.
+  SvoFrame alone_frame = p.frame();
+  alone_frame.prune.reset();
+  const PagedSvoWriter alone(alone_frame, kAloneCompression);
   SVOKIT_RETURN_IF_ERROR(p.Run(
       alone, 0, p.cells().size(),
       [&](PagedSvoWriter::EncodedPage page, std::vector<std::uint8_t> shell) -> Status {
@@ -78,6 +81,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const RegionVoxelizer& voxelizer,
                                        const std::filesystem::path& path,
                                        const SvoCompression& compression,
                                        std::uint64_t memory_limit, Progress& progress) {
+  SVOKIT_RETURN_IF_ERROR(CheckPruneOptions(options));
   StatusOr<std::unique_ptr<PagePlan>> plan =
       PagePlan::Make(voxelizer, options, metadata, memory_limit, progress);
   if (!plan.ok()) return plan.status();
@@ -90,6 +94,7 @@ StatusOr<SvoFileStats> BuildSvoByPages(const BoxVoxels& voxels, const Mesh* mesh
                                        const SvoCompression& compression,
                                        std::uint64_t memory_limit, Progress& progress) {
   if (voxels.cubes.empty()) return Status::BadInput("there are no voxels to build an octree of");
+  SVOKIT_RETURN_IF_ERROR(CheckPruneOptions(options));
   StatusOr<std::unique_ptr<PagePlan>> plan =
       PagePlan::Make(voxels, mesh, options, metadata, memory_limit, progress);
   if (!plan.ok()) return plan.status();

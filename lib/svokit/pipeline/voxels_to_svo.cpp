@@ -18,6 +18,7 @@ BuildOptions OptionsOf(const BuildSettings& build) {
   BuildOptions o;
   o.brick_side = build.brick_side;
   o.contours = build.contours;
+  o.prune = build.prune;
   return o;
 }
 

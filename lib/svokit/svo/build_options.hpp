@@ -3,10 +3,12 @@
 // inputs every builder refuses (reference_build.hpp, compact_build.hpp, the builds by pages).
 
 #include <cstdint>
+#include <optional>
 
 #include "svokit/core/status.hpp"
 #include "svokit/mesh/mesh.hpp"
 #include "svokit/svo/contour.hpp"
+#include "svokit/svo/svo_chunk.hpp"
 #include "svokit/voxelize/voxel_set.hpp"
 
 namespace svokit {
@@ -28,7 +30,13 @@ struct BuildOptions {
   /// A solid built by pages from the mesh: what decides each page's interior (by exact crossings;
   /// InteriorFinder::method() kColumns). Null: a surface, or `interior` holds it.
   const InteriorFinder* interior_finder = nullptr;
+  /// Variable-resolution leaves: each page pruned to these tolerances as it is written
+  /// (svo/prune_tree.hpp). Needs bricks; not for solids.
+  std::optional<PruneTolerances> prune;
 };
+
+/// What pruning refuses: no bricks, a solid.
+Status CheckPruneOptions(const BuildOptions& options);
 
 /// What every builder refuses: an empty voxel set, a brick side other than 3, 2 or 0, contours
 /// without the mesh, attribute arrays that do not match the voxels.

@@ -78,6 +78,8 @@ StatusOr<CompactSvo> BuildCompactSvo(VoxelSet voxels, const Mesh* mesh, const Bu
   frame.grid = voxels.grid;
   frame.mode = voxels.mode;
   frame.metadata = std::move(metadata);
+  frame.prune = options.prune;
+  shape.pruned = options.prune.has_value();
   shape.depth = OctreeDepth(voxels.grid);
   shape.brick_side = options.brick_side;
   // Without bricks the voxels' own colours and normals are still kept.

@@ -114,6 +114,19 @@ std::vector<std::uint64_t> KeysOfLevel(const MaskTree& tree, std::uint32_t level
   return std::move(TreeLevelKeys(tree, 0, level).back());
 }
 
+bool UnderPrunedLeaf(const MaskTree& tree, std::uint64_t key, std::uint32_t depth) {
+  std::uint64_t i = 0;
+  for (std::uint32_t l = tree.first_level; l < tree.last_level(); ++l) {
+    const std::size_t k = l - tree.first_level;
+    const std::uint8_t m = tree.masks[k][i];
+    if (m == 0) return tree.full.empty() || tree.full[k][i] == 0;
+    const unsigned c = static_cast<unsigned>(key >> (3 * (depth - l - 1)) & 7u);
+    if (!(m >> c & 1u)) return false;
+    i = static_cast<std::uint64_t>(tree.Child(l, i, c));
+  }
+  return false;
+}
+
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,
                                                             std::uint32_t depth) {
   std::vector<std::vector<std::uint64_t>> levels(depth + 1);

@@ -58,6 +58,10 @@ struct MaskTree {
   }
 };
 
+/// Whether voxel `key` (a Morton key at level `depth`, inside the tree's root) lies under a node
+/// of `tree` that has no children above the voxels: a pruned leaf (svo/prune_tree.hpp).
+bool UnderPrunedLeaf(const MaskTree& tree, std::uint64_t key, std::uint32_t depth);
+
 /// The node keys of every level, 0 (root) to depth (the voxels), each sorted ascending; the voxel
 /// level is `keys` itself (moved in, not copied, where the caller gives it up).
 std::vector<std::vector<std::uint64_t>> LevelKeysFromVoxels(std::vector<std::uint64_t> keys,

@@ -7,6 +7,7 @@
 // one chunk is a CompactSvo (compact_svo.hpp).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,25 @@ namespace svokit {
 struct SvoShape {
   std::uint32_t depth = 0, brick_side = 0;
   bool has_color = false, has_normal = false, has_contours = false;
-  bool solid = false;                  ///< nodes may have full leaves (MaskTree::full)
+  bool solid = false;  ///< nodes may have full leaves (MaskTree::full)
+  /// Nodes above the voxels may have no children: pruned leaves, whose subtree was dropped
+  /// because their brick and contour describe it within tolerances (svo/prune_tree.hpp).
+  bool pruned = false;
   std::vector<HalfRgba> shared_color;  ///< one entry, or empty
+};
+
+/// What a pruned leaf may differ by from the voxels below it (formats/svo.md, "Pruned leaves").
+struct PruneTolerances {
+  /// Per channel, between a voxel's colour and its leaf's brick interpolated at the voxel centre,
+  /// both as 8-bit sRGB (RGB) and linear (A) values on [0, 1]: ESVO's 16/256.
+  double color = 16.0 / 256.0;
+  /// 1 − cos of the angle between a voxel's normal and the brick's interpolated normal.
+  double normal = 0.01;
+  /// In voxels: every voxel centre within this of the leaf's region (its cube cut by its
+  /// contour slab), and every voxel cell of the region within this of a voxel below the leaf.
+  /// ESVO's one voxel diagonal, √3.
+  double geometry = 1.7320508075688772;
+  bool operator==(const PruneTolerances&) const = default;
 };
 
 /// What a file says of the whole octree, besides its chunks.
@@ -35,6 +53,9 @@ struct SvoFrame {
   VoxelMode mode = VoxelMode::kConservative;
   SvoShape shape;
   std::string metadata;  ///< the META section's JSON (svo_metadata.hpp in formats/svo reads it)
+  /// A pruned octree's tolerances (shape.pruned): a writer prunes each page to them
+  /// (svo/prune_tree.hpp), and META's `build` records them.
+  std::optional<PruneTolerances> prune;
 
   std::uint32_t depth() const { return shape.depth; }
 };

@@ -9,6 +9,8 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <tuple>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -19,6 +21,7 @@
 #include "svokit/svo/contour_range.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/validate/paged_detail.hpp"
+#include "svokit/validate/pruned_octree.hpp"
 #include "svokit/validate/validate.hpp"
 
 namespace svokit::validate {
@@ -43,6 +46,21 @@ std::uint64_t DistanceToCube(std::uint64_t key, std::uint32_t level, std::uint64
     d = std::max(d, at[a] < lo[a] ? lo[a] - at[a] : at[a] > hi ? at[a] - hi : 0);
   }
   return d;
+}
+
+// Whether voxel `key` lies under a node of `page` above the voxels that has no children there (a
+// pruned leaf): the deepest of its ancestors that the page holds.
+bool UnderChildlessNode(const PageLevels& page, std::uint64_t key) {
+  const std::uint32_t depth = page.first_level + static_cast<std::uint32_t>(page.keys.size()) - 1;
+  for (std::uint32_t l = depth; l-- > page.first_level;) {
+    const std::vector<std::uint64_t>& level = page.keys[l - page.first_level];
+    const std::uint64_t node = key >> 3 * (depth - l);
+    if (!std::binary_search(level.begin(), level.end(), node)) continue;
+    const std::vector<std::uint64_t>& below = page.keys[l - page.first_level + 1];
+    const auto child = std::lower_bound(below.begin(), below.end(), node << 3);
+    return child == below.end() || *child >> 3 != node;
+  }
+  return false;
 }
 
 // The nodes of `from` that `keep(level, key)` selects, with their bricks, words and attributes.
@@ -340,6 +358,8 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
                (holder->normals.empty() || chunk.halo_normals.empty() ||
                 holder->normals[i].bits == chunk.halo_normals[h].bits);
       }
+      // In a pruned octree a halo voxel may lie under a pruned leaf, which holds no voxels.
+      if (!same && shape_.pruned && holder != nullptr) same = UnderChildlessNode(*holder, key);
       if (!same) {
         r.halo.Add("halo", fmt::format("{}: page {}: halo voxel {} is not the voxel of its "
                                        "neighbour page",
@@ -375,7 +395,9 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
     }
   }
   // Bricks of the page's nodes, finest level first.
-  if (shape_.brick_side != 0 && has_page &&
+  // A pruned page's bricks are the full octree's, which its voxels no longer make: they are
+  // checked against that octree (CheckPrunedOctree).
+  if (shape_.brick_side != 0 && has_page && !shape_.pruned &&
       !BrickVoxelsMissing(local.svo, filter_, local.voxels())) {
     for (std::size_t k = levels; k-- > 0;) {
       const std::uint32_t level = page_level_ + static_cast<std::uint32_t>(k);
@@ -385,6 +407,9 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
       r.brick_counts.samples += n.samples;
       r.brick_counts.shared += n.shared;
     }
+  }
+  if (shape_.brick_side != 0 && has_page &&
+      (shape_.pruned || !BrickVoxelsMissing(local.svo, filter_, local.voxels()))) {
     const SvoLevel& lv = local.svo.levels[page_level_];
     const std::size_t s = local.first[page_level_] * samples_;
     r.root.node_count = 1;
@@ -395,7 +420,7 @@ StatusOr<PageResult> PagedValidator::CheckPage(std::size_t item) {
       r.root.normal.assign(lv.normal.begin() + s, lv.normal.begin() + s + samples_);
     }
   }
-  if (mesh_) r.mesh = mesh_->Check(cube, local);
+  if (mesh_ && !shape_.pruned) r.mesh = mesh_->Check(cube, local);
   return r;
 }
 
@@ -606,9 +631,15 @@ Report PagedValidator::Finish() {
       reader_.mode() == VoxelMode::kThin ? "thin" : "conservative", shape_.brick_side,
       color ? " colour" : "", normal ? " normal" : "", shape_.has_contours ? "yes" : "no");
   CheckResult bricks("bricks");
+  std::optional<CheckResult> leaves;
   const std::uint64_t voxels = counts_[depth_][0];
   const std::uint64_t colors = shape_.shared_color.empty() ? voxel_colors_ : 1;
-  if (shape_.brick_side == 0) {
+  if (shape_.pruned && options_.full != nullptr) {
+    std::tie(bricks, leaves) = CheckPrunedOctree(reader_, *options_.full, progress_);
+  } else if (shape_.pruned) {
+    bricks.Skip("a pruned octree's bricks are those of the octree it was pruned from: --reference");
+    leaves.emplace("pruned_leaves").Skip("needs --reference, the octree it was pruned from");
+  } else if (shape_.brick_side == 0) {
     bricks.Skip("no bricks");
   } else if (filter_ == 2 &&
              ((color && colors != 1 && colors != voxels) || (normal && voxel_normals_ != voxels))) {
@@ -619,6 +650,7 @@ Report PagedValidator::Finish() {
     bricks.Stat("shared_samples", brick_counts_.shared);
   }
   report.checks.push_back(std::move(bricks));
+  if (leaves) report.checks.push_back(std::move(*leaves));
   CheckResult contours("contours");
   if (!shape_.has_contours) {
     contours.Skip("no contours");
@@ -630,6 +662,13 @@ Report PagedValidator::Finish() {
   if (!mesh_) {
     report.checks.emplace_back("occupancy").Skip("needs --mesh");
     report.checks.emplace_back("contour_surface").Skip("needs --mesh");
+    return report;
+  }
+  if (shape_.pruned) {
+    // Pruning drops voxels within the tolerances: the full octree answers to the mesh.
+    for (const char* check : {"occupancy", "contour_surface"}) {
+      report.checks.emplace_back(check).Skip("a pruned octree: validate the full one with --mesh");
+    }
     return report;
   }
   report.checks.push_back(mesh_->Occupancy(mesh_totals_, counts_[depth_][0]));

@@ -19,6 +19,9 @@ struct ValidateOptions {
   /// ValidatePaged: bytes of pages and their checks held at once besides the mesh (0: a few pages
   /// per thread).
   std::uint64_t memory_limit = 0;
+  /// A pruned octree's full octree, the one it was pruned from (ValidatePaged): its bricks and
+  /// leaves are checked against it (pruned_octree.hpp).
+  const SvoReader* full = nullptr;
 };
 
 Report Validate(const LenientSvo& file, const std::string& name, const ValidateOptions& options,

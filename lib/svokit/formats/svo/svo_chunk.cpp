@@ -550,9 +550,10 @@ StatusOr<std::vector<std::uint64_t>> DecodeMasks(const StreamSet& set, const Svo
                                       masks.begin() + static_cast<std::ptrdiff_t>(at + nodes));
     at += nodes;
     std::uint64_t next = 0;
-    // A node without children is a solid's, holding full leaves (checked with the full masks).
+    // A node without children is a pruned leaf, or a solid's holding full leaves (checked with
+    // the full masks).
     for (const std::uint8_t m : level) {
-      if (m == 0 && !shape.solid) {
+      if (m == 0 && !shape.solid && !shape.pruned) {
         return Status::BadInput("{}: a node of level {} has no children", name,
                                 frame.root_level + k);
       }
@@ -587,7 +588,7 @@ Status DecodeFullMasks(const StreamSet& set, const SvoShape& shape, const ChunkF
           return Status::BadInput("{}: a node of level {} has a child that is both full and not",
                                   name, frame.root_level + k);
         }
-        if ((f[i] | level[i]) == 0) {
+        if ((f[i] | level[i]) == 0 && !shape.pruned) {
           return Status::BadInput("{}: a node of level {} has no children", name,
                                   frame.root_level + k);
         }
@@ -735,7 +736,8 @@ Status DecodeHalo(const StreamSet& set, const SvoShape& shape, const ChunkFrame&
         p != end) {
       return Status::BadInput("{}: halo keys are malformed or not increasing", name);
     }
-    // Each halo voxel lies outside the page, within one voxel of its cube.
+    // Each halo voxel lies outside the page, within one voxel of its cube; in a pruned octree
+    // it may also lie under one of the page's pruned leaves.
     const std::uint32_t shift = shape.depth - frame.root_level;
     const MortonCoord root = MortonDecode(frame.root_key);
     const std::int64_t size = std::int64_t{1} << shift;
@@ -747,6 +749,9 @@ Status DecodeHalo(const StreamSet& set, const SvoShape& shape, const ChunkFrame&
         const std::int64_t lo = r[a] * size, hi = lo + size;
         inside = inside && v[a] >= lo && v[a] < hi;
         near = near && v[a] >= lo - 1 && v[a] <= hi;
+      }
+      if (inside && shape.pruned && UnderPrunedLeaf(chunk.tree, key, shape.depth)) {
+        continue;
       }
       if (inside || !near || key >> (3 * shape.depth) != 0) {
         return Status::BadInput("{}: halo voxel {} is not next to the page", name, key);

@@ -26,6 +26,8 @@ inline constexpr std::uint32_t kMaxDepth = 20;
 inline constexpr std::uint32_t kHasColor = 1, kHasNormal = 2, kHasContours = 4;  // HEAD flags
 /// HEAD flag (version 2): the chunks carry full-leaf masks (a solid).
 inline constexpr std::uint32_t kSolid = 16;
+/// HEAD flag: nodes above the voxels may have no children (pruned leaves).
+inline constexpr std::uint32_t kPruned = 32;
 
 // Collects the issues of one decode. The strict readers stop at the first (Add returns false);
 // the lenient one records every issue (the first kMaxExamples messages of each kind) and goes on.

@@ -22,6 +22,7 @@
 #include "svokit/formats/provenance.hpp"
 #include "svokit/formats/svo/svo_chunk.hpp"
 #include "svokit/svo/compact_svo.hpp"
+#include "svokit/svo/prune_tree.hpp"
 #include "svokit/svo/svo.hpp"
 #include "svokit/svo/svo_chunk.hpp"
 
@@ -54,6 +55,10 @@ struct SvoFileStats {
   /// levels' arrays compressed together, so its stored bytes are shared among its levels in
   /// proportion to their decoded bytes. The frame belongs to no level.
   std::vector<std::vector<SvoSectionBytes>> levels;
+  /// A pruned octree's (SvoFrame::prune): what pruning dropped, and the chunks' stored bytes
+  /// (pages and top chunk) had they not been pruned.
+  PruneStats prune;
+  std::uint64_t unpruned_chunk_bytes = 0;
 };
 
 /// Writes a file as its pages arrive, in key order, from a build that may never hold
@@ -74,6 +79,8 @@ class PagedSvoWriter {
     std::vector<std::uint8_t> bytes;
     ChunkBytes stats;
     std::vector<std::array<std::uint64_t, 3>> levels;  ///< per level held: nodes, contours, samples
+    PruneStats prune;                                  ///< with SvoFrame::prune
+    std::uint64_t unpruned_bytes = 0;                  ///< the page's bytes before pruning
   };
   EncodedPage Encode(const SvoChunk& page) const;
 
@@ -102,6 +109,8 @@ class PagedSvoWriter {
   std::vector<std::uint64_t> keys_, sizes_;
   std::vector<std::array<std::uint64_t, 3>> levels_;
   ChunkBytes stats_bytes_, top_stats_;
+  PruneStats prune_;
+  std::uint64_t unpruned_bytes_ = 0;
   std::vector<std::uint8_t> head_, top_;
 };
 

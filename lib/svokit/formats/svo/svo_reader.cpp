@@ -295,4 +295,12 @@ SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape,
   return out;
 }
 
+Status RequireUnpruned(const SvoReader& reader, std::string_view what) {
+  if (!reader.shape().pruned) return Status::Ok();
+  return Status::BadInput(
+      "{}: a pruned octree (--prune) holds no voxels below its pruned leaves, and {} needs every "
+      "voxel: use the octree it was pruned from",
+      reader.name(), what);
+}
+
 }  // namespace svokit

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "svokit/core/box.hpp"
@@ -125,5 +126,9 @@ struct SvoChunkLevel {
 /// Level `level` of `chunk` (root_level ≤ level < root_level + levels_held()), bricks assembled;
 /// a page's voxel level computed from its voxels and halo.
 SvoChunkLevel AssembleChunkLevel(const SvoChunk& chunk, const SvoShape& shape, std::uint32_t level);
+
+/// Bad input naming the file when its octree is pruned (svo-build --prune): `what` (e.g. "an
+/// export") needs every voxel, and a pruned leaf holds none below it.
+Status RequireUnpruned(const SvoReader& reader, std::string_view what);
 
 }  // namespace svokit

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <iterator>
 #include <memory>
 #include <optional>
 
@@ -41,6 +42,7 @@ using svo_detail::kHead;
 using svo_detail::kMetadata;
 using svo_detail::kPages;
 using svo_detail::kPageTable;
+using svo_detail::kPruned;
 using svo_detail::kSharedColor;
 using svo_detail::kSolid;
 using svo_detail::kTop;
@@ -83,9 +85,16 @@ PagedSvoWriter::PagedSvoWriter(const SvoFrame& frame, const SvoCompression& comp
                    std::vector<std::uint8_t>(frame_.metadata.begin(), frame_.metadata.end()));
 }
 
-PagedSvoWriter::EncodedPage PagedSvoWriter::Encode(const SvoChunk& page) const {
+PagedSvoWriter::EncodedPage PagedSvoWriter::Encode(const SvoChunk& whole) const {
   EncodedPage out;
-  out.key = page.root_key;
+  out.key = whole.root_key;
+  std::optional<SvoChunk> pruned;
+  if (frame_.prune) {
+    out.unpruned_bytes = EncodeChunk(whole, frame_.shape, compression_).size();
+    pruned = whole;
+    out.prune = PrunePage(*pruned, frame_.shape, *frame_.prune);
+  }
+  const SvoChunk& page = pruned ? *pruned : whole;
   out.bytes = EncodeChunk(page, frame_.shape, compression_, &out.stats);
   for (std::uint32_t l = page_level_; l <= frame_.depth(); ++l) {
     out.levels.push_back(ChunkLevelCounts(page, l));
@@ -108,6 +117,8 @@ Status PagedSvoWriter::ProducePages(const container::Writer::Emit& emit) {
       for (int j = 0; j < 3; ++j) levels_[page_level_ + k][j] += page.levels[k][j];
     }
     stats_bytes_.Add(page.stats);
+    prune_.Add(page.prune);
+    unpruned_bytes_ += page.unpruned_bytes;
     return Status::Ok();
   });
 }
@@ -127,7 +138,7 @@ Status PagedSvoWriter::Finish() {
   head.Put(shape.brick_side);
   head.Put((shape.has_color ? kHasColor : 0) | (shape.has_normal ? kHasNormal : 0) |
            (shape.has_contours ? kHasContours : 0) | (shared ? kSharedColor : 0) |
-           (shape.solid ? kSolid : 0));
+           (shape.solid ? kSolid : 0) | (shape.pruned ? kPruned : 0));
   head.Put(page_level_);
   head.Put(static_cast<std::uint64_t>(keys_.size()));
   head.Put(shared ? shape.shared_color[0] : HalfRgba(0, 0, 0, 0));
@@ -149,6 +160,8 @@ SvoFileStats PagedSvoWriter::Stats(std::uint64_t file_bytes) const {
   svo_detail::SetPageSizes(sizes_, stats);
   for (const auto& [name, v] : all.by_name) stats.sections.push_back({name, v.second, v.first});
   svo_detail::CompleteStats(file_bytes, stats);
+  stats.prune = prune_;
+  stats.unpruned_chunk_bytes = frame_.prune ? unpruned_bytes_ + top_.size() : 0;
   return stats;
 }
 
@@ -255,7 +268,7 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   }
   const std::uint32_t side = v.shape.brick_side;
   if ((side != 0 && side != 2 && side != 3) ||
-      (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor | kSolid)) ||
+      (flags & ~(kHasColor | kHasNormal | kHasContours | kSharedColor | kSolid | kPruned)) ||
       ((flags & kSharedColor) && !(flags & kHasColor)) || codec > 1) {
     return bad_head(
         fmt::format("brick side {}, flags {:#x} or codec {} are invalid", side, flags, codec));
@@ -264,6 +277,7 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   v.shape.has_normal = flags & kHasNormal;
   v.shape.has_contours = flags & kHasContours;
   v.shape.solid = flags & kSolid;
+  v.shape.pruned = flags & kPruned;
   if (flags & kSharedColor) v.shape.shared_color = {shared};
   if (v.page_level >= depth && !(v.page_level == 0 && depth == 0)) {
     return bad_head(
@@ -393,9 +407,22 @@ struct PageVoxels {
     OctNormal normal;
   };
   std::vector<Halo> halos;
+  /// A pruned octree's pruned leaves, as the ranges of voxel keys below them, ascending.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> pruned;
 
-  void Add(std::size_t p, const SvoChunk& page) {
+  void Add(std::size_t p, const SvoChunk& page, const SvoShape& shape) {
     for (const std::uint64_t key : ChunkVoxelKeys(page)) keys.push_back(key);
+    if (shape.pruned) {
+      const auto levels = TreeLevelKeys(page.tree, page.root_key, shape.depth);
+      for (std::uint32_t l = page.root_level; l < shape.depth; ++l) {
+        const std::vector<std::uint8_t>& masks = page.tree.masks[l - page.root_level];
+        const std::uint32_t shift = 3 * (shape.depth - l);
+        for (std::size_t i = 0; i < masks.size(); ++i) {
+          const std::uint64_t key = levels[l - page.root_level][i];
+          if (masks[i] == 0) pruned.push_back({key << shift, (key + 1) << shift});
+        }
+      }
+    }
     colors.insert(colors.end(), page.colors.begin(), page.colors.end());
     normals.insert(normals.end(), page.normals.begin(), page.normals.end());
     for (std::size_t h = 0; h < page.halo_keys.size(); ++h) {
@@ -431,7 +458,7 @@ bool AppendPages(const Version2& v, std::uint32_t last, const std::string& name,
         continue;
       }
       pages.push_back(&**decoded[i]);
-      if (last == v.shape.depth) voxels.Add(p, **decoded[i]);
+      if (last == v.shape.depth) voxels.Add(p, **decoded[i], v.shape);
     }
     assembler.Append(pages);
     for (std::size_t i = 0; i < count; ++i) decoded[i].reset();
@@ -503,10 +530,18 @@ bool CheckFullLeavesInGrid(const Version2& v, const Svo& svo, const std::string&
   return consistent;
 }
 
-// A page's halo voxels are voxels of other pages, with their attributes.
-bool CheckHalos(const PageVoxels& voxels, const std::string& name, IssueSink& sink) {
+// A page's halo voxels are voxels of other pages, with their attributes, or in a pruned octree
+// lie under a pruned leaf.
+bool CheckHalos(PageVoxels& voxels, const std::string& name, IssueSink& sink) {
   bool consistent = true;
+  std::sort(voxels.pruned.begin(), voxels.pruned.end());
+  const auto under_pruned_leaf = [&](std::uint64_t key) {
+    const auto it = std::upper_bound(voxels.pruned.begin(), voxels.pruned.end(),
+                                     std::pair{key, ~std::uint64_t{0}});
+    return it != voxels.pruned.begin() && key < std::prev(it)->second;
+  };
   for (const PageVoxels::Halo& h : voxels.halos) {
+    if (under_pruned_leaf(h.key)) continue;
     const auto it = std::lower_bound(voxels.keys.begin(), voxels.keys.end(), h.key);
     const std::size_t i = static_cast<std::size_t>(it - voxels.keys.begin());
     const bool same = it != voxels.keys.end() && *it == h.key &&
