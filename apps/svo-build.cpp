@@ -5,6 +5,7 @@
 
 #include "apps/chain_options.hpp"
 #include "apps/cli.hpp"
+#include "apps/dag_cli.hpp"
 #include "apps/import_cli.hpp"
 #include "apps/run.hpp"
 #include "apps/summary.hpp"
@@ -29,10 +30,15 @@ void PrintSummary(const VoxelsToSvoRequest& request, const OctreeReport& octree,
            fmt::format("depth {}, bricks {}, contours {}{}", octree.depth, bricks,
                        request.build.contours ? "on" : "off",
                        octree.memory.by_pages() ? ", by pages " + octree.memory.WithinText() : ""));
-  app::AddOctreeSummary(out, octree, request.output);
-  if (octree.memory.by_pages()) app::AddTimes(out, progress);
+  if (octree.dag) {  // the octree was a scratch file on the way
+    app::AddDagSummary(out, *octree.dag);
+    app::AddTimes(out, progress);
+  } else {
+    app::AddOctreeSummary(out, octree, request.output);
+    if (octree.memory.by_pages()) app::AddTimes(out, progress);
+  }
   if (!request.mesh.empty()) out.Line("warnings", warnings, fmt::format("{}", warnings));
-  app::AddOutput(out, request.output, octree.file.file_bytes);
+  app::AddOutput(out, request.output, octree.dag ? octree.dag->file_bytes : octree.file.file_bytes);
   out.Print();
 }
 
@@ -52,10 +58,14 @@ int main(int argc, char** argv) {
   app::ImportCli import;
   app::AddFile(cli, "input", request.input, "Voxel fragment list (.vfrag from svo-voxelize)")
       ->required();
-  app::AddFile(cli, "-o,--output", request.output, "Output .svo")->required();
+  app::AddFile(cli, "-o,--output", request.output,
+               "Output .svo, or a sparse voxel DAG of the geometry: HashDAG .dag.bin, SymVox "
+               ".svdag or .ssvdag, as svo-export writes them")
+      ->required();
   app::AddFile(cli, "--mesh", request.mesh,
                "The mesh that was voxelized (.svm or any mesh file), for the contours");
   build.Add(cli);
+  app::AddDagColorsOption(cli, request.dag_colors);
   memory_limit.Add(cli,
                    "Build page by page (128³-voxel subtrees) within SIZE bytes besides the mesh "
                    "(K, M, G suffixes), reading the .vfrag a page at a time: any size, the same "
@@ -69,7 +79,7 @@ int main(int argc, char** argv) {
     if (!settings.ok()) return fail(settings.status());
     StatusOr<std::optional<std::uint64_t>> limit = memory_limit.Bytes();
     if (!limit.ok()) return fail(limit.status());
-    if (build.contours && request.mesh.empty()) {
+    if (build.contours && request.mesh.empty() && !IsDagPath(request.output)) {
       return fail(
           Status::BadInput("{}: contours are fitted to the surface: give the voxelized "
                            "mesh with --mesh, or --no-contours",

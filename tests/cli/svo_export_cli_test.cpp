@@ -135,6 +135,21 @@ TEST(SvoExportCli, DagsFromTheOctreeAndStraightFromTheMesh) {
                 "torus.svo", "exported.dag.bin", "exported.uncompressed_colors.bin",
                 "exported.svdag", "exported.dagcolors", "direct.dag.bin",
                 "direct.uncompressed_colors.bin", "direct.svdag", "direct.dagcolors"}));
+  // svo-build makes the same DAG from the voxels, whole or by pages, and needs no mesh for it.
+  TempDir built;
+  const std::string vfrag = (built / "torus.vfrag").string();
+  ASSERT_EQ(RunTool("svo-voxelize", {mesh, "-r", "96", "-o", vfrag, "-q"}).exit_code, 0);
+  for (const std::vector<std::string>& more :
+       {std::vector<std::string>{}, {"--memory-limit", "48M", "--threads", "1"}}) {
+    std::vector<std::string> args = {vfrag, "-o", (built / "built.svdag").string(), "-q"};
+    args.insert(args.end(), more.begin(), more.end());
+    const ToolResult b = RunTool("svo-build", args);
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    EXPECT_EQ(ReadText(built / "built.svdag"), ReadText(out / "exported.svdag"));
+    EXPECT_EQ(ReadText(built / "built.dagcolors"), ReadText(out / "exported.dagcolors"));
+  }
+  EXPECT_EQ(FilesIn(built.path()),
+            (std::set<std::string>{"torus.vfrag", "built.svdag", "built.dagcolors"}));
   // A DAG is made whole, not by parts.
   TempDir parts;
   const ToolResult p = RunTool(

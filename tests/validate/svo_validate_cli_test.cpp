@@ -179,7 +179,7 @@ TEST(SvoValidateCli, PrunedOctreeValidatesAgainstItsFullOctree) {
   EXPECT_GT(report["pruned"]["leaves"], 0);
   EXPECT_LT(report["pruned"]["page_nodes_after"], report["pruned"]["page_nodes_before"]);
   EXPECT_LT(report["pruned"]["chunk_bytes_after"], report["pruned"]["chunk_bytes_before"]);
-  r = RunTool("mesh2svo", with({"-o", paged, "--prune", "default", "--memory-limit", "16M"}));
+  r = RunTool("mesh2svo", with({"-o", paged, "--prune", "default", "--memory-limit", "24M"}));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(ReadText(paged), ReadText(pruned));
 

@@ -91,15 +91,45 @@ struct OctreeReport {
   std::string level_table;                  ///< built whole: LevelTable()
   SvoFileStats file;
   MemoryPlan memory;  ///< by pages when memory.by_pages()
+  /// svo-build -o a DAG: the DAG written (`file`: the scratch octree it came from).
+  std::optional<DagExport> dag;
 };
 
+/// A DAG (`output`: .dag.bin, .svdag or .ssvdag) through a scratch octree beside it: `build`
+/// writes the octree to the path it is given, the DAG is reduced from it page by page within
+/// `memory_limit` (0: none) and the octree is removed, whatever happened.
+StatusOr<DagExport> DagThroughScratchOctree(
+    const std::filesystem::path& output, std::uint64_t memory_limit, DagColorFile colors,
+    const std::function<Status(const std::filesystem::path&)>& build, Progress& progress);
+/// The same, `build` returning its report, which gets the DAG's as its `dag`.
+template <class Report>
+StatusOr<Report> ReportThroughScratchOctree(
+    const std::filesystem::path& output, std::uint64_t memory_limit, DagColorFile colors,
+    const std::function<StatusOr<Report>(const std::filesystem::path&)>& build,
+    Progress& progress) {
+  std::optional<Report> report;
+  StatusOr<DagExport> dag = DagThroughScratchOctree(
+      output, memory_limit, colors,
+      [&](const std::filesystem::path& path) -> Status {
+        StatusOr<Report> made = build(path);
+        if (!made.ok()) return made.status();
+        report = std::move(*made);
+        return Status::Ok();
+      },
+      progress);
+  if (!dag.ok()) return dag.status();
+  report->dag = std::move(*dag);
+  return std::move(*report);
+}
+
 struct VoxelsToSvoRequest {
-  std::filesystem::path input;  ///< a .vfrag
-  std::filesystem::path mesh;   ///< the mesh that was voxelized (for contours); may be empty
-  std::filesystem::path output;
+  std::filesystem::path input;   ///< a .vfrag
+  std::filesystem::path mesh;    ///< the mesh that was voxelized (for contours); may be empty
+  std::filesystem::path output;  ///< .svo, or a DAG (.dag.bin, .svdag, .ssvdag)
   BuildSettings build;
   std::optional<std::uint64_t> memory_limit;
-  WarningSink warn;      ///< the mesh's import warnings
+  DagColorFile dag_colors = DagColorFile::kDefault;  ///< a DAG's colour file
+  WarningSink warn;                                  ///< the mesh's import warnings
   ImportOptions import;  ///< where the mesh's side files may be read from
   bool strict = false;   ///< any warning is an error: nothing is written
 };

@@ -1,8 +1,6 @@
 // mesh2svo's run: a mesh to an octree in one process — whole, by pages within a memory limit, or
 // one part of a build by pages — the same file as svo-voxelize and svo-build; or to a DAG.
 
-#include <unistd.h>
-
 #include <memory>
 
 #include <fmt/format.h>
@@ -113,27 +111,16 @@ StatusOr<MeshToSvoReport> MeshToDag(const MeshToSvoRequest& r, Progress& progres
   }
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"dag.bin", "svdag", "ssvdag"}, r.input));
   MeshToSvoRequest octree = r;
-  octree.output =
-      r.output.parent_path() / fmt::format(".{}.{}.svo", r.output.filename().string(), ::getpid());
   octree.build.brick_side = 0;
   octree.build.contours = false;
   octree.voxelize.settings.normals = false;
-  struct Scratch {
-    std::filesystem::path path;
-    ~Scratch() {
-      std::error_code ec;
-      std::filesystem::remove(path, ec);
-    }
-  } scratch{octree.output};
-  StatusOr<MeshToSvoReport> report = MeshToSvo(octree, progress);
-  if (!report.ok()) return report.status();
-  StatusOr<SvoReader> reader = SvoReader::Open(octree.output);
-  if (!reader.ok()) return reader.status();
-  StatusOr<DagExport> dag = ExportDag(
-      *reader, r.output, {reader->depth(), r.memory_limit.value_or(0), r.dag_colors}, progress);
-  if (!dag.ok()) return dag.status();
-  report->dag = std::move(*dag);
-  return report;
+  return ReportThroughScratchOctree<MeshToSvoReport>(
+      r.output, r.memory_limit.value_or(0), r.dag_colors,
+      [&](const std::filesystem::path& path) {
+        octree.output = path;
+        return MeshToSvo(octree, progress);
+      },
+      progress);
 }
 
 }  // namespace

@@ -293,11 +293,12 @@ Status PagePlan::SetSolid(const BuildOptions& options) {
 
 // How many pages may be in flight: held whatever the page, `fixed` bytes (the snapped mesh
 // and `what`); then each page in flight, at most a surface's voxels across its cube with their
-// attributes and nodes (~40 B a voxel; with bricks, their samples too).
+// attributes and nodes (~40 B a voxel; with bricks, their samples too; pruned, the page's
+// assembled bricks, keys and the pruned copy besides).
 // The top levels' contours are fitted before the pages, to all triangles at once (~320 B a
 // triangle at their peak).
 Status PagePlan::SetLimit(std::uint64_t fixed, std::uint64_t memory_limit, const char* what) {
-  const std::uint64_t per_voxel = frame_.shape.brick_side == 0 ? 40 : 160;
+  const std::uint64_t per_voxel = frame_.shape.brick_side == 0 ? 40 : (frame_.prune ? 320 : 160);
   const std::uint64_t page = per_voxel * 4 << (2 * bits_);
   const std::uint64_t top =
       contours_ && page_level_ > 0 ? std::uint64_t{320} * mesh_->triangles.size() : 0;

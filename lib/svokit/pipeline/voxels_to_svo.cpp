@@ -100,9 +100,30 @@ StatusOr<OctreeReport> BuildWhole(const VoxelsToSvoRequest& r, BuildOptions opti
   return report;
 }
 
+// A DAG of the voxels: their octree without bricks or contours into a scratch file, reduced.
+StatusOr<OctreeReport> VoxelsToDag(const VoxelsToSvoRequest& r, Progress& progress) {
+  if (r.build.prune) {
+    return Status::BadInput("{}: --prune makes an .svo's leaves coarser; a DAG holds every voxel",
+                            r.output.string());
+  }
+  SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"dag.bin", "svdag", "ssvdag"}, r.input));
+  VoxelsToSvoRequest octree = r;
+  octree.build.brick_side = 0;
+  octree.build.contours = false;
+  octree.mesh.clear();
+  return ReportThroughScratchOctree<OctreeReport>(
+      r.output, r.memory_limit.value_or(0), r.dag_colors,
+      [&](const std::filesystem::path& path) {
+        octree.output = path;
+        return VoxelsToSvo(octree, progress);
+      },
+      progress);
+}
+
 }  // namespace
 
 StatusOr<OctreeReport> VoxelsToSvo(const VoxelsToSvoRequest& r, Progress& progress) {
+  if (IsDagPath(r.output)) return VoxelsToDag(r, progress);
   SVOKIT_RETURN_IF_ERROR(CheckOutputPath(r.output, {"svo"}, r.input));
   SVOKIT_RETURN_IF_ERROR(CheckNotAnInput(r.output, {r.mesh}));
   StatusOr<std::optional<InteriorCubes>> interior = ReadVfragInterior(r.input);

@@ -329,8 +329,8 @@ class PagePruner {
   }
 
   // The page without the dropped nodes: masks (a leaf's 0), contours, samples laid out again
-  // over the kept nodes, the kept voxels, and the halo with the dropped voxels next to a kept
-  // one. Returns how many voxels joined the halo.
+  // over the kept nodes, the kept voxels, and as the halo the voxels next to a kept one that it
+  // no longer holds (its halo's and its dropped ones). Returns how many dropped voxels joined.
   std::uint64_t Rebuild(const std::vector<std::vector<NodeState>>& state) {
     SvoChunk out;
     out.root_level = page_.root_level;
@@ -396,11 +396,16 @@ class PagePruner {
       if (per_voxel_colors) added_colors.push_back(page_.colors[i]);
       if (shape_.has_normal) added_normals.push_back(page_.normals[i]);
     }
-    // Both halves are ascending and disjoint: merge them.
+    // Both halves are ascending and disjoint: merge them, keeping of the page's own halo only
+    // the voxels a kept voxel still reads.
     std::size_t a = 0, b = 0;
     while (a < page_.halo_keys.size() || b < added.size()) {
       const bool old =
           b == added.size() || (a < page_.halo_keys.size() && page_.halo_keys[a] < added[b]);
+      if (old && !NextToKept(kept, Coord(page_.halo_keys[a]))) {
+        ++a;
+        continue;
+      }
       out.halo_keys.push_back(old ? page_.halo_keys[a] : added[b]);
       if (per_voxel_colors) out.halo_colors.push_back(old ? page_.halo_colors[a] : added_colors[b]);
       if (shape_.has_normal)
