@@ -63,7 +63,8 @@ class Report {
 /// The octree part of svo-build's, mesh2svo's and svo-merge's report: what each kind of array
 /// takes in the file (stored and decoded, per voxel) and the pages.
 inline void AddFileSummary(Report& report, const SvoFileStats& stats) {
-  const double voxels = static_cast<double>(stats.voxels);
+  // A pruned octree may keep no voxels: its bytes are then shown per one.
+  const double voxels = static_cast<double>(std::max<std::uint64_t>(stats.voxels, 1));
   std::string table =
       fmt::format("{:<14} {:>12} {:>12} {:>11}\n", "section", "stored B", "raw B", "B/voxel");
   Json sections = Json::array();

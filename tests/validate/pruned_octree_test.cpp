@@ -30,8 +30,8 @@ namespace {
 
 // The textured torus at `resolution` with colour and normal, 3³ bricks and contours, pruned to
 // `prune` when given (META records the build as the tools do).
-std::vector<std::uint8_t> TorusFile(std::uint32_t resolution,
-                                    std::optional<PruneTolerances> prune) {
+std::vector<std::uint8_t> TorusFile(std::uint32_t resolution, std::optional<PruneTolerances> prune,
+                                    bool contours = true) {
   static const Mesh mesh = [] {
     auto m = ImportMesh(test::DataDir() / "uv-torus.obj");
     EXPECT_TRUE(m.ok()) << m.status().message();
@@ -44,9 +44,10 @@ std::vector<std::uint8_t> TorusFile(std::uint32_t resolution,
   EXPECT_TRUE(voxels.ok());
   BuildOptions bo;
   bo.prune = prune;
+  bo.contours = contours;
   Provenance provenance;
   provenance.source = "uv-torus.obj";
-  provenance.build = BuildSettings{3, true, {}, prune};
+  provenance.build = BuildSettings{3, contours, {}, prune};
   auto svo = BuildCompactSvo(std::move(*voxels), &mesh, bo, ProvenanceJson(provenance));
   EXPECT_TRUE(svo.ok()) << svo.status().message();
   return EncodeSvo(*svo);
@@ -162,6 +163,20 @@ TEST(PrunedOctree, TheValidatorFindsLeavesBeyondTheRecordedTolerances) {
   auto [wrong, skipped] = CheckPrunedOctree(p, o, Progress::Silent());
   EXPECT_EQ(wrong.state, CheckResult::State::kFailed);
   EXPECT_EQ(skipped.state, CheckResult::State::kSkipped);
+}
+
+// Without contours a leaf's region is its whole cube: only nodes whose cube its voxels fill to
+// within the geometric tolerance become leaves.
+TEST(PrunedOctree, WithoutContoursLeavesAreTheirCubes) {
+  const std::vector<std::uint8_t> full = TorusFile(128, std::nullopt, false);
+  const std::vector<std::uint8_t> pruned = TorusFile(128, PruneTolerances{}, false);
+  const SvoReader f = Open(full, "full.svo"), p = Open(pruned, "pruned.svo");
+  auto [bricks, leaves] = CheckPrunedOctree(p, f, Progress::Silent());
+  EXPECT_EQ(bricks.state, CheckResult::State::kPassed);
+  EXPECT_EQ(leaves.state, CheckResult::State::kPassed) << leaves.note;
+  ASSERT_EQ(leaves.stats.size(), 1u);
+  EXPECT_GT(leaves.stats[0].second, 0u);
+  EXPECT_LT(p.NodeCount(p.depth()), f.NodeCount(f.depth()));
 }
 
 TEST(PrunedOctree, SameBytesAtAnyThreadCount) {

@@ -156,7 +156,9 @@ class SvoFile:
             c.fail(f"page level {page_level} not below depth {depth}")
         counts = np.frombuffer(head[40:], dtype="<u8").reshape(level_count, 3)
         for level, (nodes, contours, _) in enumerate(counts):
-            if not 1 <= nodes <= 8 ** level or contours > nodes:
+            # Below the page level a pruned octree's level may be empty: its leaves lie above.
+            least = 0 if flags & FLAG_PRUNED and level > page_level else 1
+            if not least <= nodes <= 8 ** level or contours > nodes:
                 c.fail(f"level {level}: {nodes} nodes, {contours} contours")
             if contours and not flags & FLAG_CONTOURS:
                 c.fail(f"level {level} has contours without the contour flag")

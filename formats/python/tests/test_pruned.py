@@ -24,6 +24,8 @@ from tool_env import env_path  # noqa: E402
 CASES = [
     ("torus", ("SVOKIT_DATA_DIR", "uv-torus.obj"), ["-r", "300", "--attributes", "color,normal"]),
     ("armadillo", ("SVOKIT_CGAL_MESHES", "armadillo.off"), ["-r", "200"]),
+    # Geometry alone: every 2³ node meets √3, so no voxel is kept and the voxel level is empty.
+    ("armadillo-geometry", ("SVOKIT_CGAL_MESHES", "armadillo.off"), ["-r", "200", "--attributes", "none"]),
 ]
 
 

@@ -192,7 +192,9 @@ class PagePruner {
         return false;
       }
     }
-    const std::uint32_t word = page_.contours[l - first_][i];
+    // Without contours a chunk's levels may hold no words: the region is the whole cube.
+    const std::vector<std::uint32_t>& words = page_.contours[l - first_];
+    const std::uint32_t word = words.empty() ? 0 : words[i];
     for (auto it = begin; it != end; ++it) {
       if (DistanceToSlab(word, min, size, Coord(*it)) > t_.geometry) return false;
     }
@@ -347,7 +349,9 @@ class PagePruner {
     for (std::uint32_t k = 0; k < state.size(); ++k) {
       std::vector<std::uint32_t>& words = out.contours.emplace_back();
       for (std::size_t i = 0; i < state[k].size(); ++i) {
-        if (state[k][i] != NodeState::kDropped) words.push_back(page_.contours[k][i]);
+        if (state[k][i] != NodeState::kDropped && !page_.contours[k].empty()) {
+          words.push_back(page_.contours[k][i]);
+        }
       }
     }
     const std::uint32_t samples = side_ * side_ * side_;

@@ -113,7 +113,9 @@ class PageCheck {
       }
       for (std::size_t j = 0; j < kept[k].size(); ++j) {
         const std::size_t i = kept[k][j];
-        bool same = p.contours[k][j] == f.contours[k][i];
+        // Without contours a chunk's levels may hold no words.
+        const std::uint32_t word = f.contours[k].empty() ? 0 : f.contours[k][i];
+        bool same = (p.contours[k].empty() ? 0 : p.contours[k][j]) == word;
         if (k + 1 < fk.size()) {
           const std::uint8_t m = p.tree.masks[k][j];
           same = same && (m == 0 || m == f.tree.masks[k][i]);
@@ -136,7 +138,8 @@ class PageCheck {
       } else {
         for (const auto& [l, i] : leaves) {
           if (l == level)
-            CheckLeaf(pb, j_of(kept[k], i), l, fk[k][i], f.contours[k][i], f, fk.back());
+            CheckLeaf(pb, j_of(kept[k], i), l, fk[k][i],
+                      f.contours[k].empty() ? 0 : f.contours[k][i], f, fk.back());
         }
       }
     }

@@ -292,8 +292,10 @@ StatusOr<Version2> ParseVersion2(const container::Frame& file, IssueSink& sink) 
   for (std::uint32_t l = 0; l <= depth; ++l) {
     const auto [nodes, contours, samples] = v.levels[l];
     const std::uint64_t limit = l >= 21 ? ~std::uint64_t{0} : std::uint64_t{1} << (3 * l);
-    if (nodes == 0 || nodes > limit || contours > nodes || (l == 0 && nodes != 1) ||
-        (!v.shape.has_contours && contours != 0)) {
+    // Below the page level a pruned octree's level may be empty: its leaves all lie above.
+    const bool may_be_empty = v.shape.pruned && l > v.page_level;
+    if ((nodes == 0 && !may_be_empty) || nodes > limit || contours > nodes ||
+        (l == 0 && nodes != 1) || (!v.shape.has_contours && contours != 0)) {
       return bad_head(fmt::format("level {} counts ({} nodes, {} contours) are impossible", l,
                                   nodes, contours));
     }
