@@ -9,7 +9,6 @@ import json
 import pathlib
 import subprocess
 import sys
-import tempfile
 import unittest
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -20,7 +19,7 @@ import numpy as np  # noqa: E402
 
 import svokit  # noqa: E402
 from compare import check  # noqa: E402
-from tool_env import env_path  # noqa: E402
+from tool_env import ToolCase, env_path  # noqa: E402
 
 
 # name, mesh (folder variable, file), mesh2svo options, then svo-bake options (None: no bake).
@@ -36,23 +35,14 @@ CASES = [
 ]
 
 
-class CppReaders(unittest.TestCase):
+class CppReaders(ToolCase):
     @classmethod
     def setUpClass(cls):
-        cls.bin = env_path("SVOKIT_BIN_DIR")
+        super().setUpClass()
         cls.dump = env_path("SVOKIT_FORMAT_DUMP")
-        cls.tmp = tempfile.TemporaryDirectory()
-        cls.dir = pathlib.Path(cls.tmp.name)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
 
     def make(self, name, mesh, options, bake):
-        folder, file = mesh
-        mesh_path = env_path(folder) / file
-        if not mesh_path.exists():
-            self.fail(f"test mesh {mesh_path} is missing (scripts/deps --test-data)")
+        mesh_path = self.mesh(*mesh)
         out = self.dir / f"{name}.svo"
         subprocess.run([str(self.bin / "mesh2svo"), str(mesh_path), "-o", str(out), "-q", *options],
                        check=True)

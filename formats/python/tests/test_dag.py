@@ -7,9 +7,7 @@ Needs SVOKIT_BIN_DIR, SVOKIT_DATA_DIR and SVOKIT_CGAL_MESHES, as ctest sets them
 """
 
 import pathlib
-import subprocess
 import sys
-import tempfile
 import unittest
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -20,7 +18,7 @@ import numpy as np  # noqa: E402
 
 import svokit  # noqa: E402
 from svokit import codecs, dag  # noqa: E402
-from tool_env import env_path  # noqa: E402
+from tool_env import ToolCase  # noqa: E402
 
 
 # name, mesh (folder variable, file), mesh2svo options, levels exported (None: the voxels).
@@ -65,27 +63,10 @@ def counts_below(words, visits, leaf_counts):
     return counts
 
 
-class DagFiles(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.bin = env_path("SVOKIT_BIN_DIR")
-        cls.tmp = tempfile.TemporaryDirectory()
-        cls.dir = pathlib.Path(cls.tmp.name)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
-
-    def run_tool(self, *args):
-        subprocess.run([str(self.bin / args[0]), *map(str, args[1:]), "-q"], check=True)
-
+class DagFiles(ToolCase):
     def make(self, name, mesh, options):
-        folder, file = mesh
-        mesh_path = env_path(folder) / file
-        if not mesh_path.exists():
-            self.fail(f"test mesh {mesh_path} is missing (scripts/deps --test-data)")
         out = self.dir / f"{name}.svo"
-        self.run_tool("mesh2svo", mesh_path, "-o", out, *options)
+        self.run_tool("mesh2svo", self.mesh(*mesh), "-o", out, *options)
         return out
 
     def check_hashdag(self, f, path, level, want):

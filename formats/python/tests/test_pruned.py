@@ -6,9 +6,7 @@ Needs SVOKIT_BIN_DIR, SVOKIT_DATA_DIR and SVOKIT_CGAL_MESHES, as ctest sets them
 """
 
 import pathlib
-import subprocess
 import sys
-import tempfile
 import unittest
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -18,7 +16,7 @@ sys.path.insert(0, str(HERE))
 import numpy as np  # noqa: E402
 
 import svokit  # noqa: E402
-from tool_env import env_path  # noqa: E402
+from tool_env import ToolCase  # noqa: E402
 
 # name, mesh (folder variable, file), mesh2svo options.
 CASES = [
@@ -29,28 +27,14 @@ CASES = [
 ]
 
 
-class PrunedOctrees(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.bin = env_path("SVOKIT_BIN_DIR")
-        cls.tmp = tempfile.TemporaryDirectory()
-        cls.dir = pathlib.Path(cls.tmp.name)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
-
-    def build(self, mesh, options, out, extra):
-        subprocess.run([str(self.bin / "mesh2svo"), str(mesh), "-o", str(out), *options, *extra,
-                        "-q"], check=True)
-
+class PrunedOctrees(ToolCase):
     def test_dropped_voxels_lie_below_the_leaves(self):
-        for name, (folder, file), options in CASES:
+        for name, mesh, options in CASES:
             with self.subTest(name):
-                mesh = env_path(folder) / file
                 full_path, pruned_path = self.dir / f"{name}.svo", self.dir / f"{name}-p.svo"
-                self.build(mesh, options, full_path, [])
-                self.build(mesh, options, pruned_path, ["--prune", "default"])
+                self.run_tool("mesh2svo", self.mesh(*mesh), "-o", full_path, *options)
+                self.run_tool("mesh2svo", self.mesh(*mesh), "-o", pruned_path, *options,
+                              "--prune", "default")
                 with svokit.open(full_path) as full, svokit.open(pruned_path) as pruned:
                     self.assertTrue(pruned.is_pruned)
                     self.assertFalse(full.is_pruned)
