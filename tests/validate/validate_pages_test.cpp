@@ -156,6 +156,55 @@ TEST(ValidatePages, ChangedVoxelsSameFindings) {
   ExpectSameAtEveryLimit(bytes, &TorusMesh());
 }
 
+// Triangles far larger than a page cube, one of them a sliver, at angles to every axis: each
+// cube measures the pieces of them within its reach, and voxels taken away or added next to the
+// surface (many at cube borders) are found at the distances the whole mesh gives.
+TEST(ValidatePages, TrianglesAcrossManyCubesSameFindings) {
+  Mesh mesh;
+  mesh.positions = {{0.02, 0.05, 0.01}, {0.97, 0.31, 0.13}, {0.41, 0.93, 0.22},
+                    {0.37, 0.44, 0.98}, {0.03, 0.96, 0.95}, {0.99, 0.02, 0.9}};
+  // A tetrahedron, and a sliver from corner to corner a few voxels wide.
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {4, 5, 0}};
+  mesh.positions.push_back({0.985, 0.035, 0.906});
+  mesh.triangles.push_back({4, 5, 6});
+  EnsureDefaultMaterial(mesh);
+  auto grid = GridTransform::FitResolution(mesh.Bounds(), 520);  // 5³ page cubes
+  ASSERT_TRUE(grid.ok());
+  auto voxels = Voxelize(mesh, *grid, VoxelizeOptions{});
+  ASSERT_TRUE(voxels.ok());
+  std::vector<std::uint64_t> keys;
+  for (std::size_t i = 0; i < voxels->keys.size(); ++i) {
+    if (i % 41 == 7) continue;  // missing
+    keys.push_back(voxels->keys[i]);
+    if (i % 53 == 3) {  // a voxel two steps off the surface along x, when that is empty
+      const MortonCoord c = MortonDecode(voxels->keys[i]);
+      if (c.x + 2 < grid->dims()[0]) keys.push_back(MortonEncode(c.x + 2, c.y, c.z));
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  voxels->keys.assign(keys.begin(), keys.end());
+  voxels->colors.clear();
+  voxels->normals.clear();
+  voxels->coverage.clear();
+  BuildOptions bo;
+  bo.contours = false;
+  bo.brick_side = 0;
+  auto svo = BuildCompactSvo(*voxels, nullptr, bo);
+  ASSERT_TRUE(svo.ok()) << svo.status().message();
+  const auto bytes = EncodeSvo(*svo);
+  auto reader = SvoReader::FromBytes(bytes, "t.svo");
+  ASSERT_TRUE(reader.ok());
+  ASSERT_GE(reader->page_count(), 48u);
+  const std::string report = Whole(bytes, &mesh);
+  for (const char* kind : {"missing_voxel", "extra_voxel"}) {
+    EXPECT_NE(report.find(kind), std::string::npos) << kind << "\n" << report;
+  }
+  StatusOr<std::string> paged = Paged(bytes, &mesh, 0);
+  ASSERT_TRUE(paged.ok()) << paged.status().message();
+  EXPECT_EQ(*paged, report);
+}
+
 // A solid over several pages (a whole page inside it is a full leaf of the top levels): the
 // recomputed bricks agree, page by page as whole; with the bricks the surface alone gives (its
 // interior's opacity zeroed), every level above the voxels is a filter finding that says what

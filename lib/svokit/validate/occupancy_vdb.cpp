@@ -159,6 +159,94 @@ openvdb::FloatGrid::Ptr RequiredField(const SnappedMesh& mesh, openvdb::FloatGri
   return &required == &mesh ? all : DistanceField(required);
 }
 
+// How far beyond a cube's voxel centres a primitive is kept: the band and a voxel (within the
+// margin the primitives are binned with).
+constexpr double kReach = kBand + 1.0;
+
+// Clips segment pq to box [lo, hi] (slab by slab); false when nothing of it is inside.
+bool ClipSegment(const openvdb::Vec3d& lo, const openvdb::Vec3d& hi, openvdb::Vec3d& p,
+                 openvdb::Vec3d& q) {
+  double t0 = 0, t1 = 1;
+  const openvdb::Vec3d d = q - p;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0) {
+      if (p[a] < lo[a] || p[a] > hi[a]) return false;
+      continue;
+    }
+    double ta = (lo[a] - p[a]) / d[a], tb = (hi[a] - p[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  const openvdb::Vec3d from = p;
+  p = from + d * t0;
+  q = from + d * t1;
+  return true;
+}
+
+// Adds to `part` the piece of triangle `corners` inside box [lo, hi]: the triangle itself when it
+// lies inside, else its clipped polygon as a fan. A fan triangle thinner than 1e-7 voxel becomes
+// its longest edge (every point of it is that close to the edge), since OpenVDB's closest point
+// divides by the area.
+void AddClippedTriangle(const std::array<openvdb::Vec3d, 3>& corners, const openvdb::Vec3d& lo,
+                        const openvdb::Vec3d& hi, std::uint8_t hole, bool holes,
+                        SnappedMesh& part) {
+  const auto add_triangle = [&](const openvdb::Vec3d& a, const openvdb::Vec3d& b,
+                                const openvdb::Vec3d& c) {
+    const auto base = static_cast<std::uint32_t>(part.points.size());
+    part.points.push_back(a);
+    part.points.push_back(b);
+    part.points.push_back(c);
+    part.triangles.push_back({base, base + 1, base + 2});
+    if (holes) part.triangle_holes.push_back(hole);
+  };
+  bool inside = true;
+  for (const openvdb::Vec3d& c : corners) {
+    for (int a = 0; a < 3; ++a) inside = inside && c[a] >= lo[a] && c[a] <= hi[a];
+  }
+  if (inside) {
+    add_triangle(corners[0], corners[1], corners[2]);
+    return;
+  }
+  // Sutherland–Hodgman against the six faces; a convex polygon of at most 9 corners.
+  std::vector<openvdb::Vec3d> polygon(corners.begin(), corners.end()), next;
+  for (int face = 0; face < 6 && !polygon.empty(); ++face) {
+    const int a = face / 2;
+    const bool upper = face % 2 == 1;
+    const double plane = upper ? hi[a] : lo[a];
+    const auto in = [&](const openvdb::Vec3d& v) { return upper ? v[a] <= plane : v[a] >= plane; };
+    next.clear();
+    for (std::size_t k = 0; k < polygon.size(); ++k) {
+      const openvdb::Vec3d& from = polygon[k];
+      const openvdb::Vec3d& to = polygon[(k + 1) % polygon.size()];
+      if (in(from)) next.push_back(from);
+      if (in(from) != in(to)) {
+        openvdb::Vec3d cut = from + (to - from) * ((plane - from[a]) / (to[a] - from[a]));
+        cut[a] = plane;
+        next.push_back(cut);
+      }
+    }
+    polygon.swap(next);
+  }
+  for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+    const openvdb::Vec3d &a = polygon[0], &b = polygon[k], &c = polygon[k + 1];
+    const std::array<std::pair<openvdb::Vec3d, openvdb::Vec3d>, 3> edges{{{a, b}, {b, c}, {c, a}}};
+    const auto longest =
+        std::max_element(edges.begin(), edges.end(), [](const auto& x, const auto& y) {
+          return (x.second - x.first).lengthSqr() < (y.second - y.first).lengthSqr();
+        });
+    const double length = (longest->second - longest->first).length();
+    if (length == 0) continue;
+    if ((b - a).cross(c - a).length() / length < 1e-7) {
+      part.segments.push_back({longest->first, longest->second});
+      if (holes) part.segment_holes.push_back(hole);
+    } else {
+      add_triangle(a, b, c);
+    }
+  }
+}
+
 void InitializeOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
@@ -329,18 +417,27 @@ void CubeOccupancy::Check(const std::array<std::int64_t, 3>& lo, std::int64_t si
   const double tol = kDistanceTolerance;
   // The cube's primitives alone: the distance at the cube's voxels is the whole mesh's, since
   // every primitive within the band's reach of them is here.
+  // Each primitive is clipped to the cube grown by the band (and a voxel): a voxel of the cube
+  // closer than the band to a primitive is as close to its clipped part, and OpenVDB then
+  // voxelizes a large triangle once in all rather than whole in every cube it crosses.
+  const openvdb::Vec3d reach_lo(static_cast<double>(lo[0]) - kReach,
+                                static_cast<double>(lo[1]) - kReach,
+                                static_cast<double>(lo[2]) - kReach);
+  const openvdb::Vec3d reach_hi =
+      reach_lo + openvdb::Vec3d(static_cast<double>(side - 1) + 2 * kReach);
   SnappedMesh part;
   const SnappedMesh& all = m.snapped;
   for (const std::uint32_t i : near) {
     if (i < all.triangles.size()) {
       const auto& t = all.triangles[i];
-      const auto base = static_cast<std::uint32_t>(part.points.size());
-      for (int v = 0; v < 3; ++v) part.points.push_back(all.points[t[v]]);
-      part.triangles.push_back({base, base + 1, base + 2});
-      if (!all.triangle_holes.empty()) part.triangle_holes.push_back(all.triangle_holes[i]);
+      const std::uint8_t hole = all.triangle_holes.empty() ? 0 : all.triangle_holes[i];
+      AddClippedTriangle({all.points[t[0]], all.points[t[1]], all.points[t[2]]}, reach_lo, reach_hi,
+                         hole, !all.triangle_holes.empty(), part);
     } else {
       const std::size_t segment = i - all.triangles.size();
-      part.segments.push_back(all.segments[segment]);
+      auto [p, q] = all.segments[segment];
+      if (!ClipSegment(reach_lo, reach_hi, p, q)) continue;
+      part.segments.push_back({p, q});
       if (!all.segment_holes.empty()) part.segment_holes.push_back(all.segment_holes[segment]);
     }
   }
