@@ -142,7 +142,10 @@ class Baker {
   Status Octree() {
     const SvoReader& reader = octree_.reader();
     const std::uint32_t page_level = reader.page_level();
+    // Every level's AO sized from HEAD's counts once (HeldBesides counts them): grown by
+    // doubling, the voxels' level alone would hold up to twice its bytes.
     std::vector<std::vector<std::uint8_t>> ao(reader.depth() + 1);
+    for (std::uint32_t l = page_level; l <= reader.depth(); ++l) ao[l].reserve(reader.NodeCount(l));
     AoSums roots;
     double ao_sum = 0;
     std::uint64_t traced = 0;
@@ -177,6 +180,8 @@ class Baker {
         return s;
       }
     }
+    // The pages kept for tracing are done with: the write's section buffer takes their place.
+    octree_.ReleasePages();
     if (page_level > 0) {
       std::vector<std::vector<std::uint8_t>> top = NodeAo(octree_.top().tree, std::move(roots));
       for (std::uint32_t l = 0; l < page_level; ++l) ao[l] = std::move(top[l]);

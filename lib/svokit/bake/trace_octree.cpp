@@ -254,6 +254,20 @@ std::shared_ptr<const TracePage> TraceOctree::Page(std::size_t i) const {
   return page;
 }
 
+void TraceOctree::ReleasePages() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto it = uses_.begin(); it != uses_.end();) {
+    const auto e = entries_.find(*it);
+    if (e->second.bytes == 0) {  // still decoding: its decoder accounts for it
+      ++it;
+      continue;
+    }
+    held_ -= e->second.bytes;
+    entries_.erase(e);
+    it = uses_.erase(it);
+  }
+}
+
 Status TraceOctree::error() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return error_.value_or(Status::Ok());

@@ -125,6 +125,10 @@ class TraceOctree {
   /// its error is kept: error() says it once the tracing is done.
   std::shared_ptr<const TracePage> Page(std::size_t i) const;
   Status error() const;
+  /// Lets go of every page the cache keeps (those still in use live on with their users): the
+  /// tracing is done and its memory goes to what comes next. A page asked for later is decoded
+  /// again.
+  void ReleasePages() const;
 
   /// The opacity of sample `sample` (x + side·(y + side·z)) of the brick of a voxel with the
   /// occupancy `around` (VoxelOccupancy::Around): the voxels whose closed cube holds the sample,

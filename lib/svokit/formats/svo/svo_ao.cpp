@@ -1,6 +1,8 @@
 // The `AOCC` section of a version-2 .svo (formats/svo.md, "Ambient occlusion"): one byte of baked
 // ambient occlusion per node of every level, in node order, zstd-compressed as one stream.
 
+#include <cstring>
+
 #include <zstd.h>
 
 #include "svokit/core/bytes.hpp"
@@ -39,39 +41,49 @@ bool DecompressPrefix(std::span<const std::uint8_t> frame, std::span<std::uint8_
 std::vector<std::uint8_t> EncodeAoSection(std::span<const std::vector<std::uint8_t>> ao) {
   std::uint64_t raw = 0;
   for (const std::vector<std::uint8_t>& level : ao) raw += level.size();
-  // The levels compressed as one frame, fed level by level (no copy of them all).
-  std::vector<std::uint8_t> stored(ZSTD_compressBound(raw));
+  // Header: levels and codec (two u32; GCC 12 misreads four scalar appends as an overflow), the
+  // raw and stored sizes (two u64, the stored one written once known), then the stream.
+  const auto put_header = [&](ByteWriter& bytes, std::uint32_t codec, std::uint64_t stored) {
+    const std::uint32_t head[2] = {static_cast<std::uint32_t>(ao.size()), codec};
+    const std::uint64_t sizes[2] = {raw, stored};
+    bytes.PutArray(std::span<const std::uint32_t>(head));
+    bytes.PutArray(std::span<const std::uint64_t>(sizes));
+  };
+  ByteWriter bytes;
+  put_header(bytes, kZstd, 0);
+  std::vector<std::uint8_t>& out = bytes.bytes();
+  const std::size_t header = out.size();
+  // The levels compressed as one frame, fed level by level and drained a piece at a time: what is
+  // held is the compressed bytes, not a buffer of ZSTD_compressBound(raw).
+  std::vector<std::uint8_t> piece(std::size_t{1} << 20);
   ZSTD_CCtx* ctx = ZSTD_createCCtx();
   ZSTD_CCtx_setParameter(ctx, ZSTD_c_compressionLevel, 9);
   ZSTD_CCtx_setPledgedSrcSize(ctx, raw);
-  ZSTD_outBuffer out{stored.data(), stored.size(), 0};
   bool zstd = true;
   for (std::size_t l = 0; zstd && l <= ao.size(); ++l) {
     const bool last = l == ao.size();
     ZSTD_inBuffer in{last ? nullptr : ao[l].data(), last ? 0 : ao[l].size(), 0};
     std::size_t left = 0;
     do {
-      left = ZSTD_compressStream2(ctx, &out, &in, last ? ZSTD_e_end : ZSTD_e_continue);
+      ZSTD_outBuffer to{piece.data(), piece.size(), 0};
+      left = ZSTD_compressStream2(ctx, &to, &in, last ? ZSTD_e_end : ZSTD_e_continue);
       zstd = !ZSTD_isError(left);
+      out.insert(out.end(), piece.begin(), piece.begin() + static_cast<std::ptrdiff_t>(to.pos));
+      zstd = zstd && out.size() - header < raw;  // stored raw when zstd does not shrink it
     } while (zstd && (last ? left != 0 : in.pos < in.size));
   }
   ZSTD_freeCCtx(ctx);
-  zstd = zstd && out.pos < raw;
-  stored.resize(zstd ? out.pos : 0);
-  // The header as two arrays: GCC 12 misreads four scalar appends as an overflow.
-  const std::uint32_t head[2] = {static_cast<std::uint32_t>(ao.size()), zstd ? kZstd : kStored};
-  const std::uint64_t sizes[2] = {raw, zstd ? out.pos : raw};
-  ByteWriter bytes;
-  bytes.PutArray(std::span<const std::uint32_t>(head));
-  bytes.PutArray(std::span<const std::uint64_t>(sizes));
   if (zstd) {
-    bytes.PutArray(std::span<const std::uint8_t>(stored));
-  } else {
-    for (const std::vector<std::uint8_t>& level : ao) {
-      bytes.PutArray(std::span<const std::uint8_t>(level));
-    }
+    const std::uint64_t stored = out.size() - header;
+    std::memcpy(out.data() + header - sizeof stored, &stored, sizeof stored);
+    return std::move(out);
   }
-  return std::move(bytes.bytes());
+  ByteWriter plain;
+  put_header(plain, kStored, raw);
+  for (const std::vector<std::uint8_t>& level : ao) {
+    plain.PutArray(std::span<const std::uint8_t>(level));
+  }
+  return std::move(plain.bytes());
 }
 
 namespace {
