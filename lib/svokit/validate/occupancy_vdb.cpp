@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "svokit/core/morton.hpp"
+#include "svokit/core/polygon_clip.hpp"
 #include "svokit/svo/key_index.hpp"
 #include "svokit/validate/checks.hpp"
 #include "svokit/validate/paged_detail.hpp"
@@ -209,26 +210,19 @@ void AddClippedTriangle(const std::array<openvdb::Vec3d, 3>& corners, const open
     add_triangle(corners[0], corners[1], corners[2]);
     return;
   }
-  // Sutherland–Hodgman against the six faces; a convex polygon of at most 9 corners.
-  std::vector<openvdb::Vec3d> polygon(corners.begin(), corners.end()), next;
-  for (int face = 0; face < 6 && !polygon.empty(); ++face) {
-    const int a = face / 2;
-    const bool upper = face % 2 == 1;
-    const double plane = upper ? hi[a] : lo[a];
-    const auto in = [&](const openvdb::Vec3d& v) { return upper ? v[a] <= plane : v[a] >= plane; };
-    next.clear();
-    for (std::size_t k = 0; k < polygon.size(); ++k) {
-      const openvdb::Vec3d& from = polygon[k];
-      const openvdb::Vec3d& to = polygon[(k + 1) % polygon.size()];
-      if (in(from)) next.push_back(from);
-      if (in(from) != in(to)) {
-        openvdb::Vec3d cut = from + (to - from) * ((plane - from[a]) / (to[a] - from[a]));
-        cut[a] = plane;
-        next.push_back(cut);
-      }
-    }
-    polygon.swap(next);
+  // Clipped slab by slab with svokit's clipper (core/polygon_clip.hpp): at most 9 corners.
+  constexpr int kMaxCorners = 9;
+  std::array<Vec3d, kMaxCorners + 2> buffer_a, buffer_b;
+  Vec3d* poly = buffer_a.data();
+  Vec3d* spare = buffer_b.data();
+  for (int v = 0; v < 3; ++v) poly[v] = {corners[v].x(), corners[v].y(), corners[v].z()};
+  int n = 3;
+  for (int a = 0; a < 3 && n > 0; ++a) {
+    n = ClipToUnitSlab<kMaxCorners>(
+        poly, spare, n, [&](const Vec3d& v) { return (v[a] - lo[a]) / (hi[a] - lo[a]); });
   }
+  std::vector<openvdb::Vec3d> polygon;
+  for (int v = 0; v < n; ++v) polygon.emplace_back(poly[v].x, poly[v].y, poly[v].z);
   for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
     const openvdb::Vec3d &a = polygon[0], &b = polygon[k], &c = polygon[k + 1];
     const std::array<std::pair<openvdb::Vec3d, openvdb::Vec3d>, 3> edges{{{a, b}, {b, c}, {c, a}}};
