@@ -188,8 +188,7 @@ StatusOr<std::unique_ptr<TraceOctree>> TraceOctree::Open(const SvoReader& reader
                        "the top levels, cone tracing's pages (a few a thread, and one more kept) "
                        "and what is baked");
     if (!fits.ok()) return fits.status().WithContext(reader.name());
-    // An eighth stays free for what the allocator holds of pages already let go.
-    octree->capacity_ = std::max(largest, (memory_limit - fixed) / 8 * 7);
+    octree->capacity_ = std::max(largest, CacheShare(memory_limit - fixed));
   }
   return octree;
 }

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "svokit/core/held_bytes.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/inspect/paged_svo.hpp"
@@ -612,8 +613,9 @@ StatusOr<RenderResult> RenderSvo(const SvoReader& reader, const RenderOptions& o
                                                    "this file", "a page cached and one assembled");
   if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
   const std::size_t threads = std::min(*in_flight, Concurrency());
-  const std::uint64_t capacity = memory_limit == 0 ? kDefaultPagesPerThread * threads * largest
-                                                   : memory_limit - threads * largest;
+  const std::uint64_t capacity =
+      memory_limit == 0 ? kDefaultPagesPerThread * threads * largest
+                        : std::max(largest, CacheShare(memory_limit - threads * largest));
   PageCache<Svo> cache(
       capacity,
       [&](std::size_t i) -> StatusOr<Svo> {

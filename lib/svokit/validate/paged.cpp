@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "svokit/core/held_bytes.hpp"
 #include "svokit/core/morton.hpp"
 #include "svokit/core/parallel.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
@@ -531,7 +532,7 @@ StatusOr<Report> PagedValidator::Run() {
   if (!in_flight.ok()) return in_flight.status().WithContext(reader_.name());
   const std::uint64_t rest = options_.memory_limit == 0
                                  ? std::uint64_t{64} << 20
-                                 : options_.memory_limit - fixed - *in_flight * item;
+                                 : CacheShare(options_.memory_limit - fixed - *in_flight * item);
   shells_ = std::make_unique<ShellCache>(std::max<std::uint64_t>(rest, item / 2));
 
   StatusOr<SvoChunk> top = reader_.Top();
