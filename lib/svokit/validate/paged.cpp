@@ -557,6 +557,8 @@ StatusOr<Report> PagedValidator::Run() {
         });
     if (!s.ok()) return s;
   }
+  // The shells are done with: the top levels' join takes their room.
+  shells_ = std::make_unique<ShellCache>(0);
   if (shape_.brick_side != 0 && page_level_ > 0 && pages_ok_) {
     Progress::Stage stage(progress_, "top bricks", 1);
     paged_detail::LocalOctree t = paged_detail::JoinTop(
