@@ -132,6 +132,22 @@ struct Located {
   double distance;  // voxels
 };
 
+// OpenVDB cuts every triangle wider than 16 voxels of a mesh under 1000 polygons into four, as
+// tasks, recursively (VoxelizePolygons::evalTriangle); the pieces flood their shared edges again.
+// A cube's few dozen triangles need no tasks: this view counts 1000 polygons, the extra ones
+// without corners, which the voxelizer skips.
+struct UnsplitMesh {
+  static constexpr std::size_t kPolygons = 1000;
+  const SnappedMesh* mesh;
+
+  std::size_t polygonCount() const { return std::max(mesh->triangles.size(), kPolygons); }
+  std::size_t pointCount() const { return mesh->points.size(); }
+  std::size_t vertexCount(std::size_t n) const { return n < mesh->triangles.size() ? 3 : 0; }
+  void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
+    mesh->getIndexSpacePoint(n, v, pos);
+  }
+};
+
 // A band of 2 voxels: OpenVDB's first pass computes the exact distance (double closest point)
 // of every voxel within √3/2 voxel of a triangle, and everything else reads as ≥ 2 h.
 constexpr float kBand = 2.0f;
@@ -147,7 +163,7 @@ openvdb::FloatGrid::Ptr DistanceField(const SnappedMesh& mesh) {
     distance->setTransform(transform);
   } else {
     distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-        mesh, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
+        UnsplitMesh{&mesh}, *transform, kBand, 0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
   }
   AddSegmentDistances(mesh, kBand, *distance);
   return distance;
