@@ -123,7 +123,6 @@ StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
   stats.page_level = v.page_level;
   // Chunk c: the top chunk (c = 0), then page c − 1; each one's bytes, decoded when by level.
   const std::size_t chunks = v.pages.size() + 1;
-  std::vector<StatusOr<ChunkBytes>> parts(chunks, ChunkBytes{});
   const auto measure = [&](std::size_t c) -> StatusOr<ChunkBytes> {
     const bool top = c == 0;
     if (top && v.top.empty()) return ChunkBytes{};
@@ -131,18 +130,33 @@ StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
         top ? name() + ": top chunk" : fmt::format("{}: page {}", name(), c - 1);
     const std::span<const std::uint8_t> bytes =
         top ? v.top : v.page_bytes.subspan(v.pages[c - 1].offset, v.pages[c - 1].size);
+    if (top) {
+      if (!by_level) return ChunkStreamBytes(bytes, chunk_name);
+      StatusOr<SvoChunk> chunk = Top();
+      if (!chunk.ok()) return chunk.status();
+      return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
+    }
     if (!by_level) return ChunkStreamBytes(bytes, chunk_name);
-    StatusOr<SvoChunk> chunk = top ? Top() : Page(c - 1);
+    StatusOr<SvoChunk> chunk = Page(c - 1);
     if (!chunk.ok()) return chunk.status();
     return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
   };
-  ParallelChunks(chunks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) parts[c] = measure(c);
-  });
+  // A batch of chunks at a time, added in chunk order (the first error is reported): each one's
+  // bytes by section are a few maps, too many to hold for every page of a large file.
+  constexpr std::size_t kBatch = 4096;
   ChunkBytes all;
-  for (const StatusOr<ChunkBytes>& part : parts) {  // in chunk order: the first error is reported
-    if (!part.ok()) return part.status();
-    all.Add(*part);
+  for (std::size_t first = 0; first < chunks; first += kBatch) {
+    const std::size_t n = std::min(kBatch, chunks - first);
+    std::vector<StatusOr<ChunkBytes>> parts(n, ChunkBytes{});
+    ParallelChunks(n, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t c = begin; c < end; ++c) parts[c] = measure(first + c);
+    });
+    // The batch's pages of the file go back, as every page read's do (one call for them all).
+    if (first + n > 1) ReleasePages(first == 0 ? 0 : first - 1, first + n - 1);
+    for (const StatusOr<ChunkBytes>& part : parts) {
+      if (!part.ok()) return part.status();
+      all.Add(*part);
+    }
   }
   std::vector<std::uint64_t> sizes;
   for (const svo_detail::Version2::Page& p : v.pages) sizes.push_back(p.size);
@@ -254,15 +268,24 @@ StatusOr<ChunkBytes> SvoReader::PageStreamBytes(std::size_t i) const {
 }
 
 void SvoReader::ReleasePage(std::size_t i) const {
+  ReleasePages(i, i + 1);
+}
+
+void SvoReader::ReleasePages(std::size_t first, std::size_t end) const {
   // Bytes given to FromBytes are the caller's, not a mapping of the reader's own.
   if (!state_->mapped) return;
   // A read maps the file pages around it too (the kernel's fault-around, 64 KiB): they go as well,
   // or reads of pages in any order would keep much of the file.
   constexpr std::uint64_t kFaultAround = 64 << 10;
-  const svo_detail::Version2::Page& p = state_->v.pages[i];
+  std::uint64_t begin = UINT64_MAX, stop = 0;
+  for (std::size_t i = first; i < end; ++i) {
+    const svo_detail::Version2::Page& p = state_->v.pages[i];
+    begin = std::min(begin, p.offset);
+    stop = std::max(stop, p.offset + p.size);
+  }
   const std::span<const std::uint8_t> all = state_->v.page_bytes;
-  const std::uint64_t lo = p.offset > kFaultAround ? p.offset - kFaultAround : 0;
-  const std::uint64_t hi = std::min<std::uint64_t>(all.size(), p.offset + p.size + kFaultAround);
+  const std::uint64_t lo = begin > kFaultAround ? begin - kFaultAround : 0;
+  const std::uint64_t hi = std::min<std::uint64_t>(all.size(), stop + kFaultAround);
   ReleaseMappedFilePages(all.data() + lo, all.data() + hi);
 }
 

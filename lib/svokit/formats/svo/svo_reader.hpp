@@ -91,6 +91,8 @@ class SvoReader {
   explicit SvoReader(std::unique_ptr<State> state);
   // Gives page i's mapped file bytes back to the kernel, and the ones mapped around them.
   void ReleasePage(std::size_t i) const;
+  // The same for pages [first, end) (one call for the span of the file they lie in).
+  void ReleasePages(std::size_t first, std::size_t end) const;
   std::unique_ptr<State> state_;
   friend struct LenientSvoReader;
 };
