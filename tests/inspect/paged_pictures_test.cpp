@@ -88,9 +88,13 @@ void ExpectSameSlices(const std::filesystem::path& path, std::uint32_t level,
       const SliceSpec spec{axis, index};
       const SliceOptions options{.level = level};
       StatusOr<RgbaImage> want = RenderSlice(*whole, spec, options);
-      // The smallest limit with one thread, a few pages' with two, the default.
+      // The smallest limit with one thread (a band of the picture and a page), a few pages' with
+      // two, the default.
+      const StatusOr<std::uint64_t> band = SliceBandBytes(*r, spec, options);
+      ASSERT_EQ(band.ok(), want.ok());
+      const std::uint64_t least = largest + (band.ok() ? *band : 0);
       for (const auto& [threads, bytes] :
-           {std::pair<std::size_t, std::uint64_t>{1, largest}, {2, 3 * largest}, {2, 0}}) {
+           {std::pair<std::size_t, std::uint64_t>{1, least}, {2, least + 2 * largest}, {2, 0}}) {
         ThreadLimit limit(threads);
         StatusOr<RgbaImage> got = RenderSlice(*r, spec, options, bytes);
         const std::string where = "axis " + std::to_string(axis) + " index " +
@@ -129,6 +133,13 @@ TEST(PagedSlice, ALimitBelowThePagesIsRefusedNamingTheSmallestThatWorks) {
   ASSERT_FALSE(got.ok());
   EXPECT_NE(got.status().message().find(PagedTorus().path.string()), std::string::npos);
   EXPECT_NE(got.status().message().find("or more"), std::string::npos) << got.status().message();
+  // A band of the picture counts: a page's bytes alone are too few.
+  const std::uint64_t largest = LargestPage(*r, r->depth());
+  const StatusOr<std::uint64_t> band = SliceBandBytes(*r, {2, 200}, {});
+  ASSERT_TRUE(band.ok());
+  EXPECT_GT(*band, 0u);
+  EXPECT_FALSE(RenderSlice(*r, {2, 200}, {}, largest + *band - 1).ok());
+  EXPECT_TRUE(RenderSlice(*r, {2, 200}, {}, largest + *band).ok());
   StatusOr<RgbaImage> deep = RenderSlice(*r, {2, 0}, {.level = 10}, 0);
   ASSERT_FALSE(deep.ok());
   EXPECT_NE(deep.status().message().find("exceeds the octree's depth 9"), std::string::npos)

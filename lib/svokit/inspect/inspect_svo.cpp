@@ -59,25 +59,26 @@ StatusOr<SlicePicture> Slice(const InspectRequest& r, const Svo* svo, const SvoR
   SliceOptions options;
   options.level = r.level;
   Progress::Stage stage(progress, "slice", 1);
-  StatusOr<RgbaImage> image = svo != nullptr
-                                  ? RenderSlice(*svo, r.slice, options)
-                                  : RenderSlice(*reader, r.slice, options, r.memory_limit, &stage);
-  // The paged route's errors name the file already.
-  if (!image.ok() && svo != nullptr) image = image.status().WithContext(r.input.string());
-  if (image.ok()) {
-    if (Status s = WriteRgbaImage(*image, r.slice_path); !s.ok()) {
-      image = s.WithContext(r.input.string());
-    }
+  // A paged file's slice is written band by band (its errors name the file already).
+  StatusOr<std::array<int, 2>> size = std::array<int, 2>{};
+  if (svo == nullptr) {
+    size = WriteSlicePng(*reader, r.slice, options, r.memory_limit, r.slice_path, &stage);
+  } else if (StatusOr<RgbaImage> image = RenderSlice(*svo, r.slice, options); !image.ok()) {
+    size = image.status().WithContext(r.input.string());
+  } else if (Status s = WriteRgbaImage(*image, r.slice_path); !s.ok()) {
+    size = s.WithContext(r.input.string());
+  } else {
+    size = std::array<int, 2>{image->width, image->height};
   }
-  if (!image.ok()) {
+  if (!size.ok()) {
     stage.Cancel();
-    return image.status();
+    return size.status();
   }
   return SlicePicture{.path = r.slice_path.string(),
                       .axis = r.slice.axis,
                       .index = r.slice.index,
-                      .width = image->width,
-                      .height = image->height};
+                      .width = (*size)[0],
+                      .height = (*size)[1]};
 }
 
 }  // namespace

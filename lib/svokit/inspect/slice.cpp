@@ -5,12 +5,14 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "svokit/core/morton.hpp"
 #include "svokit/formats/svo/svo_stream.hpp"
 #include "svokit/inspect/paged_svo.hpp"
+#include "svokit/mesh/png_writer.hpp"
 
 namespace svokit {
 
@@ -117,13 +119,36 @@ class SliceCanvas {
       return Status::BadInput("slice of {}x{} cells at {} pixels per cell is too large", c.cols_,
                               c.rows_, c.scale_);
     }
-    c.image_ =
-        RgbaImage(static_cast<int>(c.cols_) * c.scale_, static_cast<int>(c.rows_) * c.scale_);
+    c.width_ = static_cast<int>(c.cols_) * c.scale_;
+    c.height_ = static_cast<int>(c.rows_) * c.scale_;
     return c;
   }
 
   std::uint32_t level() const { return level_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // The picture's rows [first, first + count) (fresh: all transparent), which the painting fills.
+  void HoldRows(int first, int count) {
+    row0_ = first;
+    image_ = RgbaImage(width_, count);
+  }
   RgbaImage& image() { return image_; }
+  // The pixel rows [first, end) of the cells whose row-axis index lies in [lo, hi).
+  std::pair<int, int> PixelRows(std::uint32_t lo, std::uint32_t hi) const {
+    lo = std::min(lo, rows_);
+    hi = std::min(hi, rows_);
+    const std::uint32_t top = flip_rows_ ? rows_ - hi : lo, bottom = flip_rows_ ? rows_ - lo : hi;
+    return {static_cast<int>(top) * scale_, static_cast<int>(bottom) * scale_};
+  }
+  // The bytes of one band: the rows of one row of pages (`page_level`'s nodes), or the whole
+  // picture when the slice's level is above the pages.
+  std::uint64_t BandBytes(std::uint32_t page_level) const {
+    const auto [first, end] =
+        level_ < page_level ? std::pair{0, height_} : PixelRows(0, 1u << (level_ - page_level));
+    return static_cast<std::uint64_t>(end - first) * static_cast<std::uint64_t>(width_) * 4;
+  }
+  int row_axis() const { return row_axis_; }
+  bool rows_run_down() const { return flip_rows_; }
 
   // Paints the nodes of `svo` below node `node` of `level` (at grid position `ijk` of that level)
   // that cross the slice, down to the slice level; children of level `cut` are left to the octrees
@@ -163,10 +188,11 @@ class SliceCanvas {
     if (ijk[col_axis_] >= cols_ || ijk[row_axis_] >= rows_) return;
     const std::uint32_t col = ijk[col_axis_];
     const std::uint32_t row = flip_rows_ ? rows_ - 1 - ijk[row_axis_] : ijk[row_axis_];
+    const int y0 = static_cast<int>(row) * scale_ - row0_;
+    if (y0 < 0 || y0 >= image_.height) return;  // outside the rows held
     for (int dy = 0; dy < scale_; ++dy) {
       for (int dx = 0; dx < scale_; ++dx) {
-        std::uint8_t* px =
-            image_.at(static_cast<int>(col) * scale_ + dx, static_cast<int>(row) * scale_ + dy);
+        std::uint8_t* px = image_.at(static_cast<int>(col) * scale_ + dx, y0 + dy);
         px[0] = rgb[0];
         px[1] = rgb[1];
         px[2] = rgb[2];
@@ -182,6 +208,9 @@ class SliceCanvas {
     cell[slice_.axis] = slice_.index;
     const std::uint32_t col0 = cell[col_axis_], row0 = cell[row_axis_];
     for (std::uint32_t r = 0; r < side && row0 + r < rows_; ++r) {
+      const std::uint32_t row = flip_rows_ ? rows_ - 1 - (row0 + r) : row0 + r;
+      const int y = static_cast<int>(row) * scale_ - row0_;
+      if (y < 0 || y >= image_.height) continue;  // outside the rows held
       for (std::uint32_t c = 0; c < side && col0 + c < cols_; ++c) {
         cell[col_axis_] = col0 + c;
         cell[row_axis_] = row0 + r;
@@ -196,6 +225,8 @@ class SliceCanvas {
   bool flip_rows_ = true;
   std::uint32_t cols_ = 0, rows_ = 0;
   int scale_ = 1;
+  int width_ = 0, height_ = 0;
+  int row0_ = 0;  // the picture's row that image_'s row 0 is
   RgbaImage image_;
 };
 
@@ -210,26 +241,41 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
       SliceCanvas::Make(svo.grid.dims(), svo.depth,
                         static_cast<std::uint32_t>(svo.levels.size() - 1), slice, options);
   if (!canvas.ok()) return canvas.status();
+  canvas->HoldRows(0, canvas->height());
   canvas->Paint(svo, 0, 0, {0, 0, 0}, kNoCut);
   return std::move(canvas->image());
 }
 
-StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
-                                const SliceOptions& options, std::uint64_t memory_limit,
-                                Progress::Stage* stage) {
+StatusOr<std::uint64_t> SliceBandBytes(const SvoReader& reader, const SliceSpec& slice,
+                                       const SliceOptions& options) {
+  if (options.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, *options.level));
+  StatusOr<SliceCanvas> canvas =
+      SliceCanvas::Make(reader.grid().dims(), reader.depth(), reader.depth(), slice, options);
+  if (!canvas.ok()) return canvas.status().WithContext(reader.name());
+  return canvas->BandBytes(reader.page_level());
+}
+
+Status StreamSlice(const SvoReader& reader, const SliceSpec& slice, const SliceOptions& options,
+                   std::uint64_t memory_limit, const SliceRows& rows, Progress::Stage* stage) {
   if (options.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, *options.level));
   StatusOr<SliceCanvas> canvas =
       SliceCanvas::Make(reader.grid().dims(), reader.depth(), reader.depth(), slice, options);
   if (!canvas.ok()) return canvas.status().WithContext(reader.name());
   const std::uint32_t level = canvas->level(), page_level = reader.page_level();
   // The top levels are held whole (as the statistics hold them); their nodes of the page level
-  // are pages, painted as they stream past.
+  // are pages.
+  std::optional<Svo> top;
   if (page_level > 0) {
-    StatusOr<Svo> top = ReadTopSvo(reader, level);
-    if (!top.ok()) return top.status();
-    canvas->Paint(*top, 0, 0, {0, 0, 0}, page_level);
+    StatusOr<Svo> read = ReadTopSvo(reader, level);
+    if (!read.ok()) return read.status();
+    top = std::move(*read);
   }
-  if (level < page_level) return std::move(canvas->image());
+  if (level < page_level) {
+    SVOKIT_RETURN_IF_ERROR(rows.begin(canvas->width(), canvas->height()));
+    canvas->HoldRows(0, canvas->height());
+    canvas->Paint(*top, 0, 0, {0, 0, 0}, page_level);
+    return rows.take(canvas->image().pixels);
+  }
   // Only the pages the plane through the slice's cell centres crosses.
   const double cell =
       reader.grid().voxel_size() * std::ldexp(1.0, static_cast<int>(reader.depth() - level));
@@ -239,6 +285,19 @@ StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
       reader.grid().origin()[slice.axis] + (slice.index + 0.5) * cell;
   StatusOr<SvoStreamPlan> plan = PlanStream(reader, SvoStreamOptions{.box = plane});
   if (!plan.ok()) return plan.status();
+  // The picture is made a band at a time, a band per row of pages (cells of the row axis
+  // [k·side, (k + 1)·side)), in the order the picture's rows run: a page lies in one band.
+  const std::uint32_t side = 1u << (level - page_level), bands = 1u << page_level;
+  const auto band_at = [&](std::uint32_t k) {  // the k-th band in the picture's order
+    return canvas->rows_run_down() ? bands - 1 - k : k;
+  };
+  const auto order_of = [&](std::size_t page) {
+    const MortonCoord c = MortonDecode(reader.page(page).key);
+    const std::uint32_t band = canvas->row_axis() == 0 ? c.x : canvas->row_axis() == 1 ? c.y : c.z;
+    return canvas->rows_run_down() ? bands - 1 - band : band;
+  };
+  std::stable_sort(plan->pages.begin(), plan->pages.end(),
+                   [&](std::size_t a, std::size_t b) { return order_of(a) < order_of(b); });
   // What a page in flight holds is its assembly's peak, which the stream directory bounds.
   std::uint64_t largest = 1;
   for (const std::size_t i : plan->pages) {
@@ -246,20 +305,76 @@ StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
     if (!bytes.ok()) return bytes.status();
     largest = std::max(largest, *bytes);
   }
-  StatusOr<std::size_t> in_flight = InFlightWithin(memory_limit, 0, largest, largest, "this file",
-                                                   "the pages in flight (one at least)");
+  StatusOr<std::size_t> in_flight =
+      InFlightWithin(memory_limit, canvas->BandBytes(page_level), largest, largest, "this file",
+                     "a band of the picture and the pages in flight (one at least)");
   if (!in_flight.ok()) return in_flight.status().WithContext(reader.name());
   plan->in_flight = *in_flight;
-  SVOKIT_RETURN_IF_ERROR(StreamPages<Svo>(
+  SVOKIT_RETURN_IF_ERROR(rows.begin(canvas->width(), canvas->height()));
+  // Holds the k-th band, writing those before it: each starts with the top's full leaves.
+  std::uint32_t opened = 0;
+  const auto hold = [&](std::uint32_t k) -> Status {
+    for (; opened <= k; ++opened) {
+      if (opened > 0) SVOKIT_RETURN_IF_ERROR(rows.take(canvas->image().pixels));
+      const std::uint32_t band = band_at(opened);
+      const auto [first, end] = canvas->PixelRows(band * side, band * side + side);
+      canvas->HoldRows(first, end - first);
+      if (top) canvas->Paint(*top, 0, 0, {0, 0, 0}, page_level);
+    }
+    return Status::Ok();
+  };
+  const Status streamed = StreamPages<Svo>(
       reader, *plan,
       [&](std::size_t, SvoChunk chunk) -> StatusOr<Svo> { return PageSvo(reader, chunk, level); },
       [&](std::size_t page, Svo svo) {
+        SVOKIT_RETURN_IF_ERROR(hold(order_of(page)));
         const MortonCoord c = MortonDecode(reader.page(page).key);
         canvas->Paint(svo, page_level, 0, {c.x, c.y, c.z}, kNoCut);
         return Status::Ok();
       },
-      stage));
-  return std::move(canvas->image());
+      stage);
+  if (!streamed.ok()) return streamed;
+  SVOKIT_RETURN_IF_ERROR(hold(bands - 1));
+  return rows.take(canvas->image().pixels);
+}
+
+StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
+                                const SliceOptions& options, std::uint64_t memory_limit,
+                                Progress::Stage* stage) {
+  RgbaImage image;
+  std::size_t filled = 0;
+  const SliceRows rows{.begin =
+                           [&](int width, int height) {
+                             image = RgbaImage(width, height);
+                             return Status::Ok();
+                           },
+                       .take =
+                           [&](std::span<const std::uint8_t> rgba) {
+                             std::copy(rgba.begin(), rgba.end(),
+                                       image.pixels.begin() + static_cast<std::ptrdiff_t>(filled));
+                             filled += rgba.size();
+                             return Status::Ok();
+                           }};
+  SVOKIT_RETURN_IF_ERROR(StreamSlice(reader, slice, options, memory_limit, rows, stage));
+  return image;
+}
+
+StatusOr<std::array<int, 2>> WriteSlicePng(const SvoReader& reader, const SliceSpec& slice,
+                                           const SliceOptions& options, std::uint64_t memory_limit,
+                                           const std::filesystem::path& path,
+                                           Progress::Stage* stage) {
+  std::optional<PngWriter> png;
+  const SliceRows rows{
+      .begin = [&](int width, int height) -> Status {
+        StatusOr<PngWriter> opened = PngWriter::Open(path, width, height, 4);
+        if (!opened.ok()) return opened.status();
+        png = std::move(*opened);
+        return Status::Ok();
+      },
+      .take = [&](std::span<const std::uint8_t> rgba) { return png->WriteRows(rgba); }};
+  SVOKIT_RETURN_IF_ERROR(StreamSlice(reader, slice, options, memory_limit, rows, stage));
+  SVOKIT_RETURN_IF_ERROR(png->Commit());
+  return std::array<int, 2>{png->width(), png->height()};
 }
 
 }  // namespace svokit

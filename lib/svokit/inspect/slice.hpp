@@ -7,8 +7,12 @@
 // Orientation, as the views of ray_cast.hpp see the grid: z=K as from the front (x right, y up),
 // x=K as from the left (z right, y up), y=K as from the top (x right, z down).
 
+#include <array>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <optional>
+#include <span>
 #include <string_view>
 
 #include "svokit/core/progress.hpp"
@@ -43,12 +47,33 @@ inline constexpr std::uint8_t kSliceInterior[3] = {70, 110, 170};
 StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
                                 const SliceOptions& options = {});
 
+/// Where a paged file's slice goes: its size first, then its rows top to bottom, a band at a time.
+struct SliceRows {
+  std::function<Status(int width, int height)> begin;
+  std::function<Status(std::span<const std::uint8_t> rgba)> take;
+};
+
 /// The same picture of a paged file, read page by page: the top levels whole, then only the pages
-/// the slice crosses, within `memory_limit` bytes of pages in flight (0: a few per thread; a limit
-/// below the largest page's is bad input naming the smallest that works). `stage` advances per
-/// page.
+/// the slice crosses, a row of pages at a time, each band of the picture handed to `rows` once
+/// its pages are painted. `memory_limit` bytes hold a band and the pages in flight (0: a few
+/// pages per thread; a limit below one band and the largest page is bad input naming the
+/// smallest that works). `stage` advances per page.
+Status StreamSlice(const SvoReader& reader, const SliceSpec& slice, const SliceOptions& options,
+                   std::uint64_t memory_limit, const SliceRows& rows,
+                   Progress::Stage* stage = nullptr);
+/// The bytes StreamSlice holds of the picture at once: the rows of one row of pages (the whole
+/// picture when the slice's level is above the pages). Bad input as StreamSlice's.
+StatusOr<std::uint64_t> SliceBandBytes(const SvoReader& reader, const SliceSpec& slice,
+                                       const SliceOptions& options);
+/// StreamSlice's picture whole.
 StatusOr<RgbaImage> RenderSlice(const SvoReader& reader, const SliceSpec& slice,
                                 const SliceOptions& options, std::uint64_t memory_limit,
                                 Progress::Stage* stage = nullptr);
+/// StreamSlice's picture written as PNG band by band (PngWriter): never whole in memory. Its
+/// width and height.
+StatusOr<std::array<int, 2>> WriteSlicePng(const SvoReader& reader, const SliceSpec& slice,
+                                           const SliceOptions& options, std::uint64_t memory_limit,
+                                           const std::filesystem::path& path,
+                                           Progress::Stage* stage = nullptr);
 
 }  // namespace svokit

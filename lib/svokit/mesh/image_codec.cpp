@@ -16,6 +16,7 @@
 
 #include "svokit/core/file_io.hpp"
 #include "svokit/mesh/image_headers.hpp"
+#include "svokit/mesh/png_writer.hpp"
 #include "svokit/mesh/stb_codec.hpp"
 
 namespace svokit {
@@ -295,9 +296,10 @@ Status WriteImage(const std::filesystem::path& path, int width, int height, int 
     return Status::BadInput("{}: no extension to choose an image format by", path.string());
   }
   if (format == "png") {
-    std::vector<std::uint8_t> png = stb::EncodePng(width, height, channels, pixels.data());
-    if (png.empty()) return Status::Internal("{}: cannot encode the image", path.string());
-    return WriteFileAtomic(path, png);
+    StatusOr<PngWriter> png = PngWriter::Open(path, width, height, channels);
+    if (!png.ok()) return png.status();
+    SVOKIT_RETURN_IF_ERROR(png->WriteRows(pixels));
+    return png->Commit();
   }
   const Plugin& plugin = LoadPlugin();
   if (!plugin.decode) return plugin.error.WithContext(path.string());

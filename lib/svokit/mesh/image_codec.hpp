@@ -1,6 +1,7 @@
 #pragma once
 // Image decoding and encoding. The common formats (PNG, JPEG, BMP, TGA, GIF, HDR, PSD, PNM) are
-// decoded by stb_image inside libsvokit (stb_codec.hpp), and PNG is written by stb_image_write.
+// decoded by stb_image inside libsvokit (stb_codec.hpp), and PNG is written row by row
+// with zlib (png_writer.hpp).
 // OpenEXR and TIFF go through OpenImageIO, which drags in some 260 shared libraries (~0.2 s,
 // ~300 MB of address space): it lives in a plugin module (libsvokit_oiio.so, built beside
 // libsvokit) that is dlopen'ed the first time such an image is decoded or written. The format is
@@ -68,7 +69,7 @@ StatusOr<std::vector<float>> DecodeImagePixels(const std::string& name,
                                                ImageHeader& header);
 
 /// Encodes 8-bit pixels (width × height × channels, row 0 at the top; 4 channels = RGBA with
-/// straight alpha) in the format the extension of `path` names (png by stb_image_write; tif, jpg,
+/// straight alpha) in the format the extension of `path` names (png by PngWriter; tif, jpg,
 /// ... by the plugin) and writes it as AtomicFileWriter does: a failed write leaves no file. Bad
 /// sizes, or a format OpenImageIO cannot write, are bad input.
 Status WriteImage(const std::filesystem::path& path, int width, int height, int channels,

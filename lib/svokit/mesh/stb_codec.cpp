@@ -1,4 +1,4 @@
-// The one translation unit that compiles stb_image and stb_image_write (see stb_codec.hpp).
+// The one translation unit that compiles stb_image (see stb_codec.hpp).
 
 #include "svokit/mesh/stb_codec.hpp"
 
@@ -90,11 +90,6 @@ void* CountedRealloc(void* p, std::size_t size) {
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
-
-#define STBI_WRITE_NO_STDIO
-#define STB_IMAGE_WRITE_STATIC
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <stb/stb_image_write.h>
 
 static_assert(STBI_MAX_DIMENSIONS > svokit::kImageSideLimit);
 
@@ -210,20 +205,6 @@ DecodeResult Decode(std::span<const std::uint8_t> bytes, std::size_t allocation_
                              CountedFree(const_cast<void*>(p));
                            })};
   return result;
-}
-
-std::vector<std::uint8_t> EncodePng(int width, int height, int channels,
-                                    const std::uint8_t* pixels) {
-  std::vector<std::uint8_t> png;
-  const auto append = [](void* context, void* data, int size) {
-    auto* out = static_cast<std::vector<std::uint8_t>*>(context);
-    const auto* first = static_cast<const std::uint8_t*>(data);
-    out->insert(out->end(), first, first + size);
-  };
-  if (!stbi_write_png_to_func(append, &png, width, height, channels, pixels, width * channels)) {
-    png.clear();
-  }
-  return png;
 }
 
 }  // namespace svokit::stb

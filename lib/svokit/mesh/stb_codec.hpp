@@ -1,6 +1,6 @@
 #pragma once
-// The common image formats (PNG, JPEG, BMP, TGA, GIF, HDR, PSD, PNM) decoded, and PNG encoded, by
-// stb_image and stb_image_write, compiled into stb_codec.cpp alone. Every allocation the decoder
+// The common image formats (PNG, JPEG, BMP, TGA, GIF, HDR, PSD, PNM) decoded by
+// stb_image, compiled into stb_codec.cpp alone. Every allocation the decoder
 // makes is counted against a cap the caller sets from the header, so a file that declares a small
 // image but inflates to a large one fails instead of allocating.
 
@@ -38,9 +38,5 @@ struct DecodeResult {
   bool over_cap = false;
 };
 DecodeResult Decode(std::span<const std::uint8_t> bytes, std::size_t allocation_cap);
-
-/// PNG bytes of 8-bit pixels (width × height × channels, row 0 at the top); empty on failure.
-std::vector<std::uint8_t> EncodePng(int width, int height, int channels,
-                                    const std::uint8_t* pixels);
 
 }  // namespace svokit::stb
