@@ -288,13 +288,11 @@ Status StreamSlice(const SvoReader& reader, const SliceSpec& slice, const SliceO
   // The picture is made a band at a time, a band per row of pages (cells of the row axis
   // [k·side, (k + 1)·side)), in the order the picture's rows run: a page lies in one band.
   const std::uint32_t side = 1u << (level - page_level), bands = 1u << page_level;
-  const auto band_at = [&](std::uint32_t k) {  // the k-th band in the picture's order
-    return canvas->rows_run_down() ? bands - 1 - k : k;
-  };
+  // The k-th band in the picture's order, and the converse: a band's place in that order.
+  const auto band_at = [&](std::uint32_t k) { return canvas->rows_run_down() ? bands - 1 - k : k; };
   const auto order_of = [&](std::size_t page) {
     const MortonCoord c = MortonDecode(reader.page(page).key);
-    const std::uint32_t band = canvas->row_axis() == 0 ? c.x : canvas->row_axis() == 1 ? c.y : c.z;
-    return canvas->rows_run_down() ? bands - 1 - band : band;
+    return band_at(canvas->row_axis() == 0 ? c.x : canvas->row_axis() == 1 ? c.y : c.z);
   };
   std::stable_sort(plan->pages.begin(), plan->pages.end(),
                    [&](std::size_t a, std::size_t b) { return order_of(a) < order_of(b); });
