@@ -130,14 +130,8 @@ StatusOr<SvoFileStats> SvoReader::FileStats(bool by_level) const {
         top ? name() + ": top chunk" : fmt::format("{}: page {}", name(), c - 1);
     const std::span<const std::uint8_t> bytes =
         top ? v.top : v.page_bytes.subspan(v.pages[c - 1].offset, v.pages[c - 1].size);
-    if (top) {
-      if (!by_level) return ChunkStreamBytes(bytes, chunk_name);
-      StatusOr<SvoChunk> chunk = Top();
-      if (!chunk.ok()) return chunk.status();
-      return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
-    }
     if (!by_level) return ChunkStreamBytes(bytes, chunk_name);
-    StatusOr<SvoChunk> chunk = Page(c - 1);
+    StatusOr<SvoChunk> chunk = top ? Top() : Page(c - 1);
     if (!chunk.ok()) return chunk.status();
     return ChunkStreamBytes(bytes, *chunk, shape(), chunk_name);
   };
