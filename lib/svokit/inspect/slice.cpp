@@ -246,21 +246,31 @@ StatusOr<RgbaImage> RenderSlice(const Svo& svo, const SliceSpec& slice,
   return std::move(canvas->image());
 }
 
-StatusOr<std::uint64_t> SliceBandBytes(const SvoReader& reader, const SliceSpec& slice,
-                                       const SliceOptions& options) {
+namespace {
+
+// The canvas of a paged file's slice; bad input (level, index, size) names the file.
+StatusOr<SliceCanvas> PagedCanvas(const SvoReader& reader, const SliceSpec& slice,
+                                  const SliceOptions& options) {
   if (options.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, *options.level));
   StatusOr<SliceCanvas> canvas =
       SliceCanvas::Make(reader.grid().dims(), reader.depth(), reader.depth(), slice, options);
   if (!canvas.ok()) return canvas.status().WithContext(reader.name());
+  return canvas;
+}
+
+}  // namespace
+
+StatusOr<std::uint64_t> SliceBandBytes(const SvoReader& reader, const SliceSpec& slice,
+                                       const SliceOptions& options) {
+  StatusOr<SliceCanvas> canvas = PagedCanvas(reader, slice, options);
+  if (!canvas.ok()) return canvas.status();
   return canvas->BandBytes(reader.page_level());
 }
 
 Status StreamSlice(const SvoReader& reader, const SliceSpec& slice, const SliceOptions& options,
                    std::uint64_t memory_limit, const SliceRows& rows, Progress::Stage* stage) {
-  if (options.level) SVOKIT_RETURN_IF_ERROR(CheckSvoLevel(reader, *options.level));
-  StatusOr<SliceCanvas> canvas =
-      SliceCanvas::Make(reader.grid().dims(), reader.depth(), reader.depth(), slice, options);
-  if (!canvas.ok()) return canvas.status().WithContext(reader.name());
+  StatusOr<SliceCanvas> canvas = PagedCanvas(reader, slice, options);
+  if (!canvas.ok()) return canvas.status();
   const std::uint32_t level = canvas->level(), page_level = reader.page_level();
   // The top levels are held whole (as the statistics hold them); their nodes of the page level
   // are pages.

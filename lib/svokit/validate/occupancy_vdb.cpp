@@ -33,13 +33,6 @@ struct SnappedMesh {
   // Per triangle and segment, when some material reads alpha: 1 where the primitive's material
   // does, so its voxels may be holes (none is then required). Empty: every primitive is opaque.
   std::vector<std::uint8_t> triangle_holes, segment_holes;
-
-  std::size_t polygonCount() const { return triangles.size(); }
-  std::size_t pointCount() const { return points.size(); }
-  std::size_t vertexCount(std::size_t) const { return 3; }
-  void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
-    pos = points[triangles[n][v]];
-  }
 };
 
 // `solid`: the file's interior is filled, so alpha made no holes (it is off for solids).
@@ -132,10 +125,11 @@ struct Located {
   double distance;  // voxels
 };
 
-// OpenVDB cuts every triangle wider than 16 voxels of a mesh under 1000 polygons into four, as
-// tasks, recursively (VoxelizePolygons::evalTriangle); the pieces flood their shared edges again.
-// A cube's few dozen triangles need no tasks: this view counts 1000 polygons, the extra ones
-// without corners, which the voxelizer skips.
+// A SnappedMesh's triangles as meshToVolume reads a mesh. OpenVDB cuts every triangle wider than
+// 16 voxels of a mesh under 1000 polygons into four, as tasks, recursively
+// (VoxelizePolygons::evalTriangle); the pieces flood their shared edges again. A cube's few dozen
+// triangles need no tasks: this view counts 1000 polygons, the extra ones without corners, which
+// the voxelizer skips.
 struct UnsplitMesh {
   static constexpr std::size_t kPolygons = 1000;
   const SnappedMesh* mesh;
@@ -144,7 +138,7 @@ struct UnsplitMesh {
   std::size_t pointCount() const { return mesh->points.size(); }
   std::size_t vertexCount(std::size_t n) const { return n < mesh->triangles.size() ? 3 : 0; }
   void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
-    mesh->getIndexSpacePoint(n, v, pos);
+    pos = mesh->points[mesh->triangles[n][v]];
   }
 };
 
